@@ -1,0 +1,35 @@
+# The two commands of the README. Both install what is missing, then configure and build
+# (Release, in build/), then run.
+#   make demo   the main job
+#   make test   every test, through ctest
+BUILD_DIR ?= build
+BUILD_TYPE ?= Release
+JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+PIXELGYM := $(BUILD_DIR)/examples/pixelgym
+
+.PHONY: all deps configure build demo test bench clean
+
+all: build
+
+deps:
+	scripts/install-deps.sh
+
+configure: deps
+	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE)
+
+build: configure
+	cmake --build $(BUILD_DIR) --parallel $(JOBS)
+
+# The main job until the trainer lands: a random policy on GridWorld-v0, returns printed and a
+# snapshot written to runs/demo/.
+demo: build
+	$(PIXELGYM) rollout GridWorld-v0 --episodes 5 --seed 0 --snapshot runs/demo/gridworld.png
+
+test: build
+	ctest --test-dir $(BUILD_DIR) --output-on-failure --parallel $(JOBS)
+
+bench: build
+	$(BUILD_DIR)/bench/envs_bench
+
+clean:
+	rm -rf $(BUILD_DIR)

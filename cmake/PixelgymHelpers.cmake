@@ -1,0 +1,44 @@
+# Helpers shared by every folder's CMakeLists.txt.
+
+# pixelgym_set_warnings(target): the warning flags for pixelgym's own code; errors when
+# PIXELGYM_WERROR is on. Third-party headers come in through imported targets, which CMake
+# marks SYSTEM, so their warnings do not count.
+function(pixelgym_set_warnings target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor
+                                           -Woverloaded-virtual -Wcast-align -Wnull-dereference)
+  if(PIXELGYM_WERROR)
+    target_compile_options(${target} PRIVATE -Werror)
+  endif()
+endfunction()
+
+# pixelgym_add_library(NAME SOURCES ... DEPS ...): library pixelgym_NAME with alias
+# pixelgym::NAME; headers are included as "NAME/file.h" from the project root.
+function(pixelgym_add_library name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  add_library(pixelgym_${name} ${ARG_SOURCES})
+  add_library(pixelgym::${name} ALIAS pixelgym_${name})
+  target_compile_features(pixelgym_${name} PUBLIC cxx_std_17)
+  target_include_directories(pixelgym_${name} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>)
+  target_link_libraries(pixelgym_${name} PUBLIC ${ARG_DEPS})
+  set_target_properties(pixelgym_${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  pixelgym_set_warnings(pixelgym_${name})
+endfunction()
+
+# pixelgym_add_test(SOURCE LIBS ...): one GoogleTest executable per test file, named after its
+# path under tests/ (tests/envs/array_test.cc -> envs_array_test), its tests registered with
+# ctest by gtest_discover_tests at test time. Tests run in the build tree with
+# PIXELGYM_TEST_OUTPUT_DIR naming where they may write files a person should look at.
+function(pixelgym_add_test source)
+  cmake_parse_arguments(ARG "" "" "LIBS" ${ARGN})
+  file(RELATIVE_PATH relative ${PROJECT_SOURCE_DIR}/tests ${CMAKE_CURRENT_SOURCE_DIR}/${source})
+  string(REGEX REPLACE "\\.cc$" "" target ${relative})
+  string(REPLACE "/" "_" target ${target})
+  add_executable(${target} ${source})
+  target_link_libraries(${target} PRIVATE ${ARG_LIBS} GTest::gmock GTest::gtest_main)
+  target_compile_definitions(${target} PRIVATE
+    PIXELGYM_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+    PIXELGYM_TEST_OUTPUT_DIR="${PROJECT_BINARY_DIR}/test_output")
+  pixelgym_set_warnings(${target})
+  gtest_discover_tests(${target} DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60
+                       WORKING_DIRECTORY ${PROJECT_BINARY_DIR})
+endfunction()

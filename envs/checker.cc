@@ -1,0 +1,185 @@
+#include "envs/checker.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <sstream>
+
+namespace pixelgym {
+namespace {
+
+// A failed check: thrown inside a check to stop it with a reason.
+struct CheckFailure {
+  std::string reason;
+};
+
+void expect(bool condition, const std::string& reason) {
+  if (!condition) throw CheckFailure{reason};
+}
+
+void expect_in_space(const Space& space, const Value& value, const std::string& what) {
+  const std::string reason = space.mismatch(value);
+  expect(reason.empty(), what + " " + value.to_string() + " is not in " + space.to_string() +
+                             ": " + reason);
+}
+
+// One step of a recorded trajectory.
+struct Transition {
+  Value obs;
+  double reward;
+  bool terminated;
+  bool truncated;
+};
+
+// reset(seed), then `num_steps` actions from a generator seeded with `seed`, resetting (unseeded)
+// when an episode ends. Every transition is recorded; observations are checked as they come.
+std::vector<Transition> rollout(Env& env, std::uint64_t seed, int num_steps) {
+  std::vector<Transition> trajectory;
+  Rng action_rng(seed);
+  Value obs = env.reset(seed).obs;
+  trajectory.push_back({obs, 0.0, false, false});
+  for (int t = 0; t < num_steps; ++t) {
+    const Value action = env.action_space().sample(action_rng);
+    StepResult step = env.step(action);
+    trajectory.push_back({step.obs, step.reward, step.terminated, step.truncated});
+    if (step.terminated || step.truncated) trajectory.push_back({env.reset().obs, 0.0, false, false});
+  }
+  return trajectory;
+}
+
+void check_space_samples(const Space& space) {
+  Rng rng(12345);
+  constexpr int kSamples = 16;
+  expect(!space.to_string().empty(), "to_string() is empty");
+  for (int i = 0; i < kSamples; ++i) {
+    const Value sample = space.sample(rng);
+    const std::string reason = space.mismatch(sample);
+    expect(reason.empty(), "sample " + std::to_string(i) + " " + sample.to_string() +
+                               " is not in its own space " + space.to_string() + ": " + reason);
+  }
+}
+
+}  // namespace
+
+bool CheckReport::passed() const {
+  return std::all_of(results.begin(), results.end(), [](const CheckResult& r) { return r.passed; });
+}
+
+std::vector<CheckResult> CheckReport::failures() const {
+  std::vector<CheckResult> failed;
+  std::copy_if(results.begin(), results.end(), std::back_inserter(failed),
+               [](const CheckResult& r) { return !r.passed; });
+  return failed;
+}
+
+CheckReport check_env(Env& env, const CheckOptions& options) {
+  CheckReport report;
+  const std::uint64_t seed = options.seed;
+  const auto run = [&](const std::string& name, const std::function<void()>& check) {
+    CheckResult result{name, true, ""};
+    try {
+      check();
+    } catch (const CheckFailure& failure) {
+      result = {name, false, failure.reason};
+    } catch (const std::exception& error) {
+      result = {name, false, std::string("threw: ") + error.what()};
+    }
+    report.results.push_back(result);
+  };
+
+  run("observation_space", [&] { check_space_samples(env.observation_space()); });
+  run("action_space", [&] { check_space_samples(env.action_space()); });
+
+  run("reset", [&] {
+    expect_in_space(env.observation_space(), env.reset(seed).obs, "reset(seed) observation");
+  });
+
+  run("reset_seed", [&] {
+    const Value first = env.reset(seed).obs;
+    const Value second = env.reset(seed).obs;
+    expect(first.equals(second), "reset(seed=" + std::to_string(seed) + ") twice gave " +
+                                     first.to_string() + " then " + second.to_string());
+  });
+
+  run("reset_unseeded", [&] {
+    const Value seeded = env.reset(seed).obs;
+    const Value next = env.reset().obs;
+    const Value next_again = (env.reset(seed), env.reset().obs);
+    expect(next.equals(next_again),
+           "reset() after reset(seed) is not repeatable: the generator is not the seeded one");
+    const Value other_seeded = env.reset(seed + 1).obs;
+    const Value other_next = env.reset().obs;
+    // Only envs whose start depends on the seed can show a reseed to a fixed state.
+    if (!seeded.equals(other_seeded)) {
+      expect(!next.equals(other_next),
+             "reset() gave the same observation after reset(seed) with seeds " +
+                 std::to_string(seed) + " and " + std::to_string(seed + 1) +
+                 ": unseeded resets must continue the generator, not reseed it");
+    }
+  });
+
+  run("step", [&] {
+    std::vector<Transition> trajectory = rollout(env, seed, options.num_steps);
+    for (std::size_t i = 0; i < trajectory.size(); ++i) {
+      expect_in_space(env.observation_space(), trajectory[i].obs,
+                      "observation " + std::to_string(i));
+      expect(std::isfinite(trajectory[i].reward),
+             "reward " + std::to_string(trajectory[i].reward) + " at transition " +
+                 std::to_string(i) + " is not finite");
+    }
+  });
+
+  run("step_determinism", [&] {
+    const std::vector<Transition> a = rollout(env, seed, options.num_steps);
+    const std::vector<Transition> b = rollout(env, seed, options.num_steps);
+    expect(a.size() == b.size(), "two runs with seed " + std::to_string(seed) +
+                                     " had different episode boundaries");
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      const std::string where = " differ at transition " + std::to_string(i) + " of two runs with seed " +
+                                std::to_string(seed) + " and the same actions";
+      expect(a[i].obs.equals(b[i].obs), "observations" + where);
+      expect(a[i].reward == b[i].reward || (std::isnan(a[i].reward) && std::isnan(b[i].reward)),
+             "rewards" + where);
+      expect(a[i].terminated == b[i].terminated && a[i].truncated == b[i].truncated,
+             "terminated/truncated flags" + where);
+    }
+  });
+
+  run("observation_aliasing", [&] {
+    const std::vector<Transition> trajectory = rollout(env, seed, std::min(options.num_steps, 10));
+    for (std::size_t i = 1; i < trajectory.size(); ++i) {
+      expect(!trajectory[i].obs.shares_memory(trajectory[i - 1].obs),
+             "observations " + std::to_string(i - 1) + " and " + std::to_string(i) +
+                 " share memory: the env must return a new buffer each step");
+    }
+  });
+
+  run("render", [&] {
+    env.reset(seed);
+    const Array frame = env.render();
+    const Shape& shape = frame.shape();
+    expect(frame.dtype() == DType::kUInt8 && shape.size() == 3 && shape[2] == 3 && shape[0] > 0 &&
+               shape[1] > 0,
+           std::string("render() returned ") + dtype_name(frame.dtype()) + " " +
+               shape_to_string(shape) + ", expected uint8 (H, W, 3) with H, W > 0");
+  });
+
+  run("metadata", [&] {
+    const Metadata& metadata = env.metadata();
+    const auto& modes = metadata.render_modes;
+    expect(std::find(modes.begin(), modes.end(), "rgb_array") != modes.end(),
+           "render_modes does not include \"rgb_array\"");
+    std::ostringstream fps;
+    fps << metadata.render_fps;
+    expect(std::isfinite(metadata.render_fps) && metadata.render_fps > 0,
+           "render_fps must be > 0, got " + fps.str());
+  });
+
+  run("close", [&] {
+    env.close();
+    env.close();
+  });
+  return report;
+}
+
+}  // namespace pixelgym

@@ -1,0 +1,142 @@
+#include "envs/registry.h"
+
+#include <algorithm>
+#include <cctype>
+#include <regex>
+#include <stdexcept>
+
+#include "envs/tasks/builtin.h"
+#include "envs/time_limit.h"
+
+namespace pixelgym {
+namespace {
+
+constexpr const char* kMaxEpisodeStepsKey = "max_episode_steps";
+
+std::string lowercase(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return text;
+}
+
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+}  // namespace
+
+void Registry::register_env(EnvSpec spec) {
+  static const std::regex kIdPattern("[A-Za-z][A-Za-z0-9_]*-v[0-9]+");
+  if (!std::regex_match(spec.id, kIdPattern)) {
+    throw std::invalid_argument("register_env: id \"" + spec.id +
+                                "\" is not of the form Name-vN (e.g. CartPoleSwingup-v0)");
+  }
+  if (!spec.factory) throw std::invalid_argument("register_env: " + spec.id + " has no factory");
+  for (const ParamSpec& param : spec.params) {
+    if (param.name == kMaxEpisodeStepsKey) {
+      throw std::invalid_argument("register_env: " + spec.id +
+                                  ": the kwarg name max_episode_steps is reserved for make()");
+    }
+  }
+  if (spec.max_episode_steps && *spec.max_episode_steps <= 0) {
+    throw std::invalid_argument("register_env: " + spec.id + ": max_episode_steps must be positive");
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (const auto& existing : specs_) {
+    if (existing->id == spec.id) {
+      throw std::invalid_argument("register_env: " + spec.id + " is already registered");
+    }
+  }
+  specs_.push_back(std::make_shared<const EnvSpec>(std::move(spec)));
+}
+
+std::shared_ptr<const EnvSpec> Registry::spec(const std::string& id) const {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& spec : specs_) {
+      if (spec->id == id) return spec;
+    }
+  }
+  std::string message = "unknown env id \"" + id + "\"";
+  const std::vector<std::string> closest = closest_ids(id);
+  if (closest.empty()) {
+    message += "; no envs are registered";
+  } else {
+    message += "; did you mean ";
+    for (std::size_t i = 0; i < closest.size(); ++i) {
+      message += (i == 0 ? "" : i + 1 == closest.size() ? " or " : ", ") + closest[i];
+    }
+    message += "? (`pixelgym list` shows all " + std::to_string(registered_ids().size()) + ")";
+  }
+  throw std::invalid_argument(message);
+}
+
+std::unique_ptr<Env> Registry::make(const std::string& id, const Params& kwargs) const {
+  const std::shared_ptr<const EnvSpec> env_spec = spec(id);
+  std::vector<ParamSpec> accepted = env_spec->params;
+  accepted.push_back({kMaxEpisodeStepsKey,
+                      Param(env_spec->max_episode_steps ? *env_spec->max_episode_steps : 0),
+                      "steps before TimeLimit truncates the episode; 0 for no limit"});
+  Params resolved = resolve_params(accepted, kwargs, id);
+  const std::int64_t max_episode_steps = resolved.at(kMaxEpisodeStepsKey).as_int();
+  if (max_episode_steps < 0) {
+    throw std::invalid_argument(id + ": kwarg \"max_episode_steps\" must be >= 0 (0: no limit), got " +
+                                std::to_string(max_episode_steps));
+  }
+  resolved.erase(kMaxEpisodeStepsKey);
+
+  std::unique_ptr<Env> env = env_spec->factory(resolved);
+  if (env == nullptr) throw std::runtime_error(id + ": the registered factory returned null");
+  env->set_spec(env_spec);
+  if (max_episode_steps > 0) env = std::make_unique<TimeLimit>(std::move(env), max_episode_steps);
+  return env;
+}
+
+std::vector<std::string> Registry::registered_ids() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<std::string> ids;
+  for (const auto& spec : specs_) ids.push_back(spec->id);
+  std::sort(ids.begin(), ids.end());
+  return ids;
+}
+
+std::vector<std::string> Registry::closest_ids(const std::string& id, std::size_t count) const {
+  std::vector<std::pair<std::size_t, std::string>> ranked;
+  for (const std::string& candidate : registered_ids()) {
+    ranked.emplace_back(edit_distance(lowercase(id), lowercase(candidate)), candidate);
+  }
+  std::sort(ranked.begin(), ranked.end());
+  std::vector<std::string> closest;
+  for (std::size_t i = 0; i < ranked.size() && i < count; ++i) closest.push_back(ranked[i].second);
+  return closest;
+}
+
+Registry& default_registry() {
+  static Registry* registry = [] {
+    static Registry instance;
+    register_builtin_envs(instance);
+    return &instance;
+  }();
+  return *registry;
+}
+
+std::unique_ptr<Env> make(const std::string& id, const Params& kwargs) {
+  return default_registry().make(id, kwargs);
+}
+
+void register_env(EnvSpec spec) { default_registry().register_env(std::move(spec)); }
+
+std::vector<std::string> registered_ids() { return default_registry().registered_ids(); }
+
+}  // namespace pixelgym

@@ -1,0 +1,69 @@
+// Registry: env ids to factories — make(), register_env(), registered_ids() (gymnasium.make).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "envs/env.h"
+#include "envs/params.h"
+
+namespace pixelgym {
+
+/// How to make one registered env.
+struct EnvSpec {
+  /// "Name-vN": changing a task's dynamics, reward or observation bumps N.
+  std::string id;
+  /// One line for `pixelgym list`.
+  std::string description;
+  /// The kwargs the env accepts, with types, defaults and docs (its Config's fields).
+  std::vector<ParamSpec> params;
+  /// When set, `make` wraps the env in TimeLimit with this many steps.
+  std::optional<std::int64_t> max_episode_steps;
+  /// Builds the env from kwargs already resolved against `params` (every key present, typed).
+  std::function<std::unique_ptr<Env>(const Params& kwargs)> factory;
+};
+
+/// A set of env specs. The process-wide default one (used by the free functions below) holds
+/// the built-in envs; tests build their own. Thread-safe.
+class Registry {
+ public:
+  /// Adds `spec`. Throws std::invalid_argument for an id not of the form Name-vN, an id already
+  /// registered, a missing factory, or a param named "max_episode_steps" (reserved for make).
+  void register_env(EnvSpec spec);
+
+  /// Builds env `id` with `kwargs`, wrapped in TimeLimit when the spec (or the reserved kwarg
+  /// "max_episode_steps") sets a limit. Throws std::invalid_argument for an unknown id (naming
+  /// the closest registered ids), an unknown kwarg (listing the valid ones with types and
+  /// defaults) or a kwarg of the wrong type.
+  std::unique_ptr<Env> make(const std::string& id, const Params& kwargs = {}) const;
+
+  /// The spec registered as `id`; throws like `make` for an unknown id.
+  std::shared_ptr<const EnvSpec> spec(const std::string& id) const;
+
+  /// Every registered id, sorted.
+  std::vector<std::string> registered_ids() const;
+
+  /// Up to `count` registered ids ordered by edit distance to `id` (case-insensitive).
+  std::vector<std::string> closest_ids(const std::string& id, std::size_t count = 3) const;
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<std::shared_ptr<const EnvSpec>> specs_;
+};
+
+/// The process-wide registry, holding the built-in envs.
+Registry& default_registry();
+
+/// `default_registry().make(id, kwargs)`.
+std::unique_ptr<Env> make(const std::string& id, const Params& kwargs = {});
+/// `default_registry().register_env(spec)`.
+void register_env(EnvSpec spec);
+/// `default_registry().registered_ids()`.
+std::vector<std::string> registered_ids();
+
+}  // namespace pixelgym

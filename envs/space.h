@@ -1,0 +1,62 @@
+// Space: the set of valid observations or actions, as in gymnasium.spaces.Space.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "envs/array.h"
+#include "envs/rng.h"
+#include "envs/value.h"
+
+namespace pixelgym {
+
+/// Base of every space. Spaces are immutable after construction except for the generator that
+/// the argument-less `sample()` uses, which `seed()` resets (as Gymnasium's `space.seed`). That
+/// generator makes sampling through one space object not thread-safe; `sample(rng)` with a
+/// generator of your own is.
+class Space {
+ public:
+  virtual ~Space() = default;
+
+  /// A random element of this space drawn from `rng`.
+  virtual Value sample(Rng& rng) const = 0;
+  /// A random element drawn from this space's own generator (seeded from entropy unless
+  /// `seed()` was called).
+  Value sample() const;
+  /// Reseeds this space's own generator; returns the seed used (drawn from entropy when none is
+  /// given).
+  std::uint64_t seed(std::optional<std::uint64_t> seed = std::nullopt) const;
+
+  /// True when `value` is an element of this space: right structure, dtype, shape and bounds.
+  bool contains(const Value& value) const { return mismatch(value).empty(); }
+  /// Why `value` is not an element ("dtype float32, expected int64"), or "" when it is.
+  virtual std::string mismatch(const Value& value) const = 0;
+
+  /// The shape of an element; std::nullopt for Dict and Tuple spaces (as in Gymnasium).
+  virtual std::optional<Shape> shape() const = 0;
+  /// The dtype of an element; std::nullopt for Dict and Tuple spaces.
+  virtual std::optional<DType> dtype() const = 0;
+  /// Gymnasium's notation: "Box(-1.0, 1.0, (1,), float32)", "Discrete(4)".
+  virtual std::string to_string() const = 0;
+  /// Same kind and same parameters (bounds, sizes, keys...).
+  virtual bool equals(const Space& other) const = 0;
+
+ protected:
+  Space() = default;
+  Space(const Space&) = default;
+  Space& operator=(const Space&) = default;
+
+ private:
+  mutable std::optional<Rng> rng_;
+};
+
+/// Spaces are shared, never copied: a Dict space holds its subspaces this way.
+using SpacePtr = std::shared_ptr<const Space>;
+
+/// Throws std::invalid_argument "<context>: <value> is not in <space>: <reason>" unless `space`
+/// contains `value`.
+void require_contains(const Space& space, const Value& value, const std::string& context);
+
+}  // namespace pixelgym

@@ -1,0 +1,86 @@
+#include "envs/spaces/dict.h"
+
+#include <stdexcept>
+
+namespace pixelgym::spaces {
+namespace {
+
+std::string key_list(const Dict::Entries& entries) {
+  std::string text;
+  for (const auto& entry : entries) text += (text.empty() ? "\"" : ", \"") + entry.first + "\"";
+  return text.empty() ? "none" : text;
+}
+
+}  // namespace
+
+Dict::Dict(Entries entries) : entries_(std::move(entries)) {
+  for (std::size_t i = 0; i < entries_.size(); ++i) {
+    const std::string& key = entries_[i].first;
+    if (key.empty()) throw std::invalid_argument("spaces::Dict: empty key");
+    if (entries_[i].second == nullptr) {
+      throw std::invalid_argument("spaces::Dict: subspace \"" + key + "\" is null");
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (entries_[j].first == key) {
+        throw std::invalid_argument("spaces::Dict: duplicate key \"" + key + "\"");
+      }
+    }
+  }
+}
+
+Value Dict::sample(Rng& rng) const {
+  pixelgym::Dict value;
+  for (const auto& [key, space] : entries_) value.insert(key, space->sample(rng));
+  return value;
+}
+
+std::string Dict::mismatch(const Value& value) const {
+  if (!value.is_dict()) return std::string("expected a Dict, got a ") + value.kind();
+  const pixelgym::Dict& dict = value.dict();
+  for (const auto& [key, space] : entries_) {
+    if (!dict.contains(key)) return "missing key \"" + key + "\"";
+    const std::string reason = space->mismatch(dict.at(key));
+    if (!reason.empty()) return "key \"" + key + "\": " + reason;
+  }
+  for (const std::string& key : dict.keys()) {
+    if (!has(key)) return "unexpected key \"" + key + "\" (expected " + key_list(entries_) + ")";
+  }
+  return "";
+}
+
+std::string Dict::to_string() const {
+  std::string text = "Dict(";
+  for (std::size_t i = 0; i < entries_.size(); ++i) {
+    if (i > 0) text += ", ";
+    text += "'" + entries_[i].first + "': " + entries_[i].second->to_string();
+  }
+  return text + ")";
+}
+
+bool Dict::equals(const Space& other) const {
+  const auto* dict = dynamic_cast<const Dict*>(&other);
+  if (dict == nullptr || dict->entries_.size() != entries_.size()) return false;
+  for (std::size_t i = 0; i < entries_.size(); ++i) {
+    if (dict->entries_[i].first != entries_[i].first ||
+        !dict->entries_[i].second->equals(*entries_[i].second)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+bool Dict::has(const std::string& key) const {
+  for (const auto& entry : entries_) {
+    if (entry.first == key) return true;
+  }
+  return false;
+}
+
+const Space& Dict::at(const std::string& key) const {
+  for (const auto& entry : entries_) {
+    if (entry.first == key) return *entry.second;
+  }
+  throw std::out_of_range("spaces::Dict: no key \"" + key + "\" (keys: " + key_list(entries_) + ")");
+}
+
+}  // namespace pixelgym::spaces

@@ -1,0 +1,38 @@
+// spaces::Dict: an ordered mapping of named subspaces, as gymnasium.spaces.Dict.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "envs/space.h"
+
+namespace pixelgym::spaces {
+
+/// Elements are pixelgym::Dict values with exactly these keys, each value in its subspace.
+/// Keys keep the order given (pixel tasks list "pixels" first, then state arrays).
+class Dict final : public Space {
+ public:
+  using Entries = std::vector<std::pair<std::string, SpacePtr>>;
+
+  /// Throws std::invalid_argument for an empty or duplicate key or a null subspace.
+  explicit Dict(Entries entries);
+
+  using Space::sample;
+  Value sample(Rng& rng) const override;
+  std::string mismatch(const Value& value) const override;
+  std::optional<Shape> shape() const override { return std::nullopt; }
+  std::optional<DType> dtype() const override { return std::nullopt; }
+  std::string to_string() const override;
+  bool equals(const Space& other) const override;
+
+  const Entries& entries() const { return entries_; }
+  bool has(const std::string& key) const;
+  /// Throws std::out_of_range naming the key and the keys present.
+  const Space& at(const std::string& key) const;
+
+ private:
+  Entries entries_;
+};
+
+}  // namespace pixelgym::spaces

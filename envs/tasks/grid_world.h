@@ -1,0 +1,79 @@
+// GridWorld-v0: the 4x4 gridworld every RL course starts from.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+
+#include "envs/env.h"
+#include "envs/registry.h"
+
+namespace pixelgym {
+
+/// Settings of GridWorld (its `make` kwargs).
+struct GridWorldConfig {
+  /// Size of `render()` frames in pixels.
+  int render_width = 256;
+  int render_height = 256;
+
+  /// The kwargs above with their defaults and docs.
+  static std::vector<ParamSpec> params();
+  /// Reads resolved kwargs. Throws std::invalid_argument for a size outside [16, 8192].
+  static GridWorldConfig from_params(const Params& params);
+};
+
+/// A 4x4 grid. The agent (blue) starts in the top-left cell; the goal (green) is the
+/// bottom-right cell; one wall cell (gray) at row 1, column 1 blocks movement.
+///
+/// - Actions: Discrete(4), in Gymnasium FrozenLake's order: 0 left, 1 down, 2 right, 3 up. A
+///   move into the wall or off the grid leaves the agent where it is.
+/// - Observation: Discrete(16), the agent's cell as row * 4 + column.
+/// - Reward: +1.0 on the step that reaches the goal, which terminates the episode; -0.04 on
+///   every other step.
+/// - The registered spec truncates after 50 steps (TimeLimit).
+/// The start is fixed, so the generator is not used; seeding still works as for every env.
+class GridWorld final : public Env {
+ public:
+  static constexpr int kSize = 4;
+  enum Action : std::int64_t { kLeft = 0, kDown = 1, kRight = 2, kUp = 3 };
+  struct Cell {
+    int row;
+    int col;
+    friend bool operator==(Cell a, Cell b) { return a.row == b.row && a.col == b.col; }
+  };
+  static constexpr Cell kStart{0, 0};
+  static constexpr Cell kGoal{3, 3};
+  static constexpr Cell kWall{1, 1};
+  static constexpr double kStepReward = -0.04;
+  static constexpr double kGoalReward = 1.0;
+  static constexpr std::int64_t kMaxEpisodeSteps = 50;
+
+  explicit GridWorld(GridWorldConfig config = {});
+
+  const Space& observation_space() const override { return *observation_space_; }
+  const Space& action_space() const override { return *action_space_; }
+  const Metadata& metadata() const override { return metadata_; }
+
+  /// Where the agent is now.
+  Cell agent() const { return agent_; }
+
+  /// The registry entry for GridWorld-v0.
+  static EnvSpec spec_v0();
+
+ protected:
+  std::string type_name() const override { return "GridWorld"; }
+  ResetResult do_reset(std::optional<std::uint64_t> seed, const Options& options) override;
+  StepResult do_step(const Value& action) override;
+  Array do_render() override;
+
+ private:
+  Value observe() const;
+
+  GridWorldConfig config_;
+  SpacePtr observation_space_;
+  SpacePtr action_space_;
+  Metadata metadata_;
+  Cell agent_ = kStart;
+};
+
+}  // namespace pixelgym

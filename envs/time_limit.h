@@ -1,0 +1,32 @@
+// TimeLimit: truncates episodes after a number of steps (gymnasium.wrappers.TimeLimit).
+#pragma once
+
+#include <cstdint>
+
+#include "envs/wrapper.h"
+
+namespace pixelgym {
+
+/// Sets `truncated` on the step that makes the episode `max_episode_steps` long. It lives in
+/// envs/ rather than wrappers/ because the registry applies it to every env whose spec has
+/// `max_episode_steps`.
+class TimeLimit final : public Wrapper {
+ public:
+  /// Throws std::invalid_argument unless max_episode_steps > 0.
+  TimeLimit(std::unique_ptr<Env> env, std::int64_t max_episode_steps);
+
+  std::int64_t max_episode_steps() const { return max_episode_steps_; }
+  /// Steps taken in the current episode.
+  std::int64_t elapsed_steps() const { return elapsed_steps_; }
+
+ protected:
+  std::string type_name() const override { return "TimeLimit"; }
+  ResetResult do_reset(std::optional<std::uint64_t> seed, const Options& options) override;
+  StepResult do_step(const Value& action) override;
+
+ private:
+  std::int64_t max_episode_steps_;
+  std::int64_t elapsed_steps_ = 0;
+};
+
+}  // namespace pixelgym

@@ -1,0 +1,93 @@
+// Value: what an observation, an action or an info entry is — an Array, a Dict or a Tuple.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "envs/array.h"
+
+namespace pixelgym {
+
+class Value;
+
+/// An ordered map from string keys to Values (insertion order is kept, as in Gymnasium's Dict).
+class Dict {
+ public:
+  Dict() = default;
+  Dict(std::initializer_list<std::pair<std::string, Value>> entries);
+
+  /// Adds `key`, or replaces its value when present (keeping its position).
+  void insert(const std::string& key, Value value);
+  bool contains(const std::string& key) const;
+  /// Throws std::out_of_range naming the key and the keys present.
+  const Value& at(const std::string& key) const;
+  Value& at(const std::string& key);
+  std::size_t size() const { return keys_.size(); }
+  bool empty() const { return keys_.empty(); }
+  const std::vector<std::string>& keys() const { return keys_; }
+  const std::vector<Value>& values() const { return values_; }
+  std::vector<Value>& values() { return values_; }
+
+ private:
+  std::ptrdiff_t find(const std::string& key) const;
+
+  std::vector<std::string> keys_;
+  std::vector<Value> values_;
+};
+
+/// A fixed-length sequence of Values.
+class Tuple {
+ public:
+  Tuple() = default;
+  Tuple(std::initializer_list<Value> items);
+  explicit Tuple(std::vector<Value> items);
+
+  std::size_t size() const { return items_.size(); }
+  /// Throws std::out_of_range.
+  const Value& at(std::size_t i) const;
+  const std::vector<Value>& items() const { return items_; }
+
+ private:
+  std::vector<Value> items_;
+};
+
+/// One of Array, Dict or Tuple. Copies are shallow for the arrays inside (they share memory).
+class Value {
+ public:
+  Value();  // an empty Array
+  Value(Array array);  // NOLINT(google-explicit-constructor): arrays are values
+  Value(Dict dict);    // NOLINT(google-explicit-constructor)
+  Value(Tuple tuple);  // NOLINT(google-explicit-constructor)
+
+  bool is_array() const { return std::holds_alternative<Array>(data_); }
+  bool is_dict() const { return std::holds_alternative<Dict>(data_); }
+  bool is_tuple() const { return std::holds_alternative<Tuple>(data_); }
+
+  /// The held alternative; each throws std::invalid_argument naming what is held instead.
+  const Array& array() const;
+  Array& array();
+  const Dict& dict() const;
+  Dict& dict();
+  const Tuple& tuple() const;
+
+  /// "array", "Dict" or "Tuple".
+  const char* kind() const;
+  /// A deep copy: no array in the result shares memory with this one.
+  Value clone() const;
+  /// Same structure, keys, dtypes, shapes and bytes.
+  bool equals(const Value& other) const;
+  /// True when any array in this value shares memory with any array in `other`.
+  bool shares_memory(const Value& other) const;
+  /// Every array in this value, depth first in key / item order.
+  std::vector<Array> leaves() const;
+  /// A readable description for messages: Array::to_string, or Dict{"key": ..., ...}.
+  std::string to_string() const;
+
+ private:
+  std::variant<Array, Dict, Tuple> data_;
+};
+
+}  // namespace pixelgym

@@ -1,0 +1,86 @@
+// Wrapper bases: Wrapper, ObservationWrapper, ActionWrapper, RewardWrapper (as in Gymnasium).
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "envs/env.h"
+
+namespace pixelgym {
+
+/// An env that owns another and, by default, passes every call through to it.
+///
+/// Only the protocol is forwarded: spaces, metadata, spec, reset/step/render/close. There is no
+/// implicit forwarding of anything else (Gymnasium 1.x dropped `__getattr__` forwarding too):
+/// reach the inner env with `env()` or the innermost one with `unwrapped()`.
+class Wrapper : public Env {
+ public:
+  /// Throws std::invalid_argument when `env` is null.
+  explicit Wrapper(std::unique_ptr<Env> env);
+
+  const Space& observation_space() const override { return env_->observation_space(); }
+  const Space& action_space() const override { return env_->action_space(); }
+  const Metadata& metadata() const override { return env_->metadata(); }
+  Env& unwrapped() override { return env_->unwrapped(); }
+  const EnvSpec* spec() const override { return env_->spec(); }
+  /// "TimeLimit<GridWorld-v0>".
+  std::string name() const override { return type_name() + "<" + env_->name() + ">"; }
+
+  /// The env one level in.
+  Env& env() { return *env_; }
+  const Env& env() const { return *env_; }
+
+ protected:
+  std::string type_name() const override { return "Wrapper"; }
+  ResetResult do_reset(std::optional<std::uint64_t> seed, const Options& options) override;
+  StepResult do_step(const Value& action) override;
+  Array do_render() override;
+  void do_close() override;
+
+  std::unique_ptr<Env> env_;
+};
+
+/// A wrapper that transforms observations. Subclasses implement `observation()` and, when it
+/// changes the space, call `set_observation_space()` from their constructor.
+class ObservationWrapper : public Wrapper {
+ public:
+  using Wrapper::Wrapper;
+  const Space& observation_space() const override;
+
+ protected:
+  virtual Value observation(const Value& obs) = 0;
+  void set_observation_space(SpacePtr space);
+  ResetResult do_reset(std::optional<std::uint64_t> seed, const Options& options) override;
+  StepResult do_step(const Value& action) override;
+
+ private:
+  SpacePtr observation_space_;  // null: the inner env's
+};
+
+/// A wrapper that transforms actions before the inner env sees them. Subclasses implement
+/// `action()` and, when it changes the space, call `set_action_space()` from their constructor.
+class ActionWrapper : public Wrapper {
+ public:
+  using Wrapper::Wrapper;
+  const Space& action_space() const override;
+
+ protected:
+  virtual Value action(const Value& action) = 0;
+  void set_action_space(SpacePtr space);
+  StepResult do_step(const Value& action) override;
+
+ private:
+  SpacePtr action_space_;  // null: the inner env's
+};
+
+/// A wrapper that transforms rewards. Subclasses implement `reward()`.
+class RewardWrapper : public Wrapper {
+ public:
+  using Wrapper::Wrapper;
+
+ protected:
+  virtual double reward(double reward) = 0;
+  StepResult do_step(const Value& action) override;
+};
+
+}  // namespace pixelgym

@@ -1,0 +1,178 @@
+// pixelgym list | info | check | snapshot | rollout
+#include <cstdio>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "envs/checker.h"
+#include "envs/registry.h"
+#include "examples/pixelgym/cli.h"
+
+namespace pixelgym::cli {
+namespace {
+
+std::string join(const std::vector<std::string>& items) {
+  std::string text;
+  for (const std::string& item : items) text += (text.empty() ? "" : ", ") + item;
+  return text;
+}
+
+int run_list() {
+  for (const std::string& id : registered_ids()) {
+    std::cout << std::left << std::setw(28) << id << " "
+              << default_registry().spec(id)->description << "\n";
+  }
+  return 0;
+}
+
+int run_info(const std::string& id, const std::vector<std::string>& sets) {
+  const auto spec = default_registry().spec(id);
+  std::unique_ptr<Env> env = make_env(id, sets);
+  std::cout << id << ": " << spec->description << "\n"
+            << "observation_space: " << env->observation_space().to_string() << "\n"
+            << "action_space:      " << env->action_space().to_string() << "\n"
+            << "render_modes:      " << join(env->metadata().render_modes) << "\n"
+            << "render_fps:        " << env->metadata().render_fps << "\n"
+            << "max_episode_steps: "
+            << (spec->max_episode_steps ? std::to_string(*spec->max_episode_steps) : "none") << "\n"
+            << "config (--set key=value):\n";
+  for (const ParamSpec& param : spec->params) {
+    std::cout << "  " << std::left << std::setw(18) << param.name << std::setw(8)
+              << param_type_name(param.type()) << "default " << std::setw(10)
+              << param.default_value.to_string() << param.doc << "\n";
+  }
+  std::cout << "  " << std::left << std::setw(18) << "max_episode_steps" << std::setw(8) << "int"
+            << "default " << std::setw(10)
+            << (spec->max_episode_steps ? std::to_string(*spec->max_episode_steps) : "0")
+            << "steps before TimeLimit truncates; 0 for no limit\n";
+  env->close();
+  return 0;
+}
+
+int run_check(const std::string& id, std::uint64_t seed, int steps,
+              const std::vector<std::string>& sets) {
+  std::unique_ptr<Env> env = make_env(id, sets);
+  const CheckReport report = check_env(*env, {seed, steps});
+  for (const CheckResult& result : report.results) {
+    std::cout << (result.passed ? "ok    " : "FAIL  ") << result.name;
+    if (!result.passed) std::cout << ": " << result.reason;
+    std::cout << "\n";
+  }
+  const std::size_t failed = report.failures().size();
+  if (failed == 0) {
+    std::cout << id << ": all " << report.results.size() << " checks passed\n";
+    return 0;
+  }
+  std::cout << id << ": " << failed << " of " << report.results.size() << " checks failed\n";
+  return kExitFailure;
+}
+
+int run_snapshot(const std::string& id, std::uint64_t seed, int steps, const std::string& out,
+                 const std::vector<std::string>& sets) {
+  std::unique_ptr<Env> env = make_env(id, sets);
+  env->reset(seed);
+  Rng action_rng(seed);
+  for (int t = 0; t < steps; ++t) {
+    const StepResult step = env->step(env->action_space().sample(action_rng));
+    if (step.terminated || step.truncated) env->reset();
+  }
+  const Array frame = env->render();
+  write_frame_png(out, frame);
+  std::cout << "wrote " << out << " (" << frame.shape()[1] << "x" << frame.shape()[0] << ", "
+            << id << ", seed " << seed << ", " << steps << " steps)\n";
+  env->close();
+  return 0;
+}
+
+int run_rollout(const std::string& id, std::uint64_t seed, int episodes,
+                const std::string& snapshot, const std::vector<std::string>& sets) {
+  std::unique_ptr<Env> env = make_env(id, sets);
+  Rng action_rng(seed);
+  double total = 0.0;
+  for (int episode = 0; episode < episodes; ++episode) {
+    // The first reset seeds the env; later ones continue its generator.
+    env->reset(episode == 0 ? std::optional<std::uint64_t>(seed) : std::nullopt);
+    double episode_return = 0.0;
+    int length = 0;
+    StepResult step;
+    do {
+      step = env->step(env->action_space().sample(action_rng));
+      episode_return += step.reward;
+      ++length;
+    } while (!step.terminated && !step.truncated);
+    total += episode_return;
+    std::cout << "episode " << episode << ": return=" << episode_return << " length=" << length
+              << (step.terminated ? " terminated" : " truncated") << "\n";
+    if (!snapshot.empty() && episode == episodes - 1) write_frame_png(snapshot, env->render());
+  }
+  std::cout << "mean_return=" << total / episodes << " episodes=" << episodes << "\n";
+  if (!snapshot.empty()) std::cout << "wrote " << snapshot << "\n";
+  env->close();
+  return 0;
+}
+
+}  // namespace
+
+std::vector<Command> add_env_commands(CLI::App& app) {
+  // Options live in shared state owned by the returned callbacks.
+  struct Options {
+    std::string id;
+    std::uint64_t seed = 0;
+    int steps = 0;
+    int episodes = 5;
+    std::string out;
+    std::vector<std::string> sets;
+  };
+  auto options = std::make_shared<Options>();
+  std::vector<Command> commands;
+
+  CLI::App* list = app.add_subcommand("list", "List the registered env ids, one per line with a description");
+  commands.push_back({list, [] { return run_list(); }});
+
+  CLI::App* info = app.add_subcommand("info", "Show an env's spaces, metadata and config keys (types, defaults)");
+  info->add_option("id", options->id, "Env id, e.g. GridWorld-v0")->required();
+  add_set_option(*info, options->sets);
+  commands.push_back({info, [options] { return run_info(options->id, options->sets); }});
+
+  CLI::App* check = app.add_subcommand(
+      "check", "Run the env checker; exit 0 when every check passes, 1 otherwise (failures printed)");
+  check->add_option("id", options->id, "Env id, e.g. GridWorld-v0")->required();
+  check->add_option("--seed", options->seed, "Seed for resets and random actions")->capture_default_str();
+  check->add_option("--steps", options->steps, "Random steps per checked trajectory")
+      ->default_val(100)->check(CLI::PositiveNumber);
+  add_set_option(*check, options->sets);
+  commands.push_back({check, [options] {
+                        return run_check(options->id, options->seed, options->steps, options->sets);
+                      }});
+
+  CLI::App* snapshot = app.add_subcommand(
+      "snapshot", "Reset with a seed, take K seeded random actions, write render() as a PNG");
+  snapshot->add_option("id", options->id, "Env id, e.g. GridWorld-v0")->required();
+  snapshot->add_option("--seed", options->seed, "Seed for the reset and the random actions")->required();
+  snapshot->add_option("--out", options->out, "PNG file to write (folders are created)")->required();
+  snapshot->add_option("--steps", options->steps, "Random actions before the frame is taken")
+      ->default_val(0)->check(CLI::NonNegativeNumber);
+  add_set_option(*snapshot, options->sets);
+  commands.push_back({snapshot, [options] {
+                        return run_snapshot(options->id, options->seed, options->steps, options->out,
+                                            options->sets);
+                      }});
+
+  CLI::App* rollout = app.add_subcommand(
+      "rollout", "Run a uniform random policy for some episodes and print each return");
+  rollout->add_option("id", options->id, "Env id, e.g. GridWorld-v0")->required();
+  rollout->add_option("--seed", options->seed, "Seed for the first reset and the random actions")
+      ->capture_default_str();
+  rollout->add_option("--episodes", options->episodes, "Episodes to run")
+      ->capture_default_str()->check(CLI::PositiveNumber);
+  rollout->add_option("--snapshot", options->out, "Write the last episode's final frame to this PNG");
+  add_set_option(*rollout, options->sets);
+  commands.push_back({rollout, [options] {
+                        return run_rollout(options->id, options->seed, options->episodes,
+                                           options->out, options->sets);
+                      }});
+  return commands;
+}
+
+}  // namespace pixelgym::cli

@@ -1,0 +1,36 @@
+// PNG files for rendered images: snapshots, golden images, diff images.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace pixelgym {
+
+/// Interleaved 8-bit pixels, row 0 at the top; `channels` is 1 (gray), 3 (RGB) or 4 (RGBA).
+struct ImageView {
+  const std::uint8_t* pixels = nullptr;
+  int height = 0;
+  int width = 0;
+  int channels = 3;
+};
+
+/// An image read from a file, owning its pixels.
+struct Image {
+  int height = 0;
+  int width = 0;
+  int channels = 3;
+  std::vector<std::uint8_t> pixels;
+  ImageView view() const { return {pixels.data(), height, width, channels}; }
+};
+
+/// Writes `image` as a PNG. The file is complete or absent: it is written beside `path` under a
+/// temporary name and renamed into place. Throws std::invalid_argument for a malformed view and
+/// std::runtime_error naming the path and the reason when it cannot be written.
+void write_png(const std::string& path, const ImageView& image);
+
+/// Reads a PNG as 8-bit gray, RGB or RGBA (palette and 16-bit files are converted). Throws
+/// std::runtime_error naming the path and the reason.
+Image read_png(const std::string& path);
+
+}  // namespace pixelgym

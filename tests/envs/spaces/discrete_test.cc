@@ -1,0 +1,54 @@
+#include "envs/spaces/discrete.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <set>
+
+namespace pixelgym::spaces {
+namespace {
+
+TEST(DiscreteTest, SamplesAreContainedAndCoverTheRangeAcrossSeeds) {
+  const Discrete space(5, -2);
+  std::set<std::int64_t> seen;
+  for (std::uint64_t seed = 0; seed < 200; ++seed) {
+    Rng rng(seed);
+    const Value sample = space.sample(rng);
+    ASSERT_TRUE(space.contains(sample)) << space.mismatch(sample);
+    EXPECT_EQ(sample.array().dtype(), DType::kInt64);
+    seen.insert(sample.array().item<std::int64_t>());
+  }
+  EXPECT_EQ(seen, (std::set<std::int64_t>{-2, -1, 0, 1, 2}));
+}
+
+TEST(DiscreteTest, ContainsRejectsWrongDtypeShapeAndRange) {
+  const Discrete space(4);
+  EXPECT_TRUE(space.contains(Array::scalar<std::int64_t>(3)));
+  EXPECT_TRUE(space.contains(Array::scalar<std::int32_t>(0)));
+  EXPECT_FALSE(space.contains(Array::scalar<std::int64_t>(4)));
+  EXPECT_FALSE(space.contains(Array::scalar<std::int64_t>(-1)));
+  EXPECT_FALSE(space.contains(Array::scalar<double>(1.0)));
+  EXPECT_FALSE(space.contains(Array::scalar<double>(NAN)));
+  EXPECT_FALSE(space.contains(Array::scalar<bool>(true)));
+  EXPECT_FALSE(space.contains(Array::from_vector<std::int64_t>({1}, {1})));
+  EXPECT_FALSE(space.contains(Value(Tuple{})));
+  EXPECT_NE(space.mismatch(Array::scalar<std::int64_t>(4)).find("outside {0, ..., 3}"),
+            std::string::npos);
+}
+
+TEST(DiscreteTest, RejectsNonPositiveN) {
+  EXPECT_THROW(Discrete(0), std::invalid_argument);
+  EXPECT_THROW(Discrete(-3), std::invalid_argument);
+}
+
+TEST(DiscreteTest, ToStringEqualsShape) {
+  EXPECT_EQ(Discrete(4).to_string(), "Discrete(4)");
+  EXPECT_EQ(Discrete(4, 1).to_string(), "Discrete(4, start=1)");
+  EXPECT_TRUE(Discrete(4).equals(Discrete(4)));
+  EXPECT_FALSE(Discrete(4).equals(Discrete(4, 1)));
+  EXPECT_EQ(Discrete(4).shape(), Shape{});
+}
+
+}  // namespace
+}  // namespace pixelgym::spaces

@@ -1,0 +1,49 @@
+#include "envs/spaces/multi_discrete.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace pixelgym::spaces {
+namespace {
+
+TEST(MultiDiscreteTest, SamplesAreContainedAcrossSeeds) {
+  const MultiDiscrete space({3, 2, 5}, {0, 1, -2});
+  for (std::uint64_t seed = 0; seed < 100; ++seed) {
+    Rng rng(seed);
+    const Value sample = space.sample(rng);
+    ASSERT_TRUE(space.contains(sample)) << space.mismatch(sample);
+  }
+}
+
+TEST(MultiDiscreteTest, ContainsRejectsWrongDtypeShapeAndRange) {
+  const MultiDiscrete space({3, 2});
+  EXPECT_TRUE(space.contains(Array::from_vector<std::int64_t>({2}, {2, 1})));
+  EXPECT_FALSE(space.contains(Array::from_vector<std::int64_t>({2}, {3, 1})));
+  EXPECT_FALSE(space.contains(Array::from_vector<std::int64_t>({2}, {-1, 0})));
+  EXPECT_FALSE(space.contains(Array::from_vector<double>({2}, {1, 1})));
+  EXPECT_FALSE(space.contains(Array::from_vector<double>({2}, {NAN, 1})));
+  EXPECT_FALSE(space.contains(Array::from_vector<std::int64_t>({3}, {0, 0, 0})));
+}
+
+TEST(MultiDiscreteTest, ShapedNvec) {
+  const MultiDiscrete space({2, 2, 3, 3}, {}, Shape{2, 2});
+  EXPECT_EQ(space.shape(), (Shape{2, 2}));
+  Rng rng(0);
+  EXPECT_EQ(space.sample(rng).array().shape(), (Shape{2, 2}));
+}
+
+TEST(MultiDiscreteTest, RejectsInvalidConstruction) {
+  EXPECT_THROW(MultiDiscrete({3, 0}), std::invalid_argument);
+  EXPECT_THROW(MultiDiscrete({3, 2}, {0}), std::invalid_argument);
+  EXPECT_THROW(MultiDiscrete({3, 2}, {}, Shape{3}), std::invalid_argument);
+}
+
+TEST(MultiDiscreteTest, ToStringAndEquals) {
+  EXPECT_EQ(MultiDiscrete({3, 2}).to_string(), "MultiDiscrete([3, 2])");
+  EXPECT_TRUE(MultiDiscrete({3, 2}).equals(MultiDiscrete({3, 2})));
+  EXPECT_FALSE(MultiDiscrete({3, 2}).equals(MultiDiscrete({3, 3})));
+}
+
+}  // namespace
+}  // namespace pixelgym::spaces

@@ -1,0 +1,68 @@
+#include "envs/value.h"
+
+#include <gtest/gtest.h>
+
+namespace pixelgym {
+namespace {
+
+TEST(ValueTest, DictKeepsInsertionOrderAndReplacesInPlace) {
+  Dict dict;
+  dict.insert("pixels", Array(DType::kUInt8, {2, 2, 3}));
+  dict.insert("joint_pos", Array(DType::kFloat32, {2}));
+  dict.insert("pixels", Array(DType::kUInt8, {4, 4, 3}));
+  EXPECT_EQ(dict.keys(), (std::vector<std::string>{"pixels", "joint_pos"}));
+  EXPECT_EQ(dict.at("pixels").array().shape(), (Shape{4, 4, 3}));
+}
+
+TEST(ValueTest, MissingKeyNamesKeysPresent) {
+  Dict dict{{"a", Array::scalar(1.0)}};
+  try {
+    dict.at("b");
+    FAIL();
+  } catch (const std::out_of_range& error) {
+    EXPECT_NE(std::string(error.what()).find("\"a\""), std::string::npos);
+  }
+}
+
+TEST(ValueTest, WrongAlternativeThrows) {
+  Value value = Array::scalar(1.0);
+  EXPECT_TRUE(value.is_array());
+  EXPECT_THROW(value.dict(), std::invalid_argument);
+  EXPECT_THROW(value.tuple(), std::invalid_argument);
+}
+
+TEST(ValueTest, CloneIsDeepAndEqual) {
+  Value value = Dict{{"x", Array::from_vector<float>({2}, {1, 2})},
+                     {"t", Tuple{Array::scalar<std::int64_t>(3)}}};
+  Value copy = value.clone();
+  EXPECT_TRUE(copy.equals(value));
+  EXPECT_FALSE(copy.shares_memory(value));
+  Value shallow = value;
+  EXPECT_TRUE(shallow.shares_memory(value));
+  copy.dict().at("x").array().data<float>()[0] = 9;
+  EXPECT_FALSE(copy.equals(value));
+}
+
+TEST(ValueTest, EqualsComparesStructure) {
+  Value a = Tuple{Array::scalar(1.0)};
+  Value b = Tuple{Array::scalar(1.0), Array::scalar(1.0)};
+  Value c = Dict{{"x", Array::scalar(1.0)}};
+  EXPECT_FALSE(a.equals(b));
+  EXPECT_FALSE(a.equals(c));
+  EXPECT_FALSE(c.equals(Value(Dict{{"y", Array::scalar(1.0)}})));
+}
+
+TEST(ValueTest, LeavesAreDepthFirst) {
+  Value value = Dict{{"a", Array::scalar(1.0)}, {"b", Tuple{Array::scalar(2.0), Array::scalar(3.0)}}};
+  const std::vector<Array> leaves = value.leaves();
+  ASSERT_EQ(leaves.size(), 3U);
+  EXPECT_EQ(leaves[2].item<double>(), 3.0);
+}
+
+TEST(ValueTest, ToString) {
+  Value value = Dict{{"a", Array::scalar<std::int64_t>(1)}};
+  EXPECT_EQ(value.to_string(), "Dict{\"a\": int64 () 1}");
+}
+
+}  // namespace
+}  // namespace pixelgym

@@ -1,0 +1,113 @@
+#include "envs/wrapper.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "envs/spaces/box.h"
+#include "tests/envs/probe_env.h"
+
+namespace pixelgym {
+namespace {
+
+using testing::ProbeEnv;
+using testing::action;
+
+// Doubles observations and declares the doubled bounds.
+class DoubleObservation final : public ObservationWrapper {
+ public:
+  explicit DoubleObservation(std::unique_ptr<Env> env) : ObservationWrapper(std::move(env)) {
+    set_observation_space(std::make_shared<spaces::Box>(-20.0, 20.0, Shape{2}));
+  }
+
+ protected:
+  std::string type_name() const override { return "DoubleObservation"; }
+  Value observation(const Value& obs) override {
+    Array doubled = obs.array().clone();
+    for (int i = 0; i < 2; ++i) doubled.data<float>()[i] *= 2.0F;
+    return doubled;
+  }
+};
+
+// Takes actions in [-10, 10] and scales them into the inner env's [-1, 1].
+class ScaleAction final : public ActionWrapper {
+ public:
+  explicit ScaleAction(std::unique_ptr<Env> env) : ActionWrapper(std::move(env)) {
+    set_action_space(std::make_shared<spaces::Box>(-10.0, 10.0, Shape{1}));
+  }
+
+ protected:
+  Value action(const Value& a) override {
+    return testing::action(a.array().data<float>()[0] / 10.0F);
+  }
+};
+
+class NegateReward final : public RewardWrapper {
+ public:
+  using RewardWrapper::RewardWrapper;
+
+ protected:
+  double reward(double r) override { return -r; }
+};
+
+TEST(WrapperTest, ForwardsProtocolAndUnwraps) {
+  auto inner = std::make_unique<ProbeEnv>();
+  ProbeEnv* probe = inner.get();
+  DoubleObservation env(std::move(inner));
+  EXPECT_EQ(&env.unwrapped(), probe);
+  EXPECT_EQ(&env.env(), probe);
+  EXPECT_EQ(env.name(), "DoubleObservation<ProbeEnv>");
+  EXPECT_TRUE(env.action_space().equals(probe->action_space()));
+  EXPECT_EQ(env.metadata().render_fps, 30.0);
+}
+
+TEST(WrapperTest, ObservationWrapperTransformsResetAndStep) {
+  DoubleObservation env(std::make_unique<ProbeEnv>());
+  const Value obs = env.reset(3).obs;
+  const auto& probe = static_cast<const ProbeEnv&>(env.unwrapped());
+  EXPECT_FLOAT_EQ(obs.array().data<float>()[0], 2.0F * static_cast<float>(probe.x()));
+  EXPECT_TRUE(env.observation_space().contains(obs));
+  EXPECT_FALSE(env.env().observation_space().equals(env.observation_space()));
+  const Value stepped = env.step(action(1.0F)).obs;
+  EXPECT_FLOAT_EQ(stepped.array().data<float>()[1], 0.02F);
+}
+
+TEST(WrapperTest, SeedReachesTheInnerEnv) {
+  DoubleObservation a(std::make_unique<ProbeEnv>());
+  ProbeEnv b;
+  a.reset(99);
+  b.reset(99);
+  EXPECT_EQ(static_cast<ProbeEnv&>(a.unwrapped()).x(), b.x());
+}
+
+TEST(WrapperTest, ActionWrapperValidatesItsOwnSpaceThenTransforms) {
+  ScaleAction env(std::make_unique<ProbeEnv>());
+  env.reset(0);
+  const double x0 = static_cast<ProbeEnv&>(env.unwrapped()).x();
+  env.step(action(5.0F));  // outside the inner space, inside the wrapper's
+  EXPECT_NEAR(static_cast<ProbeEnv&>(env.unwrapped()).x(), x0 + 0.05, 1e-6);
+  EXPECT_THROW(env.step(action(11.0F)), std::invalid_argument);
+}
+
+TEST(WrapperTest, RewardWrapperTransformsReward) {
+  NegateReward env(std::make_unique<ProbeEnv>());
+  env.reset(0);
+  const StepResult result = env.step(action(0.0F));
+  EXPECT_EQ(result.reward, std::abs(static_cast<ProbeEnv&>(env.unwrapped()).x()));
+}
+
+TEST(WrapperTest, OrderIsEnforcedAtTheWrapperAndCloseReachesInner) {
+  auto inner = std::make_unique<ProbeEnv>();
+  ProbeEnv* probe = inner.get();
+  NegateReward env(std::move(inner));
+  EXPECT_THROW(env.step(action(0.0F)), ResetNeeded);
+  env.close();
+  env.close();
+  EXPECT_EQ(probe->close_calls(), 1);
+}
+
+TEST(WrapperTest, NullEnvIsRejected) {
+  EXPECT_THROW(NegateReward(nullptr), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace pixelgym

@@ -1,0 +1,120 @@
+// Runs the `pixelgym` binary and checks exit codes and output, as a user or a script sees them.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "render/image_io.h"
+
+namespace pixelgym {
+namespace {
+
+using ::testing::HasSubstr;
+
+struct CliRun {
+  int exit_code;
+  std::string output;  // stdout and stderr
+};
+
+CliRun run(const std::string& arguments) {
+  const std::string command = std::string(PIXELGYM_CLI) + " " + arguments + " 2>&1";
+  std::FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return {-1, "popen failed"};
+  std::string output;
+  std::array<char, 4096> buffer{};
+  while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) output += buffer.data();
+  const int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
+TEST(PixelgymCliTest, ListShowsGridWorldWithDescription) {
+  const CliRun result = run("list");
+  EXPECT_EQ(result.exit_code, 0);
+  EXPECT_THAT(result.output, HasSubstr("GridWorld-v0"));
+  EXPECT_THAT(result.output, HasSubstr("4x4 grid"));
+}
+
+TEST(PixelgymCliTest, InfoShowsSpacesAndConfigKeys) {
+  const CliRun result = run("info GridWorld-v0");
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("observation_space: Discrete(16)"));
+  EXPECT_THAT(result.output, HasSubstr("action_space:      Discrete(4)"));
+  EXPECT_THAT(result.output, HasSubstr("render_width"));
+  EXPECT_THAT(result.output, HasSubstr("max_episode_steps: 50"));
+}
+
+TEST(PixelgymCliTest, CheckGridWorldPasses) {
+  const CliRun result = run("check GridWorld-v0 --seed 3");
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("all 11 checks passed"));
+}
+
+TEST(PixelgymCliTest, CheckUnknownIdFailsAndSuggests) {
+  const CliRun result = run("check Nope-v0");
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_THAT(result.output, HasSubstr("unknown env id \"Nope-v0\""));
+  EXPECT_THAT(result.output, HasSubstr("GridWorld-v0"));
+}
+
+TEST(PixelgymCliTest, UnknownSubcommandAndBadFlagsExitTwoWithUsage) {
+  for (const char* arguments :
+       {"frobnicate", "", "check", "check GridWorld-v0 --bogus", "snapshot GridWorld-v0 --seed x --out a.png",
+        "check GridWorld-v0 --set novalue"}) {
+    const CliRun result = run(std::string(arguments));
+    EXPECT_EQ(result.exit_code, 2) << arguments << ": " << result.output;
+    EXPECT_THAT(result.output, HasSubstr("Usage")) << arguments;
+  }
+}
+
+TEST(PixelgymCliTest, HelpExitsZero) {
+  const CliRun result = run("snapshot --help");
+  EXPECT_EQ(result.exit_code, 0);
+  EXPECT_THAT(result.output, HasSubstr("--steps"));
+}
+
+TEST(PixelgymCliTest, SetPassesTypedKwargsAndReportsUnknownOnes) {
+  const std::string out = std::string(PIXELGYM_TEST_OUTPUT_DIR) + "/cli/gridworld_small.png";
+  std::filesystem::remove(out);
+  const CliRun small = run("snapshot GridWorld-v0 --seed 0 --steps 3 --out " + out +
+                        " --set render_width=96 --set render_height=64");
+  ASSERT_EQ(small.exit_code, 0) << small.output;
+  const Image image = read_png(out);
+  EXPECT_EQ(image.width, 96);
+  EXPECT_EQ(image.height, 64);
+
+  const CliRun unknown = run("info GridWorld-v0 --set colour=red");
+  EXPECT_EQ(unknown.exit_code, 1);
+  EXPECT_THAT(unknown.output, HasSubstr("unknown kwarg \"colour\""));
+  EXPECT_THAT(unknown.output, HasSubstr("render_width (int, default 256)"));
+
+  const CliRun bad_value = run("info GridWorld-v0 --set render_width=wide");
+  EXPECT_EQ(bad_value.exit_code, 1);
+  EXPECT_THAT(bad_value.output, HasSubstr("cannot read \"wide\" as a int"));
+}
+
+TEST(PixelgymCliTest, SnapshotIsReproducibleFromTheSeed) {
+  const std::string dir = std::string(PIXELGYM_TEST_OUTPUT_DIR) + "/cli/";
+  ASSERT_EQ(run("snapshot GridWorld-v0 --seed 4 --steps 7 --out " + dir + "a.png").exit_code, 0);
+  ASSERT_EQ(run("snapshot GridWorld-v0 --seed 4 --steps 7 --out " + dir + "b.png").exit_code, 0);
+  EXPECT_EQ(read_png(dir + "a.png").pixels, read_png(dir + "b.png").pixels);
+}
+
+TEST(PixelgymCliTest, SnapshotToUnwritablePathFailsClearly) {
+  const CliRun result = run("snapshot GridWorld-v0 --seed 0 --out /proc/pixelgym/x.png");
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_THAT(result.output, HasSubstr("/proc/pixelgym"));
+}
+
+TEST(PixelgymCliTest, RolloutPrintsReturns) {
+  const CliRun result = run("rollout GridWorld-v0 --episodes 3 --seed 1");
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("episode 2: return="));
+  EXPECT_THAT(result.output, HasSubstr("mean_return="));
+}
+
+}  // namespace
+}  // namespace pixelgym
