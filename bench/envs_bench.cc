@@ -22,7 +22,8 @@ BENCHMARK(BM_GridWorldStep);
 
 void BM_GridWorldRender(benchmark::State& state) {
   const auto size = static_cast<int>(state.range(0));
-  std::unique_ptr<Env> env = make("GridWorld-v0", {{"render_width", size}, {"render_height", size}});
+  std::unique_ptr<Env> env =
+      make("GridWorld-v0", {{"render_width", size}, {"render_height", size}});
   env->reset(0);
   for (auto _ : state) benchmark::DoNotOptimize(env->render());
   state.SetItemsProcessed(state.iterations());

@@ -23,12 +23,18 @@ std::size_t dtype_size(DType dtype) {
 
 const char* dtype_name(DType dtype) {
   switch (dtype) {
-    case DType::kBool: return "bool";
-    case DType::kUInt8: return "uint8";
-    case DType::kInt32: return "int32";
-    case DType::kInt64: return "int64";
-    case DType::kFloat32: return "float32";
-    case DType::kFloat64: return "float64";
+    case DType::kBool:
+      return "bool";
+    case DType::kUInt8:
+      return "uint8";
+    case DType::kInt32:
+      return "int32";
+    case DType::kInt64:
+      return "int64";
+    case DType::kFloat32:
+      return "float32";
+    case DType::kFloat64:
+      return "float64";
   }
   return "unknown";
 }
@@ -89,12 +95,18 @@ double Array::element_as_double(std::int64_t flat_index) const {
   }
   const std::byte* p = data_ + flat_index * static_cast<std::int64_t>(dtype_size(dtype_));
   switch (dtype_) {
-    case DType::kBool: return *reinterpret_cast<const bool*>(p) ? 1.0 : 0.0;
-    case DType::kUInt8: return *reinterpret_cast<const std::uint8_t*>(p);
-    case DType::kInt32: return *reinterpret_cast<const std::int32_t*>(p);
-    case DType::kInt64: return static_cast<double>(*reinterpret_cast<const std::int64_t*>(p));
-    case DType::kFloat32: return *reinterpret_cast<const float*>(p);
-    case DType::kFloat64: return *reinterpret_cast<const double*>(p);
+    case DType::kBool:
+      return *reinterpret_cast<const bool*>(p) ? 1.0 : 0.0;
+    case DType::kUInt8:
+      return *reinterpret_cast<const std::uint8_t*>(p);
+    case DType::kInt32:
+      return *reinterpret_cast<const std::int32_t*>(p);
+    case DType::kInt64:
+      return static_cast<double>(*reinterpret_cast<const std::int64_t*>(p));
+    case DType::kFloat32:
+      return *reinterpret_cast<const float*>(p);
+    case DType::kFloat64:
+      return *reinterpret_cast<const double*>(p);
   }
   return 0.0;
 }
@@ -108,8 +120,8 @@ Array Array::clone() const {
 Array Array::index(std::int64_t i) const {
   if (shape_.empty()) throw std::out_of_range("Array::index: a 0-dimensional array has no index");
   if (i < 0 || i >= shape_[0]) {
-    throw std::out_of_range("Array::index: index " + std::to_string(i) + " out of range for shape " +
-                            shape_to_string(shape_));
+    throw std::out_of_range("Array::index: index " + std::to_string(i) +
+                            " out of range for shape " + shape_to_string(shape_));
   }
   Array view = *this;
   view.shape_.erase(view.shape_.begin());

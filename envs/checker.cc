@@ -19,8 +19,8 @@ void expect(bool condition, const std::string& reason) {
 
 void expect_in_space(const Space& space, const Value& value, const std::string& what) {
   const std::string reason = space.mismatch(value);
-  expect(reason.empty(), what + " " + value.to_string() + " is not in " + space.to_string() +
-                             ": " + reason);
+  expect(reason.empty(),
+         what + " " + value.to_string() + " is not in " + space.to_string() + ": " + reason);
 }
 
 // One step of a recorded trajectory.
@@ -42,7 +42,8 @@ std::vector<Transition> rollout(Env& env, std::uint64_t seed, int num_steps) {
     const Value action = env.action_space().sample(action_rng);
     StepResult step = env.step(action);
     trajectory.push_back({step.obs, step.reward, step.terminated, step.truncated});
-    if (step.terminated || step.truncated) trajectory.push_back({env.reset().obs, 0.0, false, false});
+    if (step.terminated || step.truncated)
+      trajectory.push_back({env.reset().obs, 0.0, false, false});
   }
   return trajectory;
 }
@@ -123,20 +124,21 @@ CheckReport check_env(Env& env, const CheckOptions& options) {
     for (std::size_t i = 0; i < trajectory.size(); ++i) {
       expect_in_space(env.observation_space(), trajectory[i].obs,
                       "observation " + std::to_string(i));
-      expect(std::isfinite(trajectory[i].reward),
-             "reward " + std::to_string(trajectory[i].reward) + " at transition " +
-                 std::to_string(i) + " is not finite");
+      expect(std::isfinite(trajectory[i].reward), "reward " + std::to_string(trajectory[i].reward) +
+                                                      " at transition " + std::to_string(i) +
+                                                      " is not finite");
     }
   });
 
   run("step_determinism", [&] {
     const std::vector<Transition> a = rollout(env, seed, options.num_steps);
     const std::vector<Transition> b = rollout(env, seed, options.num_steps);
-    expect(a.size() == b.size(), "two runs with seed " + std::to_string(seed) +
-                                     " had different episode boundaries");
+    expect(a.size() == b.size(),
+           "two runs with seed " + std::to_string(seed) + " had different episode boundaries");
     for (std::size_t i = 0; i < a.size(); ++i) {
-      const std::string where = " differ at transition " + std::to_string(i) + " of two runs with seed " +
-                                std::to_string(seed) + " and the same actions";
+      const std::string where = " differ at transition " + std::to_string(i) +
+                                " of two runs with seed " + std::to_string(seed) +
+                                " and the same actions";
       expect(a[i].obs.equals(b[i].obs), "observations" + where);
       expect(a[i].reward == b[i].reward || (std::isnan(a[i].reward) && std::isnan(b[i].reward)),
              "rewards" + where);

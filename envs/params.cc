@@ -19,10 +19,14 @@ std::invalid_argument wrong_type(ParamType wanted, const Param& got) {
 
 const char* param_type_name(ParamType type) {
   switch (type) {
-    case ParamType::kBool: return "bool";
-    case ParamType::kInt: return "int";
-    case ParamType::kFloat: return "float";
-    case ParamType::kString: return "string";
+    case ParamType::kBool:
+      return "bool";
+    case ParamType::kInt:
+      return "int";
+    case ParamType::kFloat:
+      return "float";
+    case ParamType::kString:
+      return "string";
   }
   return "unknown";
 }
@@ -50,14 +54,17 @@ const std::string& Param::as_string() const {
 
 std::string Param::to_string() const {
   switch (type()) {
-    case ParamType::kBool: return std::get<bool>(value_) ? "true" : "false";
-    case ParamType::kInt: return std::to_string(std::get<std::int64_t>(value_));
+    case ParamType::kBool:
+      return std::get<bool>(value_) ? "true" : "false";
+    case ParamType::kInt:
+      return std::to_string(std::get<std::int64_t>(value_));
     case ParamType::kFloat: {
       std::ostringstream out;
       out << std::get<double>(value_);
       return out.str();
     }
-    case ParamType::kString: return "\"" + std::get<std::string>(value_) + "\"";
+    case ParamType::kString:
+      return "\"" + std::get<std::string>(value_) + "\"";
   }
   return "";
 }
@@ -91,7 +98,8 @@ Param parse_param(ParamType type, const std::string& text) {
       if (errno != 0 || *end != '\0') throw fail();
       return value;
     }
-    case ParamType::kString: return text;
+    case ParamType::kString:
+      return text;
   }
   throw fail();
 }
@@ -111,8 +119,8 @@ Params resolve_params(const std::vector<ParamSpec>& specs, const Params& given,
   Params resolved;
   for (const ParamSpec& spec : specs) resolved.emplace(spec.name, spec.default_value);
   for (const auto& [key, value] : given) {
-    const auto spec = std::find_if(specs.begin(), specs.end(),
-                                   [&](const ParamSpec& s) { return s.name == key; });
+    const auto spec =
+        std::find_if(specs.begin(), specs.end(), [&](const ParamSpec& s) { return s.name == key; });
     if (spec == specs.end()) {
       throw std::invalid_argument(context + ": unknown kwarg \"" + key +
                                   "\"; valid kwargs: " + describe_params(specs));

@@ -19,13 +19,13 @@ const char* param_type_name(ParamType type);
 /// (`{"width", 64}`, `{"camera", "side"}`) without ambiguity.
 class Param {
  public:
-  Param(bool value) : value_(value) {}                              // NOLINT
-  Param(int value) : value_(std::int64_t{value}) {}                 // NOLINT
-  Param(long value) : value_(std::int64_t{value}) {}                // NOLINT
-  Param(long long value) : value_(std::int64_t{value}) {}           // NOLINT
-  Param(double value) : value_(value) {}                            // NOLINT
-  Param(const char* value) : value_(std::string(value)) {}          // NOLINT
-  Param(std::string value) : value_(std::move(value)) {}            // NOLINT
+  Param(bool value) : value_(value) {}                      // NOLINT
+  Param(int value) : value_(std::int64_t{value}) {}         // NOLINT
+  Param(long value) : value_(std::int64_t{value}) {}        // NOLINT
+  Param(long long value) : value_(std::int64_t{value}) {}   // NOLINT
+  Param(double value) : value_(value) {}                    // NOLINT
+  Param(const char* value) : value_(std::string(value)) {}  // NOLINT
+  Param(std::string value) : value_(std::move(value)) {}    // NOLINT
 
   ParamType type() const { return static_cast<ParamType>(value_.index()); }
   /// Each accessor throws std::invalid_argument when the type differs; `as_float` also accepts

@@ -50,7 +50,8 @@ void Registry::register_env(EnvSpec spec) {
     }
   }
   if (spec.max_episode_steps && *spec.max_episode_steps <= 0) {
-    throw std::invalid_argument("register_env: " + spec.id + ": max_episode_steps must be positive");
+    throw std::invalid_argument("register_env: " + spec.id +
+                                ": max_episode_steps must be positive");
   }
   std::lock_guard<std::mutex> lock(mutex_);
   for (const auto& existing : specs_) {
@@ -91,7 +92,8 @@ std::unique_ptr<Env> Registry::make(const std::string& id, const Params& kwargs)
   Params resolved = resolve_params(accepted, kwargs, id);
   const std::int64_t max_episode_steps = resolved.at(kMaxEpisodeStepsKey).as_int();
   if (max_episode_steps < 0) {
-    throw std::invalid_argument(id + ": kwarg \"max_episode_steps\" must be >= 0 (0: no limit), got " +
+    throw std::invalid_argument(id +
+                                ": kwarg \"max_episode_steps\" must be >= 0 (0: no limit), got " +
                                 std::to_string(max_episode_steps));
   }
   resolved.erase(kMaxEpisodeStepsKey);

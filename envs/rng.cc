@@ -49,7 +49,8 @@ std::int64_t Rng::integer(std::int64_t low, std::int64_t high) {
     throw std::invalid_argument("Rng::integer: low " + std::to_string(low) + " > high " +
                                 std::to_string(high));
   }
-  const std::uint64_t range = static_cast<std::uint64_t>(high) - static_cast<std::uint64_t>(low) + 1;
+  const std::uint64_t range =
+      static_cast<std::uint64_t>(high) - static_cast<std::uint64_t>(low) + 1;
   if (range == 0) return static_cast<std::int64_t>(next_u64());  // the full 64-bit range
   // Reject the low values that would make `x % range` favour small results.
   const std::uint64_t threshold = (0 - range) % range;

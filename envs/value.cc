@@ -33,8 +33,8 @@ const Value& Dict::at(const std::string& key) const {
   if (i < 0) {
     std::string present;
     for (const auto& k : keys_) present += (present.empty() ? "\"" : ", \"") + k + "\"";
-    throw std::out_of_range("Dict: no key \"" + key + "\" (keys: " +
-                            (present.empty() ? "none" : present) + ")");
+    throw std::out_of_range("Dict: no key \"" + key +
+                            "\" (keys: " + (present.empty() ? "none" : present) + ")");
   }
   return values_[static_cast<std::size_t>(i)];
 }
@@ -65,19 +65,22 @@ const char* Value::kind() const {
 }
 
 const Array& Value::array() const {
-  if (!is_array()) throw std::invalid_argument(std::string("Value: expected an array, got a ") + kind());
+  if (!is_array())
+    throw std::invalid_argument(std::string("Value: expected an array, got a ") + kind());
   return std::get<Array>(data_);
 }
 Array& Value::array() { return const_cast<Array&>(static_cast<const Value&>(*this).array()); }
 
 const Dict& Value::dict() const {
-  if (!is_dict()) throw std::invalid_argument(std::string("Value: expected a Dict, got a ") + kind());
+  if (!is_dict())
+    throw std::invalid_argument(std::string("Value: expected a Dict, got a ") + kind());
   return std::get<Dict>(data_);
 }
 Dict& Value::dict() { return const_cast<Dict&>(static_cast<const Value&>(*this).dict()); }
 
 const Tuple& Value::tuple() const {
-  if (!is_tuple()) throw std::invalid_argument(std::string("Value: expected a Tuple, got a ") + kind());
+  if (!is_tuple())
+    throw std::invalid_argument(std::string("Value: expected a Tuple, got a ") + kind());
   return std::get<Tuple>(data_);
 }
 
@@ -101,8 +104,7 @@ bool Value::equals(const Value& other) const {
   if (is_array()) return array().equals(other.array());
   if (is_dict()) {
     return dict().keys() == other.dict().keys() &&
-           std::equal(dict().values().begin(), dict().values().end(),
-                      other.dict().values().begin(),
+           std::equal(dict().values().begin(), dict().values().end(), other.dict().values().begin(),
                       [](const Value& a, const Value& b) { return a.equals(b); });
   }
   const auto& mine = tuple().items();

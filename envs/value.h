@@ -57,7 +57,7 @@ class Tuple {
 /// One of Array, Dict or Tuple. Copies are shallow for the arrays inside (they share memory).
 class Value {
  public:
-  Value();  // an empty Array
+  Value();             // an empty Array
   Value(Array array);  // NOLINT(google-explicit-constructor): arrays are values
   Value(Dict dict);    // NOLINT(google-explicit-constructor)
   Value(Tuple tuple);  // NOLINT(google-explicit-constructor)

@@ -14,10 +14,14 @@ namespace {
 
 png_uint_32 png_format(int channels) {
   switch (channels) {
-    case 1: return PNG_FORMAT_GRAY;
-    case 3: return PNG_FORMAT_RGB;
-    case 4: return PNG_FORMAT_RGBA;
-    default: return 0;
+    case 1:
+      return PNG_FORMAT_GRAY;
+    case 3:
+      return PNG_FORMAT_RGB;
+    case 4:
+      return PNG_FORMAT_RGBA;
+    default:
+      return 0;
   }
 }
 
@@ -30,9 +34,11 @@ struct FileCloser {
 void write_png(const std::string& path, const ImageView& image) {
   if (image.pixels == nullptr || image.height <= 0 || image.width <= 0 ||
       (image.channels != 1 && image.channels != 3 && image.channels != 4)) {
-    throw std::invalid_argument("write_png: " + path + ": expected a non-empty image with 1, 3 or 4 "
-                                "channels, got " + std::to_string(image.height) + "x" +
-                                std::to_string(image.width) + "x" + std::to_string(image.channels));
+    throw std::invalid_argument("write_png: " + path +
+                                ": expected a non-empty image with 1, 3 or 4 "
+                                "channels, got " +
+                                std::to_string(image.height) + "x" + std::to_string(image.width) +
+                                "x" + std::to_string(image.channels));
   }
   const std::string temporary = path + ".tmp." + std::to_string(::getpid());
   std::unique_ptr<std::FILE, FileCloser> file(std::fopen(temporary.c_str(), "wb"));
@@ -45,10 +51,10 @@ void write_png(const std::string& path, const ImageView& image) {
   png.width = static_cast<png_uint_32>(image.width);
   png.height = static_cast<png_uint_32>(image.height);
   png.format = png_format(image.channels);
-  const bool written =
-      png_image_write_to_stdio(&png, file.get(), 0, image.pixels, image.width * image.channels,
-                               nullptr) != 0;
-  const bool flushed = written && std::fflush(file.get()) == 0 && ::fsync(::fileno(file.get())) == 0;
+  const bool written = png_image_write_to_stdio(&png, file.get(), 0, image.pixels,
+                                                image.width * image.channels, nullptr) != 0;
+  const bool flushed =
+      written && std::fflush(file.get()) == 0 && ::fsync(::fileno(file.get())) == 0;
   const int saved_errno = errno;
   const bool closed = std::fclose(file.release()) == 0;
   if (!written || !flushed || !closed) {

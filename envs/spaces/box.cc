@@ -16,7 +16,8 @@ struct Range {
 
 Range integer_range(DType dtype) {
   switch (dtype) {
-    case DType::kUInt8: return {0.0, 255.0};
+    case DType::kUInt8:
+      return {0.0, 255.0};
     case DType::kInt32:
       return {static_cast<double>(std::numeric_limits<std::int32_t>::min()),
               static_cast<double>(std::numeric_limits<std::int32_t>::max())};
@@ -36,8 +37,8 @@ std::string format_bound(double bound) {
 }
 
 std::string format_bounds(const std::vector<double>& bounds) {
-  const bool uniform = std::all_of(bounds.begin(), bounds.end(),
-                                   [&](double b) { return b == bounds.front(); });
+  const bool uniform =
+      std::all_of(bounds.begin(), bounds.end(), [&](double b) { return b == bounds.front(); });
   if (uniform && !bounds.empty()) return format_bound(bounds.front());
   constexpr std::size_t kMaxPrinted = 8;
   std::string text = "[";
@@ -56,8 +57,8 @@ void fill_sample(const std::vector<double>& low, const std::vector<double>& high
     const bool has_low = std::isfinite(low[i]);
     const bool has_high = std::isfinite(high[i]);
     if constexpr (std::is_integral_v<T>) {
-      out[i] = static_cast<T>(rng.integer(static_cast<std::int64_t>(low[i]),
-                                          static_cast<std::int64_t>(high[i])));
+      out[i] = static_cast<T>(
+          rng.integer(static_cast<std::int64_t>(low[i]), static_cast<std::int64_t>(high[i])));
     } else {
       double x;
       if (has_low && has_high) {
@@ -92,9 +93,9 @@ Box::Box(std::vector<double> low, std::vector<double> high, Shape shape, DType d
     throw std::invalid_argument(where + ": bool is not a Box dtype; use MultiBinary");
   }
   if (low_.size() != size || high_.size() != size) {
-    throw std::invalid_argument(where + ": low has " + std::to_string(low_.size()) +
-                                " and high " + std::to_string(high_.size()) +
-                                " values, the shape needs " + std::to_string(size));
+    throw std::invalid_argument(where + ": low has " + std::to_string(low_.size()) + " and high " +
+                                std::to_string(high_.size()) + " values, the shape needs " +
+                                std::to_string(size));
   }
   for (std::size_t i = 0; i < size; ++i) {
     if (std::isnan(low_[i]) || std::isnan(high_[i])) {
@@ -107,9 +108,8 @@ Box::Box(std::vector<double> low, std::vector<double> high, Shape shape, DType d
       if (low_[i] != std::floor(low_[i]) || high_[i] != std::floor(high_[i]) ||
           low_[i] > range.high || high_[i] < range.low) {
         throw std::invalid_argument(where + ": bounds [" + format_bound(low_[i]) + ", " +
-                                    format_bound(high_[i]) + "] of element " +
-                                    std::to_string(i) + " are not integers within " +
-                                    dtype_name(dtype_) + "'s range");
+                                    format_bound(high_[i]) + "] of element " + std::to_string(i) +
+                                    " are not integers within " + dtype_name(dtype_) + "'s range");
       }
     } else if (dtype_ == DType::kFloat32) {
       low_[i] = static_cast<float>(low_[i]);
@@ -132,12 +132,23 @@ bool Box::is_bounded() const {
 Value Box::sample(Rng& rng) const {
   Array array(dtype_, shape_);
   switch (dtype_) {
-    case DType::kUInt8: fill_sample(low_, high_, rng, array.data<std::uint8_t>()); break;
-    case DType::kInt32: fill_sample(low_, high_, rng, array.data<std::int32_t>()); break;
-    case DType::kInt64: fill_sample(low_, high_, rng, array.data<std::int64_t>()); break;
-    case DType::kFloat32: fill_sample(low_, high_, rng, array.data<float>()); break;
-    case DType::kFloat64: fill_sample(low_, high_, rng, array.data<double>()); break;
-    case DType::kBool: break;  // rejected by the constructor
+    case DType::kUInt8:
+      fill_sample(low_, high_, rng, array.data<std::uint8_t>());
+      break;
+    case DType::kInt32:
+      fill_sample(low_, high_, rng, array.data<std::int32_t>());
+      break;
+    case DType::kInt64:
+      fill_sample(low_, high_, rng, array.data<std::int64_t>());
+      break;
+    case DType::kFloat32:
+      fill_sample(low_, high_, rng, array.data<float>());
+      break;
+    case DType::kFloat64:
+      fill_sample(low_, high_, rng, array.data<double>());
+      break;
+    case DType::kBool:
+      break;  // rejected by the constructor
   }
   return array;
 }

@@ -80,7 +80,8 @@ const Space& Dict::at(const std::string& key) const {
   for (const auto& entry : entries_) {
     if (entry.first == key) return *entry.second;
   }
-  throw std::out_of_range("spaces::Dict: no key \"" + key + "\" (keys: " + key_list(entries_) + ")");
+  throw std::out_of_range("spaces::Dict: no key \"" + key + "\" (keys: " + key_list(entries_) +
+                          ")");
 }
 
 }  // namespace pixelgym::spaces

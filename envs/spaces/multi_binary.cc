@@ -9,7 +9,8 @@ MultiBinary::MultiBinary(Shape shape) : shape_(std::move(shape)) { shape_size(sh
 Value MultiBinary::sample(Rng& rng) const {
   Array array(DType::kUInt8, shape_);
   auto* out = array.data<std::uint8_t>();
-  for (std::int64_t i = 0; i < array.size(); ++i) out[i] = static_cast<std::uint8_t>(rng.integer(0, 1));
+  for (std::int64_t i = 0; i < array.size(); ++i)
+    out[i] = static_cast<std::uint8_t>(rng.integer(0, 1));
   return array;
 }
 

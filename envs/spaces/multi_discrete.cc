@@ -24,8 +24,8 @@ MultiDiscrete::MultiDiscrete(std::vector<std::int64_t> nvec, std::vector<std::in
   if (static_cast<std::int64_t>(nvec_.size()) != shape_size(shape_) ||
       start_.size() != nvec_.size()) {
     throw std::invalid_argument("MultiDiscrete: nvec has " + std::to_string(nvec_.size()) +
-                                " entries and start " + std::to_string(start_.size()) +
-                                "; shape " + shape_to_string(shape_) + " needs " +
+                                " entries and start " + std::to_string(start_.size()) + "; shape " +
+                                shape_to_string(shape_) + " needs " +
                                 std::to_string(shape_size(shape_)));
   }
   for (std::size_t i = 0; i < nvec_.size(); ++i) {

@@ -32,7 +32,8 @@ void fill_rect(Array& image, int y0, int y1, int x0, int x1, Rgb color) {
   const auto width = static_cast<int>(image.shape()[1]);
   std::uint8_t* pixels = image.data<std::uint8_t>();
   for (int y = y0; y < y1; ++y) {
-    for (int x = x0; x < x1; ++x) std::copy(color.begin(), color.end(), pixels + (y * width + x) * 3);
+    for (int x = x0; x < x1; ++x)
+      std::copy(color.begin(), color.end(), pixels + (y * width + x) * 3);
   }
 }
 
@@ -70,11 +71,20 @@ ResetResult GridWorld::do_reset(std::optional<std::uint64_t> /*seed*/, const Opt
 StepResult GridWorld::do_step(const Value& action) {
   Cell next = agent_;
   switch (static_cast<std::int64_t>(action.array().element_as_double(0))) {
-    case kLeft: next.col -= 1; break;
-    case kDown: next.row += 1; break;
-    case kRight: next.col += 1; break;
-    case kUp: next.row -= 1; break;
-    default: break;  // unreachable: the action was checked against Discrete(4)
+    case kLeft:
+      next.col -= 1;
+      break;
+    case kDown:
+      next.row += 1;
+      break;
+    case kRight:
+      next.col += 1;
+      break;
+    case kUp:
+      next.row -= 1;
+      break;
+    default:
+      break;  // unreachable: the action was checked against Discrete(4)
   }
   const bool on_grid = next.row >= 0 && next.row < kSize && next.col >= 0 && next.col < kSize;
   if (on_grid && !(next == kWall)) agent_ = next;

@@ -9,7 +9,9 @@
 namespace pixelgym::cli {
 
 void add_set_option(CLI::App& command, std::vector<std::string>& sets) {
-  command.add_option("--set", sets, "Env kwarg as key=value (repeatable); `pixelgym info ID` lists the keys")
+  command
+      .add_option("--set", sets,
+                  "Env kwarg as key=value (repeatable); `pixelgym info ID` lists the keys")
       ->type_name("KEY=VALUE");
 }
 
@@ -25,7 +27,7 @@ Params parse_sets(const std::string& id, const std::vector<std::string>& sets) {
     const std::string text = entry.substr(equals + 1);
     const auto declared = std::find_if(spec->params.begin(), spec->params.end(),
                                        [&](const ParamSpec& p) { return p.name == key; });
-    const ParamType type = key == "max_episode_steps" ? ParamType::kInt
+    const ParamType type = key == "max_episode_steps"       ? ParamType::kInt
                            : declared != spec->params.end() ? declared->type()
                                                             : ParamType::kString;
     try {
@@ -49,7 +51,8 @@ void write_frame_png(const std::string& path, const Array& frame) {
   if (!parent.empty()) {
     std::error_code error;
     std::filesystem::create_directories(parent, error);
-    if (error) throw std::runtime_error("cannot create folder " + parent.string() + ": " + error.message());
+    if (error)
+      throw std::runtime_error("cannot create folder " + parent.string() + ": " + error.message());
   }
   write_png(path, {frame.data<std::uint8_t>(), static_cast<int>(frame.shape()[0]),
                    static_cast<int>(frame.shape()[1]), 3});

@@ -1,12 +1,11 @@
 // Pieces shared by the `pixelgym` subcommands.
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <functional>
 #include <memory>
 #include <string>
 #include <vector>
-
-#include <CLI/CLI.hpp>
 
 #include "envs/array.h"
 #include "envs/env.h"

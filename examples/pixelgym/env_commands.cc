@@ -20,8 +20,8 @@ std::string join(const std::vector<std::string>& items) {
 
 int run_list() {
   for (const std::string& id : registered_ids()) {
-    std::cout << std::left << std::setw(28) << id << " "
-              << default_registry().spec(id)->description << "\n";
+    std::cout << std::left << std::setw(28) << id << " " << default_registry().spec(id)->description
+              << "\n";
   }
   return 0;
 }
@@ -79,8 +79,8 @@ int run_snapshot(const std::string& id, std::uint64_t seed, int steps, const std
   }
   const Array frame = env->render();
   write_frame_png(out, frame);
-  std::cout << "wrote " << out << " (" << frame.shape()[1] << "x" << frame.shape()[0] << ", "
-            << id << ", seed " << seed << ", " << steps << " steps)\n";
+  std::cout << "wrote " << out << " (" << frame.shape()[1] << "x" << frame.shape()[0] << ", " << id
+            << ", seed " << seed << ", " << steps << " steps)\n";
   env->close();
   return 0;
 }
@@ -127,20 +127,25 @@ std::vector<Command> add_env_commands(CLI::App& app) {
   auto options = std::make_shared<Options>();
   std::vector<Command> commands;
 
-  CLI::App* list = app.add_subcommand("list", "List the registered env ids, one per line with a description");
+  CLI::App* list =
+      app.add_subcommand("list", "List the registered env ids, one per line with a description");
   commands.push_back({list, [] { return run_list(); }});
 
-  CLI::App* info = app.add_subcommand("info", "Show an env's spaces, metadata and config keys (types, defaults)");
+  CLI::App* info = app.add_subcommand(
+      "info", "Show an env's spaces, metadata and config keys (types, defaults)");
   info->add_option("id", options->id, "Env id, e.g. GridWorld-v0")->required();
   add_set_option(*info, options->sets);
   commands.push_back({info, [options] { return run_info(options->id, options->sets); }});
 
   CLI::App* check = app.add_subcommand(
-      "check", "Run the env checker; exit 0 when every check passes, 1 otherwise (failures printed)");
+      "check",
+      "Run the env checker; exit 0 when every check passes, 1 otherwise (failures printed)");
   check->add_option("id", options->id, "Env id, e.g. GridWorld-v0")->required();
-  check->add_option("--seed", options->seed, "Seed for resets and random actions")->capture_default_str();
+  check->add_option("--seed", options->seed, "Seed for resets and random actions")
+      ->capture_default_str();
   check->add_option("--steps", options->steps, "Random steps per checked trajectory")
-      ->default_val(100)->check(CLI::PositiveNumber);
+      ->default_val(100)
+      ->check(CLI::PositiveNumber);
   add_set_option(*check, options->sets);
   commands.push_back({check, [options] {
                         return run_check(options->id, options->seed, options->steps, options->sets);
@@ -149,14 +154,17 @@ std::vector<Command> add_env_commands(CLI::App& app) {
   CLI::App* snapshot = app.add_subcommand(
       "snapshot", "Reset with a seed, take K seeded random actions, write render() as a PNG");
   snapshot->add_option("id", options->id, "Env id, e.g. GridWorld-v0")->required();
-  snapshot->add_option("--seed", options->seed, "Seed for the reset and the random actions")->required();
-  snapshot->add_option("--out", options->out, "PNG file to write (folders are created)")->required();
+  snapshot->add_option("--seed", options->seed, "Seed for the reset and the random actions")
+      ->required();
+  snapshot->add_option("--out", options->out, "PNG file to write (folders are created)")
+      ->required();
   snapshot->add_option("--steps", options->steps, "Random actions before the frame is taken")
-      ->default_val(0)->check(CLI::NonNegativeNumber);
+      ->default_val(0)
+      ->check(CLI::NonNegativeNumber);
   add_set_option(*snapshot, options->sets);
   commands.push_back({snapshot, [options] {
-                        return run_snapshot(options->id, options->seed, options->steps, options->out,
-                                            options->sets);
+                        return run_snapshot(options->id, options->seed, options->steps,
+                                            options->out, options->sets);
                       }});
 
   CLI::App* rollout = app.add_subcommand(
@@ -165,8 +173,10 @@ std::vector<Command> add_env_commands(CLI::App& app) {
   rollout->add_option("--seed", options->seed, "Seed for the first reset and the random actions")
       ->capture_default_str();
   rollout->add_option("--episodes", options->episodes, "Episodes to run")
-      ->capture_default_str()->check(CLI::PositiveNumber);
-  rollout->add_option("--snapshot", options->out, "Write the last episode's final frame to this PNG");
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  rollout->add_option("--snapshot", options->out,
+                      "Write the last episode's final frame to this PNG");
   add_set_option(*rollout, options->sets);
   commands.push_back({rollout, [options] {
                         return run_rollout(options->id, options->seed, options->episodes,

@@ -6,9 +6,10 @@
 #include "examples/pixelgym/cli.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"pixelgym: pixel-based reinforcement-learning environments (Bullet + OSMesa)\n"
-               "behind the Gymnasium API.",
-               "pixelgym"};
+  CLI::App app{
+      "pixelgym: pixel-based reinforcement-learning environments (Bullet + OSMesa)\n"
+      "behind the Gymnasium API.",
+      "pixelgym"};
   app.require_subcommand(1, 1);
   app.fallthrough(false);
   const std::vector<pixelgym::cli::Command> commands = pixelgym::cli::add_env_commands(app);
@@ -23,7 +24,8 @@ int main(int argc, char** argv) {
     }
     if (!known) {
       std::cerr << "pixelgym: unknown subcommand \"" << argv[1] << "\" (subcommands: " << names
-                << ")\n\n" << app.help();
+                << ")\n\n"
+                << app.help();
       return pixelgym::cli::kExitUsage;
     }
   }

@@ -44,14 +44,15 @@ TEST_P(CheckerFaultTest, TheMatchingCheckFailsWithAReason) {
       EXPECT_THAT(result.reason, ::testing::HasSubstr(GetParam().reason));
     }
   }
-  EXPECT_TRUE(found) << "check " << GetParam().check << " did not fail; failed: "
-                     << ::testing::PrintToString(failed_names(report));
+  EXPECT_TRUE(found) << "check " << GetParam().check
+                     << " did not fail; failed: " << ::testing::PrintToString(failed_names(report));
 }
 
 INSTANTIATE_TEST_SUITE_P(
     EveryCheck, CheckerFaultTest,
     ::testing::Values(
-        FaultCase{Fault::kObservationSpaceSamplesOutside, "observation_space", "not in its own space"},
+        FaultCase{Fault::kObservationSpaceSamplesOutside, "observation_space",
+                  "not in its own space"},
         FaultCase{Fault::kActionSpaceSamplesOutside, "action_space", "not in its own space"},
         FaultCase{Fault::kResetObservationWrongDtype, "reset", "dtype float64, expected float32"},
         FaultCase{Fault::kResetIgnoresSeed, "reset_seed", "twice gave"},
@@ -71,7 +72,8 @@ TEST(CheckerTest, ReportsEveryFailureNotOnlyTheFirst) {
   // Nondeterministic steps break both determinism checks of resets and steps at once.
   ProbeEnv env(Fault::kResetIgnoresSeed);
   const std::vector<std::string> failed = failed_names(check_env(env));
-  EXPECT_THAT(failed, ::testing::IsSupersetOf({"reset_seed", "reset_unseeded", "step_determinism"}));
+  EXPECT_THAT(failed,
+              ::testing::IsSupersetOf({"reset_seed", "reset_unseeded", "step_determinism"}));
 }
 
 }  // namespace

@@ -10,9 +10,9 @@
 namespace pixelgym {
 namespace {
 
+using testing::action;
 using ::testing::HasSubstr;
 using testing::ProbeEnv;
-using testing::action;
 
 TEST(EnvTest, StepBeforeResetThrowsResetNeeded) {
   ProbeEnv env;
@@ -49,11 +49,11 @@ TEST(EnvTest, ActionsOutsideTheSpaceAreRejectedNamingSpaceAndValue) {
   ProbeEnv env;
   env.reset(0);
   const std::vector<Value> bad = {
-      Array::from_vector<double>({1}, {0.0}),          // wrong dtype
-      Array::from_vector<float>({2}, {0.0F, 0.0F}),    // wrong shape
-      Array::from_vector<float>({1}, {NAN}),           // NaN
-      Array::from_vector<float>({1}, {1.5F}),          // out of bounds
-      Value(Dict{{"a", Array::scalar(1.0F)}}),         // wrong structure
+      Array::from_vector<double>({1}, {0.0}),        // wrong dtype
+      Array::from_vector<float>({2}, {0.0F, 0.0F}),  // wrong shape
+      Array::from_vector<float>({1}, {NAN}),         // NaN
+      Array::from_vector<float>({1}, {1.5F}),        // out of bounds
+      Value(Dict{{"a", Array::scalar(1.0F)}}),       // wrong structure
   };
   for (const Value& value : bad) {
     try {

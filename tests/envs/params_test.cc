@@ -5,9 +5,10 @@
 namespace pixelgym {
 namespace {
 
-const std::vector<ParamSpec> kSpecs = {
-    {"width", 84, "image width"}, {"scale", 0.5, "a float"}, {"camera", "side", "a string"},
-    {"shadows", true, "a bool"}};
+const std::vector<ParamSpec> kSpecs = {{"width", 84, "image width"},
+                                       {"scale", 0.5, "a float"},
+                                       {"camera", "side", "a string"},
+                                       {"shadows", true, "a bool"}};
 
 TEST(ParamsTest, LiteralsPickTheRightType) {
   EXPECT_EQ(Param(3).type(), ParamType::kInt);

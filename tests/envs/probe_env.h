@@ -34,7 +34,8 @@ class OffsetBox final : public Space {
   OffsetBox(spaces::Box box, double offset) : box_(std::move(box)), offset_(offset) {}
   Value sample(Rng& rng) const override {
     Array array = box_.sample(rng).array();
-    for (std::int64_t i = 0; i < array.size(); ++i) array.data<float>()[i] += static_cast<float>(offset_);
+    for (std::int64_t i = 0; i < array.size(); ++i)
+      array.data<float>()[i] += static_cast<float>(offset_);
     return array;
   }
   std::string mismatch(const Value& value) const override { return box_.mismatch(value); }
@@ -123,7 +124,8 @@ class ProbeEnv final : public Env {
       shared_obs_.data<float>()[1] = static_cast<float>(t_) / 100.0F;
       return shared_obs_;
     }
-    return Array::from_vector<float>({2}, {static_cast<float>(x_), static_cast<float>(t_) / 100.0F});
+    return Array::from_vector<float>({2},
+                                     {static_cast<float>(x_), static_cast<float>(t_) / 100.0F});
   }
 
   Fault fault_;

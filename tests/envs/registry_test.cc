@@ -17,8 +17,8 @@ EnvSpec probe_spec(const std::string& id) {
   spec.description = "probe";
   spec.params = {{"episode_length", 20, "steps until terminated"}, {"gain", 0.1, "unused"}};
   spec.factory = [](const Params& kwargs) {
-    return std::make_unique<testing::ProbeEnv>(testing::Fault::kNone,
-                                               static_cast<int>(kwargs.at("episode_length").as_int()));
+    return std::make_unique<testing::ProbeEnv>(
+        testing::Fault::kNone, static_cast<int>(kwargs.at("episode_length").as_int()));
   };
   return spec;
 }
@@ -57,7 +57,9 @@ TEST(RegistryTest, MaxEpisodeStepsAppliesTimeLimitAndCanBeOverridden) {
   EXPECT_EQ(dynamic_cast<TimeLimit&>(*overridden).max_episode_steps(), 9);
   auto unlimited = registry.make("Probe-v0", {{"max_episode_steps", 0}});
   EXPECT_EQ(dynamic_cast<TimeLimit*>(unlimited.get()), nullptr);
-  EXPECT_THAT(error_of([&] { registry.make("Probe-v0", {{"max_episode_steps", -1}}); }),
+  EXPECT_THAT(error_of([&] {
+                registry.make("Probe-v0", {{"max_episode_steps", -1}});
+              }),
               HasSubstr("max_episode_steps"));
 }
 
@@ -85,7 +87,9 @@ TEST(RegistryTest, UnknownKwargListsValidOnesWithTypesAndDefaults) {
 TEST(RegistryTest, WrongKwargTypeIsRejected) {
   Registry registry;
   registry.register_env(probe_spec("Probe-v0"));
-  EXPECT_THAT(error_of([&] { registry.make("Probe-v0", {{"episode_length", "long"}}); }),
+  EXPECT_THAT(error_of([&] {
+                registry.make("Probe-v0", {{"episode_length", "long"}});
+              }),
               HasSubstr("kwarg \"episode_length\" must be a int, got string \"long\""));
   EXPECT_NO_THROW(registry.make("Probe-v0", {{"gain", 1}}));  // int accepted for float
 }

@@ -7,8 +7,8 @@
 namespace pixelgym {
 namespace {
 
-using testing::ProbeEnv;
 using testing::action;
+using testing::ProbeEnv;
 
 TEST(TimeLimitTest, TruncatesOnTheLimitStepAndResets) {
   TimeLimit env(std::make_unique<ProbeEnv>(testing::Fault::kNone, 100), 3);

@@ -53,7 +53,8 @@ TEST(ValueTest, EqualsComparesStructure) {
 }
 
 TEST(ValueTest, LeavesAreDepthFirst) {
-  Value value = Dict{{"a", Array::scalar(1.0)}, {"b", Tuple{Array::scalar(2.0), Array::scalar(3.0)}}};
+  Value value =
+      Dict{{"a", Array::scalar(1.0)}, {"b", Tuple{Array::scalar(2.0), Array::scalar(3.0)}}};
   const std::vector<Array> leaves = value.leaves();
   ASSERT_EQ(leaves.size(), 3U);
   EXPECT_EQ(leaves[2].item<double>(), 3.0);

@@ -9,8 +9,8 @@
 namespace pixelgym {
 namespace {
 
-using testing::ProbeEnv;
 using testing::action;
+using testing::ProbeEnv;
 
 // Doubles observations and declares the doubled bounds.
 class DoubleObservation final : public ObservationWrapper {
@@ -105,9 +105,7 @@ TEST(WrapperTest, OrderIsEnforcedAtTheWrapperAndCloseReachesInner) {
   EXPECT_EQ(probe->close_calls(), 1);
 }
 
-TEST(WrapperTest, NullEnvIsRejected) {
-  EXPECT_THROW(NegateReward(nullptr), std::invalid_argument);
-}
+TEST(WrapperTest, NullEnvIsRejected) { EXPECT_THROW(NegateReward(nullptr), std::invalid_argument); }
 
 }  // namespace
 }  // namespace pixelgym

@@ -62,8 +62,8 @@ TEST(PixelgymCliTest, CheckUnknownIdFailsAndSuggests) {
 
 TEST(PixelgymCliTest, UnknownSubcommandAndBadFlagsExitTwoWithUsage) {
   for (const char* arguments :
-       {"frobnicate", "", "check", "check GridWorld-v0 --bogus", "snapshot GridWorld-v0 --seed x --out a.png",
-        "check GridWorld-v0 --set novalue"}) {
+       {"frobnicate", "", "check", "check GridWorld-v0 --bogus",
+        "snapshot GridWorld-v0 --seed x --out a.png", "check GridWorld-v0 --set novalue"}) {
     const CliRun result = run(std::string(arguments));
     EXPECT_EQ(result.exit_code, 2) << arguments << ": " << result.output;
     EXPECT_THAT(result.output, HasSubstr("Usage")) << arguments;
@@ -80,7 +80,7 @@ TEST(PixelgymCliTest, SetPassesTypedKwargsAndReportsUnknownOnes) {
   const std::string out = std::string(PIXELGYM_TEST_OUTPUT_DIR) + "/cli/gridworld_small.png";
   std::filesystem::remove(out);
   const CliRun small = run("snapshot GridWorld-v0 --seed 0 --steps 3 --out " + out +
-                        " --set render_width=96 --set render_height=64");
+                           " --set render_width=96 --set render_height=64");
   ASSERT_EQ(small.exit_code, 0) << small.output;
   const Image image = read_png(out);
   EXPECT_EQ(image.width, 96);

@@ -58,7 +58,11 @@ TEST(ImageIoTest, MalformedViewIsRejected) {
 
 TEST(ImageIoTest, UnreadableFileThrowsNamingIt) {
   const std::string path = output_path("not_a_png.png");
-  { std::FILE* f = std::fopen(path.c_str(), "w"); std::fputs("hello", f); std::fclose(f); }
+  {
+    std::FILE* f = std::fopen(path.c_str(), "w");
+    std::fputs("hello", f);
+    std::fclose(f);
+  }
   EXPECT_THROW(read_png(path), std::runtime_error);
   EXPECT_THROW(read_png(output_path("missing.png")), std::runtime_error);
 }

@@ -23,8 +23,8 @@ TEST(BoxTest, SamplesAreContainedAcrossSeedsForEveryBoundKind) {
     for (std::uint64_t seed = 0; seed < 50; ++seed) {
       Rng rng(seed);
       const Value sample = box.sample(rng);
-      ASSERT_TRUE(box.contains(sample)) << box.to_string() << " seed " << seed << ": "
-                                        << box.mismatch(sample);
+      ASSERT_TRUE(box.contains(sample))
+          << box.to_string() << " seed " << seed << ": " << box.mismatch(sample);
     }
   }
 }
@@ -48,8 +48,10 @@ TEST(BoxTest, ContainsRejectsWrongDtypeShapeBoundsAndNan) {
   EXPECT_FALSE(box.contains(Array::from_vector<float>({2}, {0.0F, 1.5F})));
   EXPECT_FALSE(box.contains(Array::from_vector<float>({2}, {NAN, 0.0F})));
   EXPECT_FALSE(box.contains(Value(Dict{})));
-  EXPECT_NE(box.mismatch(Array::from_vector<float>({2}, {NAN, 0.0F})).find("NaN"), std::string::npos);
-  EXPECT_NE(box.mismatch(Array::from_vector<double>({2}, {0, 0})).find("float64"), std::string::npos);
+  EXPECT_NE(box.mismatch(Array::from_vector<float>({2}, {NAN, 0.0F})).find("NaN"),
+            std::string::npos);
+  EXPECT_NE(box.mismatch(Array::from_vector<double>({2}, {0, 0})).find("float64"),
+            std::string::npos);
 }
 
 TEST(BoxTest, UnboundedFloatBoxContainsInfinityButNotNan) {
@@ -79,7 +81,8 @@ TEST(BoxTest, ToStringAndEquals) {
   EXPECT_EQ(Box(-1.0, 1.0, {1}).to_string(), "Box(-1.0, 1.0, (1,), float32)");
   EXPECT_EQ(Box(0.0, 255.0, {84, 84, 3}, DType::kUInt8).to_string(),
             "Box(0.0, 255.0, (84, 84, 3), uint8)");
-  EXPECT_EQ(Box({0.0, -kInf}, {1.0, kInf}, {2}).to_string(), "Box([0.0, -inf], [1.0, inf], (2,), float32)");
+  EXPECT_EQ(Box({0.0, -kInf}, {1.0, kInf}, {2}).to_string(),
+            "Box([0.0, -inf], [1.0, inf], (2,), float32)");
   EXPECT_TRUE(Box(-1.0, 1.0, {2}).equals(Box(-1.0, 1.0, {2})));
   EXPECT_FALSE(Box(-1.0, 1.0, {2}).equals(Box(-1.0, 2.0, {2})));
   EXPECT_FALSE(Box(-1.0, 1.0, {2}).equals(Box(-1.0, 1.0, {2}, DType::kFloat64)));

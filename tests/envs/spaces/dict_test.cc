@@ -40,7 +40,8 @@ TEST(DictSpaceTest, ContainsRejectsMissingExtraAndBadValues) {
 
   pixelgym::Dict wrong_dtype = value;
   wrong_dtype.insert("joint_pos", Array(DType::kFloat64, {2}));
-  EXPECT_NE(space.mismatch(wrong_dtype).find("key \"joint_pos\": dtype float64"), std::string::npos);
+  EXPECT_NE(space.mismatch(wrong_dtype).find("key \"joint_pos\": dtype float64"),
+            std::string::npos);
 
   pixelgym::Dict nan_value = value;
   nan_value.insert("joint_pos", Array::from_vector<float>({2}, {NAN, 0.0F}));

@@ -27,7 +27,7 @@ TEST(GridWorldTest, ShortestPathEarnsStepPenaltiesThenGoalReward) {
   env.reset(0);
   // Around the wall at (1, 1): right x3, down x3 reaches (3, 3) in six moves.
   const std::vector<Action> path = {GridWorld::kRight, GridWorld::kRight, GridWorld::kRight,
-                                    GridWorld::kDown, GridWorld::kDown, GridWorld::kDown};
+                                    GridWorld::kDown,  GridWorld::kDown,  GridWorld::kDown};
   const std::vector<std::int64_t> cells = {1, 2, 3, 7, 11, 15};
   double total = 0.0;
   for (std::size_t i = 0; i < path.size(); ++i) {
