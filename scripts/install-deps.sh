@@ -9,7 +9,7 @@ PACKAGES=(
   # toolchain
   cmake g++ make pkg-config ccache
   # engine: physics, URDF parsing, mesh import, linear algebra
-  libbullet-dev liburdfdom-dev libassimp-dev libeigen3-dev
+  libbullet-dev liburdfdom-dev libconsole-bridge-dev libtinyxml-dev libassimp-dev libeigen3-dev
   # render: off-screen OpenGL (llvmpipe) and PNG files
   libosmesa6-dev libpng-dev
   # wrappers: resize, colour conversion, H.264 video

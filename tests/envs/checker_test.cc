@@ -29,6 +29,7 @@ struct FaultCase {
   Fault fault;
   std::string check;   // the check that must catch it
   std::string reason;  // a phrase its reason must contain
+  friend void PrintTo(const FaultCase& c, std::ostream* out) { *out << c.check; }
 };
 
 class CheckerFaultTest : public ::testing::TestWithParam<FaultCase> {};

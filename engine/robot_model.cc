@@ -1,0 +1,481 @@
+#include "engine/robot_model.h"
+
+#include <console_bridge/console.h>
+#include <tinyxml.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace pixelgym::engine {
+namespace fs = std::filesystem;
+
+namespace {
+
+[[noreturn]] void fail(const std::string& path, const std::string& problem) {
+  throw UrdfError("URDF " + path + ": " + problem);
+}
+
+// Collects urdfdom's console_bridge messages while it parses, so that its reasons reach the
+// exception. console_bridge has one process-wide handler, so parses are serialized.
+class CapturedLog : public console_bridge::OutputHandler {
+ public:
+  void log(const std::string& text, console_bridge::LogLevel level, const char* /*file*/,
+           int /*line*/) override {
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_WARN) messages += (messages.empty() ? "" : "; ") + text;
+  }
+  std::string messages;
+};
+
+std::mutex& urdfdom_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+Eigen::Isometry3d to_isometry(const urdf::Pose& pose) {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.translation() = Eigen::Vector3d(pose.position.x, pose.position.y, pose.position.z);
+  X.linear() = Eigen::Quaterniond(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z)
+                   .normalized()
+                   .toRotationMatrix();
+  return X;
+}
+
+// What the XML pass learns before urdfdom sees the file.
+struct XmlFacts {
+  std::string xml;  // with <capsule> rewritten as <cylinder>
+  // (link, "visual"/"collision", index within that link) of each element that was a capsule.
+  std::set<std::tuple<std::string, std::string, int>> capsules;
+};
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, "cannot be read (missing or unreadable)");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Checks the structure that urdfdom reports poorly (or not at all) and rewrites capsules.
+XmlFacts inspect_xml(const std::string& path) {
+  const std::string text = read_file(path);
+  TiXmlDocument document;
+  document.Parse(text.c_str());
+  if (document.Error()) {
+    fail(path, "malformed XML at line " + std::to_string(document.ErrorRow()) + ", column " +
+                   std::to_string(document.ErrorCol()) + ": " + document.ErrorDesc());
+  }
+  TiXmlElement* robot = document.RootElement();
+  if (robot == nullptr || std::string(robot->Value()) != "robot") {
+    fail(path, "the root element must be <robot>");
+  }
+
+  XmlFacts facts;
+  std::vector<std::string> links;
+  for (TiXmlElement* link = robot->FirstChildElement("link"); link != nullptr;
+       link = link->NextSiblingElement("link")) {
+    const char* name = link->Attribute("name");
+    if (name == nullptr || *name == '\0') fail(path, "a <link> has no name");
+    if (std::find(links.begin(), links.end(), name) != links.end()) {
+      fail(path, "two links are named \"" + std::string(name) + "\"");
+    }
+    links.emplace_back(name);
+    for (const char* kind : {"visual", "collision"}) {
+      int index = 0;
+      for (TiXmlElement* element = link->FirstChildElement(kind); element != nullptr;
+           element = element->NextSiblingElement(kind), ++index) {
+        TiXmlElement* geometry = element->FirstChildElement("geometry");
+        TiXmlElement* capsule = geometry != nullptr ? geometry->FirstChildElement("capsule") : nullptr;
+        if (capsule != nullptr) {
+          capsule->SetValue("cylinder");
+          facts.capsules.emplace(name, kind, index);
+        }
+      }
+    }
+  }
+  if (links.empty()) fail(path, "has no links");
+
+  std::map<std::string, std::string> parent_joint_of;  // child link -> joint
+  std::map<std::string, std::vector<std::string>> children_of;
+  for (TiXmlElement* joint = robot->FirstChildElement("joint"); joint != nullptr;
+       joint = joint->NextSiblingElement("joint")) {
+    const std::string name = joint->Attribute("name") != nullptr ? joint->Attribute("name") : "";
+    const std::string type = joint->Attribute("type") != nullptr ? joint->Attribute("type") : "";
+    if (name.empty()) fail(path, "a <joint> has no name");
+    if (type == "planar" || type == "floating") {
+      fail(path, "joint \"" + name + "\" has type " + type +
+                     ", which pixelgym does not support inside a robot (supported: revolute, "
+                     "continuous, prismatic, fixed; a floating base is chosen when the robot is "
+                     "added to a world)");
+    }
+    const TiXmlElement* parent = joint->FirstChildElement("parent");
+    const TiXmlElement* child = joint->FirstChildElement("child");
+    const char* parent_name = parent != nullptr ? parent->Attribute("link") : nullptr;
+    const char* child_name = child != nullptr ? child->Attribute("link") : nullptr;
+    if (parent_name == nullptr || child_name == nullptr) {
+      fail(path, "joint \"" + name + "\" needs <parent link=...> and <child link=...>");
+    }
+    for (const char* link : {parent_name, child_name}) {
+      if (std::find(links.begin(), links.end(), link) == links.end()) {
+        fail(path, "joint \"" + name + "\" names link \"" + link + "\", which does not exist");
+      }
+    }
+    if (std::string(parent_name) == child_name) {
+      fail(path, "joint \"" + name + "\" connects link \"" + child_name + "\" to itself");
+    }
+    if (parent_joint_of.count(child_name) != 0) {
+      fail(path, "link \"" + std::string(child_name) + "\" is the child of two joints (\"" +
+                     parent_joint_of[child_name] + "\" and \"" + name + "\"): joints form a cycle");
+    }
+    parent_joint_of[child_name] = name;
+    children_of[parent_name].emplace_back(child_name);
+  }
+
+  std::vector<std::string> roots;
+  for (const std::string& link : links) {
+    if (parent_joint_of.count(link) == 0) roots.push_back(link);
+  }
+  if (roots.empty()) fail(path, "every link has a parent: the joints form a cycle");
+  if (roots.size() > 1) {
+    fail(path, "has " + std::to_string(roots.size()) + " root links (\"" + roots[0] + "\" and \"" +
+                   roots[1] + "\"); a robot is one tree");
+  }
+  std::set<std::string> reached;
+  std::vector<std::string> stack = {roots[0]};
+  while (!stack.empty()) {
+    const std::string link = stack.back();
+    stack.pop_back();
+    if (!reached.insert(link).second) continue;
+    for (const std::string& child : children_of[link]) stack.push_back(child);
+  }
+  if (reached.size() != links.size()) {
+    for (const std::string& link : links) {
+      if (reached.count(link) == 0) {
+        fail(path, "link \"" + link + "\" cannot be reached from the root \"" + roots[0] +
+                       "\": its joints form a cycle");
+      }
+    }
+  }
+  TiXmlPrinter printer;
+  document.Accept(&printer);
+  facts.xml = printer.CStr();
+  return facts;
+}
+
+Geometry convert_geometry(const urdf::Geometry& source, bool is_capsule, const std::string& path,
+                          const std::string& where, MeshCache& meshes) {
+  Geometry geometry;
+  switch (source.type) {
+    case urdf::Geometry::BOX: {
+      const auto& box = static_cast<const urdf::Box&>(source);
+      geometry.type = GeometryType::kBox;
+      geometry.box_size_m = {box.dim.x, box.dim.y, box.dim.z};
+      break;
+    }
+    case urdf::Geometry::SPHERE:
+      geometry.type = GeometryType::kSphere;
+      geometry.radius_m = static_cast<const urdf::Sphere&>(source).radius;
+      break;
+    case urdf::Geometry::CYLINDER: {
+      const auto& cylinder = static_cast<const urdf::Cylinder&>(source);
+      geometry.type = is_capsule ? GeometryType::kCapsule : GeometryType::kCylinder;
+      geometry.radius_m = cylinder.radius;
+      geometry.length_m = cylinder.length;
+      break;
+    }
+    case urdf::Geometry::MESH: {
+      const auto& mesh = static_cast<const urdf::Mesh&>(source);
+      geometry.type = GeometryType::kMesh;
+      geometry.mesh_scale = {mesh.scale.x, mesh.scale.y, mesh.scale.z};
+      try {
+        geometry.mesh = meshes.get(resolve_uri(mesh.filename, path));
+      } catch (const std::runtime_error& error) {
+        fail(path, where + ": " + error.what());
+      }
+      break;
+    }
+  }
+  const bool positive = geometry.type == GeometryType::kBox
+                            ? (geometry.box_size_m.array() > 0).all()
+                        : geometry.type == GeometryType::kMesh
+                            ? (geometry.mesh_scale.array() != 0).all()
+                            : geometry.radius_m > 0 && geometry.length_m >= 0;
+  if (!positive) fail(path, where + ": " + geometry_type_name(geometry.type) + " has a zero or negative size");
+  return geometry;
+}
+
+}  // namespace
+
+const char* geometry_type_name(GeometryType type) {
+  switch (type) {
+    case GeometryType::kBox: return "box";
+    case GeometryType::kSphere: return "sphere";
+    case GeometryType::kCylinder: return "cylinder";
+    case GeometryType::kCapsule: return "capsule";
+    case GeometryType::kMesh: return "mesh";
+  }
+  return "unknown";
+}
+
+const char* joint_type_name(JointType type) {
+  switch (type) {
+    case JointType::kRevolute: return "revolute";
+    case JointType::kContinuous: return "continuous";
+    case JointType::kPrismatic: return "prismatic";
+    case JointType::kFixed: return "fixed";
+  }
+  return "unknown";
+}
+
+RobotModel::RobotModel(std::string name, std::string path, std::vector<LinkModel> links,
+                       std::vector<JointModel> joints)
+    : name_(std::move(name)), path_(std::move(path)), links_(std::move(links)), joints_(std::move(joints)) {
+  for (std::size_t i = 0; i < joints_.size(); ++i) {
+    if (joints_[i].movable()) movable_joints_.push_back(static_cast<int>(i));
+  }
+}
+
+int RobotModel::link_index(const std::string& name) const {
+  for (std::size_t i = 0; i < links_.size(); ++i) {
+    if (links_[i].name == name) return static_cast<int>(i);
+  }
+  throw std::out_of_range("robot \"" + name_ + "\" has no link \"" + name + "\"");
+}
+
+int RobotModel::joint_index(const std::string& name) const {
+  for (std::size_t i = 0; i < joints_.size(); ++i) {
+    if (joints_[i].name == name) return static_cast<int>(i);
+  }
+  throw std::out_of_range("robot \"" + name_ + "\" has no joint \"" + name + "\"");
+}
+
+double RobotModel::total_mass_kg() const {
+  double total = 0.0;
+  for (const LinkModel& link : links_) total += link.inertial.mass_kg;
+  return total;
+}
+
+std::vector<std::string> asset_search_path() {
+  std::vector<std::string> folders;
+  if (const char* variable = std::getenv("PIXELGYM_ASSET_PATH")) {
+    std::stringstream entries(variable);
+    std::string entry;
+    while (std::getline(entries, entry, ':')) {
+      if (!entry.empty()) folders.push_back(entry);
+    }
+  }
+  folders.emplace_back(PIXELGYM_ASSETS_DIR);
+  return folders;
+}
+
+std::string asset_path(const std::string& relative) {
+  for (const std::string& folder : asset_search_path()) {
+    const fs::path candidate = fs::path(folder) / relative;
+    if (fs::exists(candidate)) return candidate.lexically_normal().string();
+  }
+  throw UrdfError("asset \"" + relative + "\" not found in PIXELGYM_ASSET_PATH or " +
+                  PIXELGYM_ASSETS_DIR);
+}
+
+std::string resolve_uri(const std::string& uri, const std::string& urdf_path) {
+  const fs::path urdf_folder = fs::absolute(urdf_path).parent_path();
+  const std::string kFile = "file://";
+  const std::string kPackage = "package://";
+  if (uri.rfind(kFile, 0) == 0) return fs::path(uri.substr(kFile.size())).lexically_normal().string();
+  if (uri.rfind(kPackage, 0) != 0) {
+    const fs::path file(uri);
+    return (file.is_absolute() ? file : urdf_folder / file).lexically_normal().string();
+  }
+  const std::string rest = uri.substr(kPackage.size());
+  const std::size_t slash = rest.find('/');
+  const std::string inside_package = slash == std::string::npos ? rest : rest.substr(slash + 1);
+  std::vector<fs::path> roots;
+  for (fs::path folder = urdf_folder; !folder.empty(); folder = folder.parent_path()) {
+    roots.push_back(folder);
+    if (folder == folder.parent_path() || roots.size() > 4) break;
+  }
+  for (const std::string& folder : asset_search_path()) roots.emplace_back(folder);
+  for (const fs::path& root : roots) {
+    for (const fs::path& candidate : {root / rest, root / inside_package}) {
+      if (fs::exists(candidate)) return candidate.lexically_normal().string();
+    }
+  }
+  throw UrdfError("cannot resolve \"" + uri + "\": looked for \"" + rest + "\" beside " +
+                  urdf_folder.string() + ", in its parents and in the asset search path");
+}
+
+std::shared_ptr<const RobotModel> parse_urdf(const std::string& path, MeshCache& meshes) {
+  const XmlFacts facts = inspect_xml(path);
+
+  urdf::ModelInterfaceSharedPtr urdf;
+  std::string urdfdom_messages;
+  {
+    std::lock_guard<std::mutex> lock(urdfdom_mutex());
+    CapturedLog log;
+    console_bridge::OutputHandler* previous = console_bridge::getOutputHandler();
+    console_bridge::useOutputHandler(&log);
+    urdf = urdf::parseURDF(facts.xml);
+    console_bridge::useOutputHandler(previous);
+    urdfdom_messages = log.messages;
+  }
+  if (urdf == nullptr) fail(path, urdfdom_messages.empty() ? "urdfdom could not parse it" : urdfdom_messages);
+
+  // Tree order: depth first from the root, children in the order urdfdom lists them.
+  std::vector<urdf::LinkConstSharedPtr> order;
+  std::vector<urdf::LinkConstSharedPtr> stack = {urdf->getRoot()};
+  while (!stack.empty()) {
+    urdf::LinkConstSharedPtr link = stack.back();
+    stack.pop_back();
+    order.push_back(link);
+    for (auto child = link->child_links.rbegin(); child != link->child_links.rend(); ++child) {
+      stack.push_back(*child);
+    }
+  }
+
+  std::vector<LinkModel> links;
+  std::vector<JointModel> joints;
+  std::map<std::string, int> index_of;
+  for (const urdf::LinkConstSharedPtr& source : order) {
+    LinkModel link;
+    link.name = source->name;
+    index_of[link.name] = static_cast<int>(links.size());
+    if (source->inertial) {
+      const urdf::Inertial& inertial = *source->inertial;
+      link.inertial.mass_kg = inertial.mass;
+      link.inertial.X_link_inertial = to_isometry(inertial.origin);
+      link.inertial.inertia_kg_m2 << inertial.ixx, inertial.ixy, inertial.ixz, inertial.ixy,
+          inertial.iyy, inertial.iyz, inertial.ixz, inertial.iyz, inertial.izz;
+    }
+    for (std::size_t i = 0; i < source->visual_array.size(); ++i) {
+      const urdf::Visual& visual = *source->visual_array[i];
+      const std::string where = "link \"" + link.name + "\" visual " + std::to_string(i);
+      if (!visual.geometry) fail(path, where + " has no geometry");
+      VisualElement element;
+      element.X_link_geometry = to_isometry(visual.origin);
+      element.geometry = convert_geometry(
+          *visual.geometry, facts.capsules.count({link.name, "visual", static_cast<int>(i)}) != 0,
+          path, where, meshes);
+      element.material.name = visual.material_name;
+      if (visual.material) {
+        const urdf::Color& color = visual.material->color;
+        element.material.rgba = {color.r, color.g, color.b, color.a};
+        // urdfdom leaves an unset colour black; black is read as "no colour given".
+        element.material.has_rgba = color.r != 0 || color.g != 0 || color.b != 0;
+        if (!element.material.has_rgba) element.material.rgba = {0.75, 0.75, 0.75, 1.0};
+        if (!visual.material->texture_filename.empty()) {
+          try {
+            element.material.texture_path = resolve_uri(visual.material->texture_filename, path);
+          } catch (const UrdfError& error) {
+            fail(path, where + " texture: " + error.what());
+          }
+        }
+      }
+      link.visuals.push_back(std::move(element));
+    }
+    for (std::size_t i = 0; i < source->collision_array.size(); ++i) {
+      const urdf::Collision& collision = *source->collision_array[i];
+      const std::string where = "link \"" + link.name + "\" collision " + std::to_string(i);
+      if (!collision.geometry) fail(path, where + " has no geometry");
+      CollisionElement element;
+      element.X_link_geometry = to_isometry(collision.origin);
+      element.geometry = convert_geometry(
+          *collision.geometry,
+          facts.capsules.count({link.name, "collision", static_cast<int>(i)}) != 0, path, where, meshes);
+      link.collisions.push_back(std::move(element));
+    }
+    links.push_back(std::move(link));
+  }
+
+  for (std::size_t i = 1; i < order.size(); ++i) {
+    const urdf::Joint& source = *order[i]->parent_joint;
+    JointModel joint;
+    joint.name = source.name;
+    joint.parent_link = index_of.at(source.parent_link_name);
+    joint.child_link = index_of.at(source.child_link_name);
+    joint.X_parent_joint = to_isometry(source.parent_to_joint_origin_transform);
+    const std::string where = "joint \"" + joint.name + "\"";
+    switch (source.type) {
+      case urdf::Joint::REVOLUTE: joint.type = JointType::kRevolute; break;
+      case urdf::Joint::CONTINUOUS: joint.type = JointType::kContinuous; break;
+      case urdf::Joint::PRISMATIC: joint.type = JointType::kPrismatic; break;
+      case urdf::Joint::FIXED: joint.type = JointType::kFixed; break;
+      default: fail(path, where + " has an unsupported type");
+    }
+    if (joint.movable()) {
+      const Eigen::Vector3d axis(source.axis.x, source.axis.y, source.axis.z);
+      if (axis.norm() < 1e-9) fail(path, where + " has a zero axis");
+      joint.axis = axis.normalized();
+    }
+    if (source.limits) {
+      joint.effort_limit = source.limits->effort;
+      joint.velocity_limit = source.limits->velocity;
+      if (joint.type == JointType::kRevolute || joint.type == JointType::kPrismatic) {
+        joint.has_limits = true;
+        joint.lower = source.limits->lower;
+        joint.upper = source.limits->upper;
+        if (joint.lower > joint.upper) {
+          std::ostringstream message;
+          message << where << " has lower limit " << joint.lower << " > upper limit " << joint.upper;
+          fail(path, message.str());
+        }
+      }
+    }
+    if (source.dynamics) {
+      joint.damping = source.dynamics->damping;
+      joint.friction = source.dynamics->friction;
+    }
+    links[static_cast<std::size_t>(joint.child_link)].parent_joint = static_cast<int>(joints.size());
+    joints.push_back(joint);
+  }
+
+  // A link that moves needs positive mass and a positive-definite inertia. (The root's mass is
+  // checked when it is added with a floating base.)
+  for (const JointModel& joint : joints) {
+    if (!joint.movable()) continue;
+    const LinkModel& link = links[static_cast<std::size_t>(joint.child_link)];
+    const std::string where = "link \"" + link.name + "\" (moved by joint \"" + joint.name + "\")";
+    if (!(link.inertial.mass_kg > 0)) {
+      std::ostringstream message;
+      message << where << " has mass " << link.inertial.mass_kg << " kg; moving links need mass > 0";
+      fail(path, message.str());
+    }
+    const Eigen::Vector3d eigenvalues =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(link.inertial.inertia_kg_m2).eigenvalues();
+    if (!(eigenvalues.minCoeff() > 0)) {
+      std::ostringstream message;
+      message << where << " has an inertia that is not positive definite (eigenvalues "
+              << eigenvalues.transpose() << ")";
+      fail(path, message.str());
+    }
+  }
+  return std::make_shared<const RobotModel>(urdf->getName(), fs::absolute(path).lexically_normal().string(),
+                                            std::move(links), std::move(joints));
+}
+
+std::shared_ptr<const RobotModel> ModelCache::load_urdf(const std::string& path) {
+  const std::string key = fs::absolute(path).lexically_normal().string();
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto found = models_.find(key);
+  if (found != models_.end()) return found->second;
+  std::shared_ptr<const RobotModel> model = parse_urdf(key, meshes_);
+  ++urdfs_parsed_;
+  models_.emplace(key, model);
+  return model;
+}
+
+int ModelCache::urdfs_parsed() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return urdfs_parsed_;
+}
+
+ModelCache& default_model_cache() {
+  static ModelCache cache;
+  return cache;
+}
+
+}  // namespace pixelgym::engine

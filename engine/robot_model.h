@@ -1,0 +1,174 @@
+// RobotModel: a URDF robot parsed once (urdfdom) with its meshes (assimp), immutable and shared.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "engine/mesh.h"
+
+namespace pixelgym::engine {
+
+/// A URDF or mesh file that cannot be used; the message names the file and the problem.
+class UrdfError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+enum class GeometryType { kBox, kSphere, kCylinder, kCapsule, kMesh };
+
+/// "box", "sphere", "cylinder", "capsule", "mesh".
+const char* geometry_type_name(GeometryType type);
+
+/// A primitive or a mesh, in metres. Cylinders and capsules lie along their local z axis.
+struct Geometry {
+  GeometryType type = GeometryType::kBox;
+  /// Box: full side lengths.
+  Eigen::Vector3d box_size_m{1.0, 1.0, 1.0};
+  /// Sphere, cylinder, capsule.
+  double radius_m = 0.0;
+  /// Cylinder and capsule: length of the cylindrical part (a capsule adds a hemisphere each end).
+  double length_m = 0.0;
+  /// Mesh: shared vertex data in the file's units, and the URDF's scale.
+  std::shared_ptr<const Mesh> mesh;
+  Eigen::Vector3d mesh_scale{1.0, 1.0, 1.0};
+};
+
+/// Surface appearance from the URDF's <material>.
+struct Material {
+  std::string name;
+  Eigen::Vector4d rgba{0.75, 0.75, 0.75, 1.0};
+  /// False when the URDF gave no colour (mesh parts then keep their own).
+  bool has_rgba = false;
+  /// Absolute path of the texture image, or empty.
+  std::string texture_path;
+};
+
+struct VisualElement {
+  Eigen::Isometry3d X_link_geometry = Eigen::Isometry3d::Identity();
+  Geometry geometry;
+  Material material;
+};
+
+struct CollisionElement {
+  Eigen::Isometry3d X_link_geometry = Eigen::Isometry3d::Identity();
+  Geometry geometry;
+};
+
+/// Mass properties; the inertia is about the centre of mass, in the frame X_link_inertial.
+struct Inertial {
+  double mass_kg = 0.0;
+  Eigen::Isometry3d X_link_inertial = Eigen::Isometry3d::Identity();
+  Eigen::Matrix3d inertia_kg_m2 = Eigen::Matrix3d::Zero();
+};
+
+struct LinkModel {
+  std::string name;
+  Inertial inertial;
+  std::vector<VisualElement> visuals;
+  std::vector<CollisionElement> collisions;
+  /// Index of the joint whose child this link is; -1 for the root.
+  int parent_joint = -1;
+};
+
+enum class JointType { kRevolute, kContinuous, kPrismatic, kFixed };
+
+/// "revolute", "continuous", "prismatic", "fixed".
+const char* joint_type_name(JointType type);
+
+struct JointModel {
+  std::string name;
+  JointType type = JointType::kFixed;
+  int parent_link = 0;
+  int child_link = 0;
+  /// The joint frame in the parent link's frame; the child link's frame is the joint frame moved
+  /// by the joint position.
+  Eigen::Isometry3d X_parent_joint = Eigen::Isometry3d::Identity();
+  /// Unit axis in the joint frame.
+  Eigen::Vector3d axis{1.0, 0.0, 0.0};
+  /// Position limits (rad or m); `has_limits` is false for continuous and fixed joints.
+  bool has_limits = false;
+  double lower = 0.0;
+  double upper = 0.0;
+  /// Largest torque (N m) or force (N) the joint's actuator gives; 0 when the URDF sets none.
+  double effort_limit = 0.0;
+  double velocity_limit = 0.0;
+  /// Viscous damping (N m s / rad or N s / m) and dry friction (N m or N).
+  double damping = 0.0;
+  double friction = 0.0;
+
+  bool movable() const { return type != JointType::kFixed; }
+};
+
+/// A robot as its URDF describes it. Links are in tree order: links()[0] is the root and every
+/// parent comes before its children; joints()[i] has child link i + 1.
+class RobotModel {
+ public:
+  RobotModel(std::string name, std::string path, std::vector<LinkModel> links,
+             std::vector<JointModel> joints);
+
+  const std::string& name() const { return name_; }
+  /// The URDF file it came from.
+  const std::string& path() const { return path_; }
+  const std::vector<LinkModel>& links() const { return links_; }
+  const std::vector<JointModel>& joints() const { return joints_; }
+  /// Indices into joints() of the non-fixed joints, in tree order (the robot's degrees of freedom).
+  const std::vector<int>& movable_joints() const { return movable_joints_; }
+  /// Throws std::out_of_range naming the robot and the name.
+  int link_index(const std::string& name) const;
+  int joint_index(const std::string& name) const;
+  double total_mass_kg() const;
+
+ private:
+  std::string name_;
+  std::string path_;
+  std::vector<LinkModel> links_;
+  std::vector<JointModel> joints_;
+  std::vector<int> movable_joints_;
+};
+
+/// Folders searched for `package://` URIs and for assets named by relative paths: the entries of
+/// the PIXELGYM_ASSET_PATH environment variable (colon-separated), then pixelgym's own assets/.
+std::vector<std::string> asset_search_path();
+
+/// The absolute path of `uri` as used inside the URDF at `urdf_path`: `file://` and absolute
+/// paths as they are, relative paths against the URDF's folder, `package://NAME/REST` by looking
+/// for NAME/REST (then REST) in the URDF's folder, its parents, and asset_search_path(). Throws
+/// UrdfError when nothing is found.
+std::string resolve_uri(const std::string& uri, const std::string& urdf_path);
+
+/// Parses a URDF and imports its meshes through `meshes`. Throws UrdfError naming the file and
+/// the problem: unreadable or malformed XML, no links, two roots, a joint cycle, an unknown
+/// parent or child, an unsupported joint type (planar, floating), lower limit > upper limit, a
+/// zero axis, a moving link with non-positive mass or a non-positive-definite inertia, and any
+/// mesh that is missing, unreadable, of an unsupported format or without triangles.
+std::shared_ptr<const RobotModel> parse_urdf(const std::string& path, MeshCache& meshes);
+
+/// Parses each URDF once and shares the result (and its meshes) with every caller. Thread-safe.
+class ModelCache {
+ public:
+  /// The model of the URDF at `path` (absolute, normalized), parsed on first use.
+  std::shared_ptr<const RobotModel> load_urdf(const std::string& path);
+  MeshCache& meshes() { return meshes_; }
+  /// How many URDF files this cache has parsed.
+  int urdfs_parsed() const;
+
+ private:
+  mutable std::mutex mutex_;
+  std::map<std::string, std::shared_ptr<const RobotModel>> models_;
+  MeshCache meshes_;
+  int urdfs_parsed_ = 0;
+};
+
+/// The process-wide cache envs load their robots through.
+ModelCache& default_model_cache();
+
+/// `path` inside pixelgym's assets/ folder (resolved through asset_search_path()).
+std::string asset_path(const std::string& relative);
+
+}  // namespace pixelgym::engine

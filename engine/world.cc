@@ -1,0 +1,739 @@
+#include "engine/world.h"
+
+#include <btBulletDynamicsCommon.h>
+#include <BulletCollision/CollisionShapes/btShapeHull.h>
+#include <BulletDynamics/Featherstone/btMultiBody.h>
+#include <BulletDynamics/Featherstone/btMultiBodyConstraintSolver.h>
+#include <BulletDynamics/Featherstone/btMultiBodyDynamicsWorld.h>
+#include <BulletDynamics/Featherstone/btMultiBodyJointLimitConstraint.h>
+#include <BulletDynamics/Featherstone/btMultiBodyJointMotor.h>
+#include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <unordered_map>
+
+namespace pixelgym::engine {
+namespace {
+
+constexpr double kHullMargin = 0.001;          // m; Bullet's 0.04 default inflates small parts
+constexpr double kUnboundedForce = 1e9;         // N or N m, for motors without a limit
+
+btVector3 to_bt(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+Eigen::Vector3d from_bt(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
+
+btTransform to_bt(const Eigen::Isometry3d& X) {
+  const Eigen::Quaterniond q(X.linear());
+  return btTransform(btQuaternion(q.x(), q.y(), q.z(), q.w()), to_bt(X.translation()));
+}
+
+Eigen::Isometry3d from_bt(const btTransform& X) {
+  Eigen::Isometry3d result = Eigen::Isometry3d::Identity();
+  const btQuaternion q = X.getRotation();
+  result.linear() = Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()).toRotationMatrix();
+  result.translation() = from_bt(X.getOrigin());
+  return result;
+}
+
+btQuaternion to_bt_rotation(const Eigen::Matrix3d& R) {
+  const Eigen::Quaterniond q(R);
+  return btQuaternion(q.x(), q.y(), q.z(), q.w());
+}
+
+// The centre-of-mass frame of a link, with axes along the principal axes of its inertia, in the
+// link's URDF frame, and the principal moments. Bullet's multibody links live in this frame.
+struct PrincipalFrame {
+  Eigen::Isometry3d X_link_com = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d moments = Eigen::Vector3d::Zero();
+};
+
+PrincipalFrame principal_frame(const Inertial& inertial) {
+  PrincipalFrame frame;
+  frame.X_link_com = inertial.X_link_inertial;
+  if (inertial.inertia_kg_m2.isZero()) return frame;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(inertial.inertia_kg_m2);
+  Eigen::Matrix3d axes = solver.eigenvectors();
+  if (axes.determinant() < 0) axes.col(2) *= -1.0;
+  frame.X_link_com.linear() = inertial.X_link_inertial.linear() * axes;
+  frame.moments = solver.eigenvalues();
+  return frame;
+}
+
+// Owns a collision shape and whatever it refers to (children of a compound, mesh data).
+struct ShapeHolder {
+  std::unique_ptr<btCollisionShape> shape;
+  std::vector<std::unique_ptr<btCollisionShape>> children;
+  std::unique_ptr<btTriangleMesh> triangles;
+};
+
+std::unique_ptr<btCollisionShape> primitive_shape(const Geometry& geometry) {
+  switch (geometry.type) {
+    case GeometryType::kBox:
+      return std::make_unique<btBoxShape>(to_bt(geometry.box_size_m * 0.5));
+    case GeometryType::kSphere:
+      return std::make_unique<btSphereShape>(geometry.radius_m);
+    case GeometryType::kCylinder:
+      return std::make_unique<btCylinderShapeZ>(
+          btVector3(geometry.radius_m, geometry.radius_m, geometry.length_m * 0.5));
+    case GeometryType::kCapsule:
+      return std::make_unique<btCapsuleShapeZ>(geometry.radius_m, geometry.length_m);
+    case GeometryType::kMesh: {
+      // Moving meshes collide as their convex hull, reduced to its hull vertices.
+      auto hull = std::make_unique<btConvexHullShape>();
+      const Mesh& mesh = *geometry.mesh;
+      for (const Eigen::Vector3f& p : mesh.positions) {
+        hull->addPoint(to_bt(p.cast<double>().cwiseProduct(geometry.mesh_scale)), false);
+      }
+      hull->recalcLocalAabb();
+      hull->optimizeConvexHull();
+      hull->setMargin(kHullMargin);
+      return hull;
+    }
+  }
+  throw std::invalid_argument("unknown geometry type");
+}
+
+}  // namespace
+
+void WorldConfig::validate() const {
+  if (!(timestep_s > 0) || !std::isfinite(timestep_s)) {
+    throw std::invalid_argument("WorldConfig: timestep_s must be positive and finite, got " +
+                                std::to_string(timestep_s));
+  }
+  if (!gravity_m_s2.allFinite()) throw std::invalid_argument("WorldConfig: gravity is not finite");
+  if (solver_iterations < 1) {
+    throw std::invalid_argument("WorldConfig: solver_iterations must be >= 1, got " +
+                                std::to_string(solver_iterations));
+  }
+}
+
+struct World::Impl {
+  struct Dof {
+    int joint = 0;        // index into the model's joints
+    int bullet_link = 0;  // index of the Bullet link it moves
+    ControlMode mode = ControlMode::kTorque;
+    double command = 0.0;
+    double max_force = 0.0;
+    double position_gain = 0.3;
+    double velocity_gain = 1.0;
+  };
+
+  struct Robot {
+    std::shared_ptr<const RobotModel> model;
+    RobotOptions options;
+    std::vector<PrincipalFrame> frames;         // per model link
+    std::vector<ShapeHolder> shapes;            // per model link; shape null when none
+    std::vector<Dof> dofs;
+    // Rebuilt by build():
+    std::unique_ptr<btMultiBody> body;
+    std::vector<std::unique_ptr<btMultiBodyLinkCollider>> colliders;
+    std::vector<std::unique_ptr<btMultiBodyConstraint>> constraints;
+    std::vector<btMultiBodyJointMotor*> motors;           // per dof, owned by `constraints`
+    std::vector<btMultiBodyJointMotor*> friction_motors;  // per dof or null
+  };
+
+  struct Body {
+    BodyOptions options;
+    ShapeHolder shape;
+    std::unique_ptr<btRigidBody> rigid;  // rebuilt by build()
+  };
+
+  // What a visual shape is attached to.
+  struct VisualRef {
+    int robot = -1;  // or -1 for a body
+    int index = 0;   // model link or body
+    Eigen::Isometry3d X_owner_geometry = Eigen::Isometry3d::Identity();
+  };
+
+  explicit Impl(const WorldConfig& world_config) : config(world_config) {
+    ground_shape = std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0);
+    build();
+  }
+
+  ~Impl() { teardown(); }
+
+  void teardown() {
+    // The dynamics world refers to everything else, so it goes first.
+    dynamics.reset();
+    for (Robot& robot : robots) {
+      robot.constraints.clear();
+      robot.motors.clear();
+      robot.friction_motors.clear();
+      robot.colliders.clear();
+      robot.body.reset();
+    }
+    for (Body& body : bodies) body.rigid.reset();
+    ground.reset();
+    solver.reset();
+    broadphase.reset();
+    dispatcher.reset();
+    collision_config.reset();
+    names.clear();
+  }
+
+  void build() {
+    collision_config = std::make_unique<btDefaultCollisionConfiguration>();
+    dispatcher = std::make_unique<btCollisionDispatcher>(collision_config.get());
+    broadphase = std::make_unique<btDbvtBroadphase>();
+    solver = std::make_unique<btMultiBodyConstraintSolver>();
+    dynamics = std::make_unique<btMultiBodyDynamicsWorld>(dispatcher.get(), broadphase.get(),
+                                                          solver.get(), collision_config.get());
+    dynamics->setGravity(to_bt(config.gravity_m_s2));
+    dynamics->getSolverInfo().m_numIterations = config.solver_iterations;
+    if (config.ground_plane) {
+      ground = std::make_unique<btCollisionObject>();
+      ground->setCollisionShape(ground_shape.get());
+      ground->setFriction(config.ground_friction);
+      dynamics->addCollisionObject(ground.get(), btBroadphaseProxy::StaticFilter,
+                                   btBroadphaseProxy::AllFilter ^ btBroadphaseProxy::StaticFilter);
+      names[ground.get()] = "ground";
+    }
+    for (std::size_t i = 0; i < robots.size(); ++i) build_robot(robots[i]);
+    for (Body& body : bodies) build_body(body);
+  }
+
+  void rebuild() {
+    teardown();
+    build();
+  }
+
+  void build_robot(Robot& robot) {
+    const RobotModel& model = *robot.model;
+    const auto& links = model.links();
+    const auto& joints = model.joints();
+    const int num_links = static_cast<int>(links.size()) - 1;
+    const PrincipalFrame& root = robot.frames[0];
+    robot.body = std::make_unique<btMultiBody>(num_links, links[0].inertial.mass_kg,
+                                               to_bt(root.moments), robot.options.fixed_base,
+                                               /*canSleep=*/false);
+    btMultiBody& body = *robot.body;
+    body.setBaseWorldTransform(to_bt(robot.options.X_world_base * root.X_link_com));
+    for (int j = 0; j < num_links; ++j) {
+      const JointModel& joint = joints[static_cast<std::size_t>(j)];
+      const PrincipalFrame& parent = robot.frames[static_cast<std::size_t>(joint.parent_link)];
+      const PrincipalFrame& child = robot.frames[static_cast<std::size_t>(joint.child_link)];
+      const LinkModel& link = links[static_cast<std::size_t>(joint.child_link)];
+      // The joint frame in the parent's and in the child's centre-of-mass frames (the child's
+      // URDF frame is the joint frame at zero position).
+      const Eigen::Isometry3d X_parentcom_joint = parent.X_link_com.inverse() * joint.X_parent_joint;
+      const Eigen::Isometry3d X_childcom_joint = child.X_link_com.inverse();
+      const btQuaternion rot_parent_to_this =
+          to_bt_rotation(X_childcom_joint.linear() * X_parentcom_joint.linear().transpose());
+      const btVector3 parent_com_to_pivot = to_bt(X_parentcom_joint.translation());
+      const btVector3 pivot_to_com = to_bt(-X_childcom_joint.translation());
+      const btVector3 axis = to_bt(X_childcom_joint.linear() * joint.axis);
+      const int parent_index = joint.parent_link - 1;
+      const double mass = link.inertial.mass_kg;
+      const btVector3 moments = to_bt(child.moments);
+      switch (joint.type) {
+        case JointType::kRevolute:
+        case JointType::kContinuous:
+          body.setupRevolute(j, mass, moments, parent_index, rot_parent_to_this, axis,
+                             parent_com_to_pivot, pivot_to_com, true);
+          break;
+        case JointType::kPrismatic:
+          body.setupPrismatic(j, mass, moments, parent_index, rot_parent_to_this, axis,
+                              parent_com_to_pivot, pivot_to_com, true);
+          break;
+        case JointType::kFixed:
+          body.setupFixed(j, mass, moments, parent_index, rot_parent_to_this, parent_com_to_pivot,
+                          pivot_to_com, true);
+          break;
+      }
+    }
+    body.finalizeMultiDof();
+    body.setLinearDamping(0.0);
+    body.setAngularDamping(0.0);
+    body.setUseGyroTerm(true);
+    body.setHasSelfCollision(robot.options.self_collision);
+    dynamics->addMultiBody(&body);
+
+    const int group = robot.options.fixed_base ? btBroadphaseProxy::StaticFilter
+                                               : btBroadphaseProxy::DefaultFilter;
+    for (std::size_t l = 0; l < links.size(); ++l) {
+      btCollisionShape* shape = robot.shapes[l].shape.get();
+      if (shape == nullptr) continue;
+      const int bullet_link = static_cast<int>(l) - 1;
+      auto collider = std::make_unique<btMultiBodyLinkCollider>(&body, bullet_link);
+      collider->setCollisionShape(shape);
+      collider->setFriction(0.8);
+      const bool is_static_base = l == 0 && robot.options.fixed_base;
+      const int link_group = l == 0 ? group : btBroadphaseProxy::DefaultFilter;
+      const int mask = is_static_base ? btBroadphaseProxy::AllFilter ^ btBroadphaseProxy::StaticFilter
+                                      : btBroadphaseProxy::AllFilter;
+      dynamics->addCollisionObject(collider.get(), link_group, mask);
+      if (l == 0) {
+        body.setBaseCollider(collider.get());
+      } else {
+        body.getLink(bullet_link).m_collider = collider.get();
+      }
+      names[collider.get()] = model.name() + "/" + links[l].name;
+      robot.colliders.push_back(std::move(collider));
+    }
+
+    robot.motors.assign(robot.dofs.size(), nullptr);
+    robot.friction_motors.assign(robot.dofs.size(), nullptr);
+    for (std::size_t d = 0; d < robot.dofs.size(); ++d) {
+      const Dof& dof = robot.dofs[d];
+      const JointModel& joint = joints[static_cast<std::size_t>(dof.joint)];
+      if (joint.has_limits) {
+        auto limit = std::make_unique<btMultiBodyJointLimitConstraint>(&body, dof.bullet_link,
+                                                                       joint.lower, joint.upper);
+        dynamics->addMultiBodyConstraint(limit.get());
+        robot.constraints.push_back(std::move(limit));
+      }
+      auto motor = std::make_unique<btMultiBodyJointMotor>(&body, dof.bullet_link, 0.0, 0.0);
+      dynamics->addMultiBodyConstraint(motor.get());
+      robot.motors[d] = motor.get();
+      robot.constraints.push_back(std::move(motor));
+      if (joint.friction > 0) {
+        auto friction = std::make_unique<btMultiBodyJointMotor>(
+            &body, dof.bullet_link, 0.0, joint.friction * config.timestep_s);
+        dynamics->addMultiBodyConstraint(friction.get());
+        robot.friction_motors[d] = friction.get();
+        robot.constraints.push_back(std::move(friction));
+      }
+    }
+    update_kinematics(robot);
+  }
+
+  void build_body(Body& body) {
+    const BodyOptions& options = body.options;
+    btVector3 inertia(0, 0, 0);
+    if (options.mass_kg > 0) body.shape.shape->calculateLocalInertia(options.mass_kg, inertia);
+    btRigidBody::btRigidBodyConstructionInfo info(options.mass_kg, nullptr, body.shape.shape.get(),
+                                                  inertia);
+    info.m_startWorldTransform = to_bt(options.X_world_body);
+    info.m_friction = options.friction;
+    body.rigid = std::make_unique<btRigidBody>(info);
+    body.rigid->setActivationState(DISABLE_DEACTIVATION);
+    if (options.collides) {
+      dynamics->addRigidBody(body.rigid.get());
+    } else {
+      body.rigid->setCollisionFlags(body.rigid->getCollisionFlags() |
+                                    btCollisionObject::CF_NO_CONTACT_RESPONSE);
+      dynamics->addRigidBody(body.rigid.get(), 0, 0);
+    }
+    names[body.rigid.get()] = options.name;
+  }
+
+  void update_kinematics(Robot& robot) {
+    robot.body->forwardKinematics(scratch_rotations, scratch_origins);
+    robot.body->updateCollisionObjectWorldTransforms(scratch_rotations, scratch_origins);
+  }
+
+  void apply_controls(Robot& robot) {
+    btMultiBody& body = *robot.body;
+    const auto& joints = robot.model->joints();
+    for (std::size_t d = 0; d < robot.dofs.size(); ++d) {
+      const Dof& dof = robot.dofs[d];
+      const JointModel& joint = joints[static_cast<std::size_t>(dof.joint)];
+      const double velocity = body.getJointVel(dof.bullet_link);
+      double torque = -joint.damping * velocity;
+      btMultiBodyJointMotor& motor = *robot.motors[d];
+      if (dof.mode == ControlMode::kTorque) {
+        double command = dof.command;
+        if (joint.effort_limit > 0) command = std::clamp(command, -joint.effort_limit, joint.effort_limit);
+        torque += command;
+        motor.setMaxAppliedImpulse(0.0);
+      } else {
+        const double max_force = dof.max_force > 0    ? dof.max_force
+                                 : joint.effort_limit > 0 ? joint.effort_limit
+                                                          : kUnboundedForce;
+        motor.setMaxAppliedImpulse(max_force * config.timestep_s);
+        if (dof.mode == ControlMode::kVelocity) {
+          motor.setPositionTarget(0.0, 0.0);
+          motor.setVelocityTarget(dof.command, dof.velocity_gain);
+        } else {
+          motor.setPositionTarget(dof.command, dof.position_gain);
+          motor.setVelocityTarget(0.0, dof.velocity_gain);
+        }
+      }
+      if (torque != 0.0) body.addJointTorque(dof.bullet_link, torque);
+    }
+  }
+
+  void check_finite(std::int64_t step) const {
+    for (const Robot& robot : robots) {
+      const btMultiBody& body = *robot.body;
+      bool finite = body.getBaseWorldTransform().getOrigin().length2() < BT_INFINITY &&
+                    std::isfinite(body.getBaseVel().length2()) &&
+                    std::isfinite(body.getBaseOmega().length2());
+      std::string where = "its base";
+      for (const Dof& dof : robot.dofs) {
+        if (!finite) break;
+        if (!std::isfinite(body.getJointPos(dof.bullet_link)) ||
+            !std::isfinite(body.getJointVel(dof.bullet_link))) {
+          finite = false;
+          where = "joint \"" + robot.model->joints()[static_cast<std::size_t>(dof.joint)].name + "\"";
+        }
+      }
+      if (!finite) {
+        throw std::runtime_error("World: robot \"" + robot.model->name() +
+                                 "\" has a non-finite state (" + where + ") after step " +
+                                 std::to_string(step));
+      }
+    }
+    for (const Body& body : bodies) {
+      const btVector3 origin = body.rigid->getWorldTransform().getOrigin();
+      if (!std::isfinite(origin.length2()) || !std::isfinite(body.rigid->getLinearVelocity().length2()) ||
+          !std::isfinite(body.rigid->getAngularVelocity().length2())) {
+        throw std::runtime_error("World: body \"" + body.options.name +
+                                 "\" has a non-finite state after step " + std::to_string(step));
+      }
+    }
+  }
+
+  Eigen::Isometry3d link_pose(const Robot& robot, int link) const {
+    const btTransform X_world_com = link == 0 ? robot.body->getBaseWorldTransform()
+                                              : robot.body->getLink(link - 1).m_cachedWorldTransform;
+    return from_bt(X_world_com) * robot.frames[static_cast<std::size_t>(link)].X_link_com.inverse();
+  }
+
+  WorldConfig config;
+  std::unique_ptr<btCollisionShape> ground_shape;
+  std::vector<Robot> robots;
+  std::vector<Body> bodies;
+  std::vector<VisualRef> visual_refs;
+
+  std::unique_ptr<btDefaultCollisionConfiguration> collision_config;
+  std::unique_ptr<btCollisionDispatcher> dispatcher;
+  std::unique_ptr<btBroadphaseInterface> broadphase;
+  std::unique_ptr<btMultiBodyConstraintSolver> solver;
+  std::unique_ptr<btCollisionObject> ground;
+  std::unique_ptr<btMultiBodyDynamicsWorld> dynamics;
+  std::unordered_map<const btCollisionObject*, std::string> names;
+  btAlignedObjectArray<btQuaternion> scratch_rotations;
+  btAlignedObjectArray<btVector3> scratch_origins;
+};
+
+World::World(WorldConfig config) : config_((config.validate(), config)) {
+  impl_ = std::make_unique<Impl>(config_);
+}
+
+World::~World() = default;
+
+int World::add_robot(std::shared_ptr<const RobotModel> model, RobotOptions options) {
+  if (model == nullptr) throw std::invalid_argument("World::add_robot: model is null");
+  const auto& links = model->links();
+  if (!options.fixed_base) {
+    const Inertial& root = links[0].inertial;
+    if (!(root.mass_kg > 0) ||
+        !(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(root.inertia_kg_m2).eigenvalues().minCoeff() > 0)) {
+      throw std::invalid_argument("World::add_robot: robot \"" + model->name() + "\" root link \"" +
+                                  links[0].name +
+                                  "\" needs positive mass and inertia for a floating base");
+    }
+  }
+  Impl::Robot robot;
+  robot.model = model;
+  robot.options = options;
+  const int robot_index = static_cast<int>(impl_->robots.size());
+  for (std::size_t l = 0; l < links.size(); ++l) {
+    const LinkModel& link = links[l];
+    robot.frames.push_back(principal_frame(link.inertial));
+    ShapeHolder holder;
+    if (!link.collisions.empty()) {
+      auto compound = std::make_unique<btCompoundShape>(/*enableDynamicAabbTree=*/false);
+      const Eigen::Isometry3d X_com_link = robot.frames.back().X_link_com.inverse();
+      for (const CollisionElement& element : link.collisions) {
+        std::unique_ptr<btCollisionShape> child = primitive_shape(element.geometry);
+        compound->addChildShape(to_bt(X_com_link * element.X_link_geometry), child.get());
+        holder.children.push_back(std::move(child));
+      }
+      holder.shape = std::move(compound);
+    }
+    robot.shapes.push_back(std::move(holder));
+    const int segmentation_id = static_cast<int>(impl_->names.size()) + 1 +
+                                static_cast<int>(visual_shapes_.size());
+    for (const VisualElement& visual : link.visuals) {
+      visual_shapes_.push_back({visual.geometry, visual.material, model->name() + "/" + link.name,
+                                segmentation_id});
+      impl_->visual_refs.push_back({robot_index, static_cast<int>(l), visual.X_link_geometry});
+    }
+  }
+  for (int joint : model->movable_joints()) {
+    Impl::Dof dof;
+    dof.joint = joint;
+    dof.bullet_link = model->joints()[static_cast<std::size_t>(joint)].child_link - 1;
+    robot.dofs.push_back(dof);
+  }
+  impl_->robots.push_back(std::move(robot));
+  impl_->rebuild();
+  return robot_index;
+}
+
+int World::add_body(BodyOptions options) {
+  if (!(options.mass_kg >= 0)) {
+    throw std::invalid_argument("World::add_body: body \"" + options.name + "\" has negative mass");
+  }
+  if (options.geometry.type == GeometryType::kMesh && options.geometry.mesh == nullptr) {
+    throw std::invalid_argument("World::add_body: body \"" + options.name + "\" has a null mesh");
+  }
+  Impl::Body body;
+  body.options = options;
+  if (options.geometry.type == GeometryType::kMesh && options.mass_kg == 0) {
+    // Static meshes collide as their triangles.
+    const Mesh& mesh = *options.geometry.mesh;
+    body.shape.triangles = std::make_unique<btTriangleMesh>();
+    for (std::size_t i = 0; i + 2 < mesh.indices.size(); i += 3) {
+      btVector3 corners[3];
+      for (int k = 0; k < 3; ++k) {
+        corners[k] = to_bt(mesh.positions[mesh.indices[i + static_cast<std::size_t>(k)]]
+                               .cast<double>()
+                               .cwiseProduct(options.geometry.mesh_scale));
+      }
+      body.shape.triangles->addTriangle(corners[0], corners[1], corners[2]);
+    }
+    body.shape.shape = std::make_unique<btBvhTriangleMeshShape>(body.shape.triangles.get(), true);
+  } else {
+    body.shape.shape = primitive_shape(options.geometry);
+  }
+  const int body_index = static_cast<int>(impl_->bodies.size());
+  visual_shapes_.push_back({options.geometry, options.material, options.name,
+                            static_cast<int>(visual_shapes_.size()) + 1});
+  impl_->visual_refs.push_back({-1, body_index, Eigen::Isometry3d::Identity()});
+  impl_->bodies.push_back(std::move(body));
+  impl_->rebuild();
+  return body_index;
+}
+
+void World::step(int steps) {
+  if (steps < 0) throw std::invalid_argument("World::step: steps must be >= 0, got " + std::to_string(steps));
+  for (int s = 0; s < steps; ++s) {
+    for (Impl::Robot& robot : impl_->robots) impl_->apply_controls(robot);
+    impl_->dynamics->stepSimulation(config_.timestep_s, 0, config_.timestep_s);
+    ++step_count_;
+    for (Impl::Robot& robot : impl_->robots) impl_->update_kinematics(robot);
+    impl_->check_finite(step_count_);
+  }
+}
+
+void World::reset() {
+  for (Impl::Robot& robot : impl_->robots) {
+    for (Impl::Dof& dof : robot.dofs) dof = Impl::Dof{dof.joint, dof.bullet_link};
+  }
+  impl_->rebuild();
+  step_count_ = 0;
+}
+
+double World::time_s() const { return static_cast<double>(step_count_) * config_.timestep_s; }
+
+void World::check_robot(int robot) const {
+  if (robot < 0 || robot >= num_robots()) {
+    throw std::out_of_range("World: no robot " + std::to_string(robot) + " (there are " +
+                            std::to_string(num_robots()) + ")");
+  }
+}
+
+void World::check_body(int body) const {
+  if (body < 0 || body >= num_bodies()) {
+    throw std::out_of_range("World: no body " + std::to_string(body) + " (there are " +
+                            std::to_string(num_bodies()) + ")");
+  }
+}
+
+int World::num_robots() const { return static_cast<int>(impl_->robots.size()); }
+
+const RobotModel& World::robot_model(int robot) const {
+  check_robot(robot);
+  return *impl_->robots[static_cast<std::size_t>(robot)].model;
+}
+
+int World::num_dofs(int robot) const {
+  check_robot(robot);
+  return static_cast<int>(impl_->robots[static_cast<std::size_t>(robot)].dofs.size());
+}
+
+Eigen::VectorXd World::joint_positions(int robot) const {
+  check_robot(robot);
+  const Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot)];
+  Eigen::VectorXd q(static_cast<Eigen::Index>(r.dofs.size()));
+  for (std::size_t d = 0; d < r.dofs.size(); ++d) {
+    q[static_cast<Eigen::Index>(d)] = r.body->getJointPos(r.dofs[d].bullet_link);
+  }
+  return q;
+}
+
+Eigen::VectorXd World::joint_velocities(int robot) const {
+  check_robot(robot);
+  const Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot)];
+  Eigen::VectorXd qd(static_cast<Eigen::Index>(r.dofs.size()));
+  for (std::size_t d = 0; d < r.dofs.size(); ++d) {
+    qd[static_cast<Eigen::Index>(d)] = r.body->getJointVel(r.dofs[d].bullet_link);
+  }
+  return qd;
+}
+
+void World::set_joint_state(int robot, const Eigen::VectorXd& positions, const Eigen::VectorXd& velocities) {
+  check_robot(robot);
+  Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot)];
+  const auto n = static_cast<Eigen::Index>(r.dofs.size());
+  if (positions.size() != n || velocities.size() != n) {
+    throw std::invalid_argument("World::set_joint_state: robot \"" + r.model->name() + "\" has " +
+                                std::to_string(n) + " degrees of freedom, got " +
+                                std::to_string(positions.size()) + " positions and " +
+                                std::to_string(velocities.size()) + " velocities");
+  }
+  if (!positions.allFinite() || !velocities.allFinite()) {
+    throw std::invalid_argument("World::set_joint_state: non-finite value for robot \"" + r.model->name() + "\"");
+  }
+  for (Eigen::Index d = 0; d < n; ++d) {
+    r.body->setJointPos(r.dofs[static_cast<std::size_t>(d)].bullet_link, positions[d]);
+    r.body->setJointVel(r.dofs[static_cast<std::size_t>(d)].bullet_link, velocities[d]);
+  }
+  impl_->update_kinematics(r);
+}
+
+void World::set_control_mode(int robot, int dof, ControlMode mode, double max_force,
+                             double position_gain, double velocity_gain) {
+  check_robot(robot);
+  Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot)];
+  if (dof < 0 || dof >= static_cast<int>(r.dofs.size())) {
+    throw std::out_of_range("World::set_control_mode: robot \"" + r.model->name() + "\" has no dof " +
+                            std::to_string(dof));
+  }
+  if (!(max_force >= 0) || !(position_gain >= 0) || !(velocity_gain >= 0)) {
+    throw std::invalid_argument("World::set_control_mode: max_force and gains must be >= 0");
+  }
+  Impl::Dof& d = r.dofs[static_cast<std::size_t>(dof)];
+  d.mode = mode;
+  d.command = 0.0;
+  d.max_force = max_force;
+  d.position_gain = position_gain;
+  d.velocity_gain = velocity_gain;
+}
+
+void World::set_control_mode(int robot, ControlMode mode, double max_force, double position_gain,
+                             double velocity_gain) {
+  for (int d = 0; d < num_dofs(robot); ++d) {
+    set_control_mode(robot, d, mode, max_force, position_gain, velocity_gain);
+  }
+}
+
+ControlMode World::control_mode(int robot, int dof) const {
+  check_robot(robot);
+  return impl_->robots[static_cast<std::size_t>(robot)].dofs.at(static_cast<std::size_t>(dof)).mode;
+}
+
+void World::set_joint_commands(int robot, const Eigen::VectorXd& commands) {
+  check_robot(robot);
+  Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot)];
+  if (commands.size() != static_cast<Eigen::Index>(r.dofs.size())) {
+    throw std::invalid_argument("World::set_joint_commands: robot \"" + r.model->name() + "\" has " +
+                                std::to_string(r.dofs.size()) + " degrees of freedom, got " +
+                                std::to_string(commands.size()) + " commands");
+  }
+  if (!commands.allFinite()) {
+    throw std::invalid_argument("World::set_joint_commands: non-finite command for robot \"" +
+                                r.model->name() + "\"");
+  }
+  for (std::size_t d = 0; d < r.dofs.size(); ++d) r.dofs[d].command = commands[static_cast<Eigen::Index>(d)];
+}
+
+Eigen::Isometry3d World::link_pose(int robot, int link) const {
+  check_robot(robot);
+  const Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot)];
+  if (link < 0 || link >= static_cast<int>(r.model->links().size())) {
+    throw std::out_of_range("World::link_pose: robot \"" + r.model->name() + "\" has no link " +
+                            std::to_string(link));
+  }
+  return impl_->link_pose(r, link);
+}
+
+Eigen::Vector3d World::link_linear_velocity(int robot, int link) const {
+  check_robot(robot);
+  const Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot)];
+  const Eigen::Isometry3d X_world_link = link_pose(robot, link);
+  if (link == 0) {
+    const Eigen::Vector3d com = from_bt(r.body->getBaseWorldTransform().getOrigin());
+    return from_bt(r.body->getBaseVel()) +
+           from_bt(r.body->getBaseOmega()).cross(X_world_link.translation() - com);
+  }
+  // v = J u along each world axis, with J the contact Jacobian of the link's origin.
+  const btMultiBody& body = *r.body;
+  const int n = body.getNumDofs() + 6;
+  std::vector<btScalar> jacobian(static_cast<std::size_t>(n));
+  btAlignedObjectArray<btScalar> scratch_r;
+  btAlignedObjectArray<btVector3> scratch_v;
+  btAlignedObjectArray<btMatrix3x3> scratch_m;
+  const btScalar* u = body.getVelocityVector();
+  Eigen::Vector3d velocity;
+  for (int axis = 0; axis < 3; ++axis) {
+    btVector3 direction(0, 0, 0);
+    direction[axis] = 1;
+    body.fillContactJacobianMultiDof(link - 1, to_bt(X_world_link.translation()), direction,
+                                     jacobian.data(), scratch_r, scratch_v, scratch_m);
+    double v = 0;
+    for (int k = 0; k < n; ++k) v += jacobian[static_cast<std::size_t>(k)] * u[k];
+    velocity[axis] = v;
+  }
+  return velocity;
+}
+
+Eigen::Isometry3d World::base_pose(int robot) const { return link_pose(robot, 0); }
+
+int World::num_bodies() const { return static_cast<int>(impl_->bodies.size()); }
+
+const BodyOptions& World::body_options(int body) const {
+  check_body(body);
+  return impl_->bodies[static_cast<std::size_t>(body)].options;
+}
+
+Eigen::Isometry3d World::body_pose(int body) const {
+  check_body(body);
+  return from_bt(impl_->bodies[static_cast<std::size_t>(body)].rigid->getWorldTransform());
+}
+
+Eigen::Vector3d World::body_linear_velocity(int body) const {
+  check_body(body);
+  return from_bt(impl_->bodies[static_cast<std::size_t>(body)].rigid->getLinearVelocity());
+}
+
+void World::set_body_pose(int body, const Eigen::Isometry3d& X_world_body) {
+  check_body(body);
+  if (!X_world_body.matrix().allFinite()) {
+    throw std::invalid_argument("World::set_body_pose: non-finite pose for body \"" +
+                                body_options(body).name + "\"");
+  }
+  btRigidBody& rigid = *impl_->bodies[static_cast<std::size_t>(body)].rigid;
+  rigid.setWorldTransform(to_bt(X_world_body));
+  rigid.setLinearVelocity(btVector3(0, 0, 0));
+  rigid.setAngularVelocity(btVector3(0, 0, 0));
+  rigid.clearForces();
+}
+
+std::vector<Contact> World::contacts() const {
+  std::vector<Contact> result;
+  btCollisionDispatcher& dispatcher = *impl_->dispatcher;
+  for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {
+    const btPersistentManifold& manifold = *dispatcher.getManifoldByIndexInternal(m);
+    for (int p = 0; p < manifold.getNumContacts(); ++p) {
+      const btManifoldPoint& point = manifold.getContactPoint(p);
+      if (point.getDistance() > 0 && point.getAppliedImpulse() <= 0) continue;
+      Contact contact;
+      contact.a = impl_->names.at(manifold.getBody0());
+      contact.b = impl_->names.at(manifold.getBody1());
+      contact.position_world_m = from_bt(point.getPositionWorldOnB());
+      contact.normal_world = from_bt(point.m_normalWorldOnB);
+      contact.normal_force_n = point.getAppliedImpulse() / config_.timestep_s;
+      result.push_back(contact);
+    }
+  }
+  return result;
+}
+
+void World::visual_poses(std::vector<Eigen::Isometry3d>& poses) const {
+  poses.resize(impl_->visual_refs.size());
+  for (std::size_t i = 0; i < impl_->visual_refs.size(); ++i) {
+    const Impl::VisualRef& ref = impl_->visual_refs[i];
+    const Eigen::Isometry3d X_world_owner =
+        ref.robot >= 0 ? impl_->link_pose(impl_->robots[static_cast<std::size_t>(ref.robot)], ref.index)
+                       : from_bt(impl_->bodies[static_cast<std::size_t>(ref.index)].rigid->getWorldTransform());
+    poses[i] = X_world_owner * ref.X_owner_geometry;
+  }
+}
+
+}  // namespace pixelgym::engine

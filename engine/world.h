@@ -1,0 +1,177 @@
+// World: one Bullet multibody dynamics world and everything in it.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine/robot_model.h"
+
+namespace pixelgym::engine {
+
+/// Settings of a World. SI units, z up.
+struct WorldConfig {
+  /// One physics step, in seconds (PyBullet's default, 1/240 s).
+  double timestep_s = 1.0 / 240.0;
+  Eigen::Vector3d gravity_m_s2{0.0, 0.0, -9.81};
+  /// Constraint solver iterations per step.
+  int solver_iterations = 50;
+  /// An infinite static plane z = 0.
+  bool ground_plane = true;
+  double ground_friction = 1.0;
+
+  /// Throws std::invalid_argument for a non-positive or non-finite timestep, non-finite gravity
+  /// or fewer than one solver iteration.
+  void validate() const;
+};
+
+/// How a joint is driven.
+enum class ControlMode {
+  /// The commanded torque (force for prismatic joints), clipped to the URDF effort limit.
+  kTorque,
+  /// A motor drives the joint velocity to its target with at most `max_force`.
+  kVelocity,
+  /// A PD motor drives the joint position to its target with at most `max_force`.
+  kPosition,
+};
+
+/// How `add_robot` places a robot.
+struct RobotOptions {
+  /// Where the root link's frame goes.
+  Eigen::Isometry3d X_world_base = Eigen::Isometry3d::Identity();
+  /// A fixed base is welded to the world; a floating base moves freely (its root link then needs
+  /// positive mass and inertia).
+  bool fixed_base = true;
+  /// Whether links of this robot collide with each other (parent-child pairs never do).
+  bool self_collision = false;
+};
+
+/// A free rigid body: a cube to push, a table, a target marker.
+struct BodyOptions {
+  std::string name;
+  Geometry geometry;
+  Material material;
+  /// 0 makes the body static.
+  double mass_kg = 1.0;
+  Eigen::Isometry3d X_world_body = Eigen::Isometry3d::Identity();
+  /// False for markers: drawn, never touched.
+  bool collides = true;
+  double friction = 0.8;
+};
+
+/// One contact point between two named things ("cartpole/pole", "cube", "ground").
+struct Contact {
+  std::string a;
+  std::string b;
+  Eigen::Vector3d position_world_m = Eigen::Vector3d::Zero();
+  /// From b towards a.
+  Eigen::Vector3d normal_world = Eigen::Vector3d::Zero();
+  double normal_force_n = 0.0;
+};
+
+/// Something the renderer draws. Its pose comes from `visual_poses()`, in the same order.
+struct VisualShape {
+  Geometry geometry;
+  Material material;
+  /// "robot/link" or the body name.
+  std::string owner;
+  /// 1-based id of the owner (a robot link or a body), for segmentation images.
+  int segmentation_id = 0;
+};
+
+/// Owns one btMultiBodyDynamicsWorld and every Bullet object in it; nothing is shared with other
+/// worlds except immutable models and meshes, so worlds in different threads are independent.
+/// Robots and bodies are identified by the index `add_robot` / `add_body` returned.
+///
+/// Determinism: the same additions and commands give bit-identical states. `reset()` rebuilds
+/// every Bullet object (solver caches and contact manifolds included), so a reset world matches a
+/// newly built one bit for bit. A step that leaves any state non-finite throws
+/// std::runtime_error naming the robot or body.
+class World {
+ public:
+  /// Throws std::invalid_argument for an invalid config.
+  explicit World(WorldConfig config = {});
+  ~World();
+  World(const World&) = delete;
+  World& operator=(const World&) = delete;
+
+  /// Adds a robot built from `model`; returns its index. Throws std::invalid_argument for a null
+  /// model or a floating base whose root link has no positive mass and inertia.
+  int add_robot(std::shared_ptr<const RobotModel> model, RobotOptions options = {});
+  /// Adds a free body; returns its index. Throws std::invalid_argument for a negative mass, a
+  /// dynamic mesh body, or a geometry of zero size.
+  int add_body(BodyOptions options);
+
+  /// Advances `steps` physics steps of config().timestep_s with the current controls.
+  void step(int steps = 1);
+  /// Returns to the state right after the robots and bodies were added: every Bullet object is
+  /// rebuilt, controls are cleared, time restarts at 0.
+  void reset();
+
+  const WorldConfig& config() const { return config_; }
+  double time_s() const;
+  std::int64_t step_count() const { return step_count_; }
+
+  // --- robots -------------------------------------------------------------------------------
+  int num_robots() const;
+  const RobotModel& robot_model(int robot) const;
+  /// Degrees of freedom: the robot's movable joints in RobotModel::movable_joints() order.
+  int num_dofs(int robot) const;
+  Eigen::VectorXd joint_positions(int robot) const;
+  Eigen::VectorXd joint_velocities(int robot) const;
+  /// Sets positions and velocities of every degree of freedom. Throws std::invalid_argument on a
+  /// size mismatch or a non-finite value.
+  void set_joint_state(int robot, const Eigen::VectorXd& positions, const Eigen::VectorXd& velocities);
+
+  /// Switches degree of freedom `dof` to `mode`. For kVelocity and kPosition, `max_force` bounds
+  /// the motor (0: the URDF effort limit, or unbounded when it has none); `position_gain` and
+  /// `velocity_gain` are Bullet's motor gains (as PyBullet's positionGain / velocityGain).
+  void set_control_mode(int robot, int dof, ControlMode mode, double max_force = 0.0,
+                        double position_gain = 0.3, double velocity_gain = 1.0);
+  /// Sets every degree of freedom to `mode` with the same settings.
+  void set_control_mode(int robot, ControlMode mode, double max_force = 0.0,
+                        double position_gain = 0.3, double velocity_gain = 1.0);
+  ControlMode control_mode(int robot, int dof) const;
+  /// The command of each degree of freedom: a torque (kTorque), a velocity (kVelocity) or a
+  /// position (kPosition), per its mode. Held until changed. Throws std::invalid_argument on a size
+  /// mismatch or a non-finite value.
+  void set_joint_commands(int robot, const Eigen::VectorXd& commands);
+
+  /// World pose of the URDF frame of link `link` (an index into RobotModel::links()).
+  Eigen::Isometry3d link_pose(int robot, int link) const;
+  /// World linear velocity of the origin of link `link`'s URDF frame, in m/s.
+  Eigen::Vector3d link_linear_velocity(int robot, int link) const;
+  Eigen::Isometry3d base_pose(int robot) const;
+
+  // --- free bodies --------------------------------------------------------------------------
+  int num_bodies() const;
+  const BodyOptions& body_options(int body) const;
+  Eigen::Isometry3d body_pose(int body) const;
+  Eigen::Vector3d body_linear_velocity(int body) const;
+  /// Moves a body and stops it.
+  void set_body_pose(int body, const Eigen::Isometry3d& X_world_body);
+
+  // --- contacts and visuals -----------------------------------------------------------------
+  /// Contact points of the last step (with positive normal force or penetration).
+  std::vector<Contact> contacts() const;
+  /// Every visual element of every robot and body, in a fixed order.
+  const std::vector<VisualShape>& visual_shapes() const { return visual_shapes_; }
+  /// The current world pose of each visual shape, in visual_shapes() order.
+  void visual_poses(std::vector<Eigen::Isometry3d>& poses) const;
+
+ private:
+  struct Impl;
+
+  void check_robot(int robot) const;
+  void check_body(int body) const;
+
+  WorldConfig config_;
+  std::unique_ptr<Impl> impl_;
+  std::vector<VisualShape> visual_shapes_;
+  std::int64_t step_count_ = 0;
+};
+
+}  // namespace pixelgym::engine

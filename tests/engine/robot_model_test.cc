@@ -1,0 +1,179 @@
+#include "engine/robot_model.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+namespace pixelgym::engine {
+namespace {
+
+using ::testing::HasSubstr;
+
+std::string data(const std::string& name) {
+  return std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/urdf/" + name;
+}
+
+struct AssetCase {
+  std::string file;
+  std::size_t links;
+  std::size_t movable_joints;
+  friend void PrintTo(const AssetCase& c, std::ostream* out) { *out << c.file; }
+};
+
+class AssetTest : public ::testing::TestWithParam<AssetCase> {};
+
+TEST_P(AssetTest, LoadsWithTheExpectedStructure) {
+  MeshCache meshes;
+  const auto model = parse_urdf(asset_path(GetParam().file), meshes);
+  EXPECT_EQ(model->links().size(), GetParam().links);
+  EXPECT_EQ(model->movable_joints().size(), GetParam().movable_joints);
+  EXPECT_EQ(model->joints().size() + 1, model->links().size());
+  for (std::size_t j = 0; j < model->joints().size(); ++j) {
+    EXPECT_EQ(model->joints()[j].child_link, static_cast<int>(j) + 1);
+    EXPECT_LT(model->joints()[j].parent_link, model->joints()[j].child_link);
+  }
+  for (const LinkModel& link : model->links()) {
+    for (const VisualElement& visual : link.visuals) {
+      if (visual.geometry.type == GeometryType::kMesh) {
+        EXPECT_NE(visual.geometry.mesh, nullptr);
+      }
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryAsset, AssetTest,
+                         ::testing::Values(AssetCase{"cartpole/cartpole.urdf", 3, 2},
+                                           AssetCase{"pendulum/pendulum.urdf", 2, 1},
+                                           AssetCase{"acrobot/acrobot.urdf", 3, 2},
+                                           AssetCase{"reacher/reacher.urdf", 4, 2},
+                                           AssetCase{"arm/arm.urdf", 10, 7},
+                                           AssetCase{"objects/table.urdf", 1, 0},
+                                           AssetCase{"objects/cube.urdf", 1, 0},
+                                           AssetCase{"objects/target.urdf", 1, 0}),
+                         [](const ::testing::TestParamInfo<AssetCase>& param_info) {
+                           std::string name = std::filesystem::path(param_info.param.file).stem().string();
+                           return name;
+                         });
+
+TEST(RobotModelTest, EveryUrdfUnderAssetsIsCovered) {
+  int count = 0;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(
+           std::string(PIXELGYM_SOURCE_DIR) + "/assets")) {
+    if (entry.path().extension() == ".urdf") ++count;
+  }
+  EXPECT_EQ(count, 8) << "a new asset needs a line in AssetTest";
+}
+
+TEST(RobotModelTest, ArmIsMadeOfMeshesWithLimitsAndInertias) {
+  MeshCache meshes;
+  const auto arm = parse_urdf(asset_path("arm/arm.urdf"), meshes);
+  EXPECT_EQ(arm->name(), "arm");
+  for (int j : arm->movable_joints()) {
+    const JointModel& joint = arm->joints()[static_cast<std::size_t>(j)];
+    EXPECT_EQ(joint.type, JointType::kRevolute);
+    EXPECT_TRUE(joint.has_limits);
+    EXPECT_LT(joint.lower, joint.upper);
+    EXPECT_GT(joint.effort_limit, 0);
+    const LinkModel& link = arm->links()[static_cast<std::size_t>(joint.child_link)];
+    ASSERT_EQ(link.visuals.size(), 1U);
+    EXPECT_EQ(link.visuals[0].geometry.type, GeometryType::kMesh);
+    ASSERT_EQ(link.collisions.size(), 1U);
+    EXPECT_EQ(link.collisions[0].geometry.type, GeometryType::kMesh);
+    EXPECT_GT(link.inertial.mass_kg, 0);
+  }
+  EXPECT_NEAR(arm->total_mass_kg(), 6.0 + 16.8 + 0.4, 1e-9);
+  EXPECT_NO_THROW(arm->link_index("end_effector"));
+  EXPECT_THROW(arm->link_index("nope"), std::out_of_range);
+}
+
+TEST(RobotModelTest, CapsulesMaterialsAndJointDetails) {
+  MeshCache meshes;
+  const auto cartpole = parse_urdf(asset_path("cartpole/cartpole.urdf"), meshes);
+  const LinkModel& pole = cartpole->links()[static_cast<std::size_t>(cartpole->link_index("pole"))];
+  EXPECT_EQ(pole.visuals[0].geometry.type, GeometryType::kCapsule);
+  EXPECT_EQ(pole.collisions[0].geometry.type, GeometryType::kCapsule);
+  EXPECT_DOUBLE_EQ(pole.visuals[0].geometry.length_m, 1.0);
+  EXPECT_TRUE(pole.visuals[0].material.has_rgba);
+  EXPECT_NEAR(pole.visuals[0].material.rgba.x(), 0.95, 1e-6);  // urdfdom keeps colours as float
+  const JointModel& slider = cartpole->joints()[static_cast<std::size_t>(cartpole->joint_index("slider"))];
+  EXPECT_EQ(slider.type, JointType::kPrismatic);
+  EXPECT_DOUBLE_EQ(slider.lower, -2.0);
+  const JointModel& hinge = cartpole->joints()[static_cast<std::size_t>(cartpole->joint_index("hinge"))];
+  EXPECT_EQ(hinge.type, JointType::kContinuous);
+  EXPECT_FALSE(hinge.has_limits);
+  EXPECT_EQ(hinge.axis, Eigen::Vector3d(0, 1, 0));
+}
+
+struct BadCase {
+  std::string file;
+  std::string problem;
+  friend void PrintTo(const BadCase& c, std::ostream* out) { *out << c.file; }
+};
+
+class BadUrdfTest : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(BadUrdfTest, IsRefusedNamingFileAndProblem) {
+  MeshCache meshes;
+  try {
+    parse_urdf(data(GetParam().file), meshes);
+    FAIL() << GetParam().file << " was accepted";
+  } catch (const UrdfError& error) {
+    EXPECT_THAT(error.what(), HasSubstr(GetParam().file));
+    EXPECT_THAT(error.what(), HasSubstr(GetParam().problem));
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    EveryBadFile, BadUrdfTest,
+    ::testing::Values(BadCase{"malformed_xml.urdf", "malformed XML at line"},
+                      BadCase{"no_links.urdf", "has no links"},
+                      BadCase{"two_roots.urdf", "2 root links (\"a\" and \"b\")"},
+                      BadCase{"joint_cycle.urdf", "cycle"},
+                      BadCase{"detached_cycle.urdf", "cannot be reached from the root"},
+                      BadCase{"two_parents.urdf", "child of two joints"},
+                      BadCase{"unknown_link.urdf", "\"ghost\", which does not exist"},
+                      BadCase{"zero_mass.urdf", "has mass 0 kg"},
+                      BadCase{"negative_mass.urdf", "has mass -2 kg"},
+                      BadCase{"bad_inertia.urdf", "not positive definite"},
+                      BadCase{"reversed_limits.urdf", "lower limit 1.5 > upper limit -1.5"},
+                      BadCase{"planar_joint.urdf", "type planar, which pixelgym does not support"},
+                      BadCase{"floating_joint.urdf", "type floating"},
+                      BadCase{"missing_mesh.urdf", "does_not_exist.obj: file not found"},
+                      BadCase{"unsupported_mesh_format.urdf", "unsupported format \".xyz\""},
+                      BadCase{"mesh_without_triangles.urdf", "has no triangles"},
+                      BadCase{"unreadable_mesh.urdf", "garbage.stl: cannot be read"},
+                      BadCase{"unresolvable_package.urdf", "cannot resolve \"package://"},
+                      BadCase{"does_not_exist.urdf", "cannot be read"}),
+    [](const ::testing::TestParamInfo<BadCase>& param_info) {
+      return std::filesystem::path(param_info.param.file).stem().string();
+    });
+
+TEST(RobotModelTest, EveryBadFileHasACase) {
+  int count = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(data(""))) {
+    if (entry.path().extension() == ".urdf" && entry.path().filename() != "minimal_valid.urdf") ++count;
+  }
+  EXPECT_EQ(count, 18);
+}
+
+TEST(RobotModelTest, ResolvesRelativeFileAndPackageUris) {
+  const std::string urdf = asset_path("arm/arm.urdf");
+  const std::string link1 = asset_path("arm/meshes/link1.obj");
+  EXPECT_EQ(resolve_uri("meshes/link1.obj", urdf), link1);
+  EXPECT_EQ(resolve_uri("file://" + link1, urdf), link1);
+  EXPECT_EQ(resolve_uri("package://arm/meshes/link1.obj", urdf), link1);
+  EXPECT_EQ(resolve_uri("package://anything/meshes/link1.obj", urdf), link1);
+  EXPECT_THROW(resolve_uri("package://arm/meshes/nothing.obj", urdf), UrdfError);
+}
+
+TEST(ModelCacheTest, ParsesOnceAndReadsEachMeshOnce) {
+  ModelCache cache;
+  const auto first = cache.load_urdf(asset_path("arm/arm.urdf"));
+  for (int i = 0; i < 15; ++i) EXPECT_EQ(cache.load_urdf(asset_path("arm/arm.urdf")).get(), first.get());
+  EXPECT_EQ(cache.urdfs_parsed(), 1);
+  EXPECT_EQ(cache.meshes().files_read(), 16);  // 7 visuals + 7 hulls + pedestal + hand
+}
+
+}  // namespace
+}  // namespace pixelgym::engine

@@ -1,0 +1,276 @@
+#include "engine/world.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <thread>
+
+namespace pixelgym::engine {
+namespace {
+
+using ::testing::HasSubstr;
+
+// A small deterministic command source (tests must not depend on envs/).
+class Commands {
+ public:
+  explicit Commands(std::uint64_t seed) : state_(seed * 2654435761ULL + 1) {}
+  double next(double scale) {
+    state_ = state_ * 6364136223846793005ULL + 1442695040888963407ULL;
+    return scale * (static_cast<double>(state_ >> 11) * 0x1.0p-53 * 2.0 - 1.0);
+  }
+
+ private:
+  std::uint64_t state_;
+};
+
+// The arm on a table beside a cube: enough contact and articulation to expose any
+// nondeterminism.
+struct Scene {
+  explicit Scene(ModelCache& cache) {
+    arm = world.add_robot(cache.load_urdf(asset_path("arm/arm.urdf")));
+    RobotOptions table_options;
+    table_options.X_world_base.translation() = Eigen::Vector3d(0.6, 0, 0);
+    world.add_robot(cache.load_urdf(asset_path("objects/table.urdf")), table_options);
+    RobotOptions cube_options;
+    cube_options.fixed_base = false;
+    cube_options.X_world_base.translation() = Eigen::Vector3d(0.45, 0.05, 0.8);
+    cube = world.add_robot(cache.load_urdf(asset_path("objects/cube.urdf")), cube_options);
+  }
+
+  void drive(Commands& commands, int steps) {
+    Eigen::VectorXd torques(7);
+    for (int s = 0; s < steps; ++s) {
+      for (int d = 0; d < 7; ++d) torques[d] = commands.next(40.0);
+      world.set_joint_commands(arm, torques);
+      world.step();
+    }
+  }
+
+  // Every double of the state, for bitwise comparison.
+  std::vector<double> state() const {
+    std::vector<double> values;
+    for (int robot : {arm, cube}) {
+      const Eigen::VectorXd q = world.joint_positions(robot);
+      const Eigen::VectorXd qd = world.joint_velocities(robot);
+      values.insert(values.end(), q.data(), q.data() + q.size());
+      values.insert(values.end(), qd.data(), qd.data() + qd.size());
+      const Eigen::Isometry3d base = world.base_pose(robot);
+      values.insert(values.end(), base.data(), base.data() + 16);
+    }
+    const Eigen::Isometry3d tip = world.link_pose(arm, world.robot_model(arm).link_index("end_effector"));
+    values.insert(values.end(), tip.data(), tip.data() + 16);
+    return values;
+  }
+
+  World world;
+  int arm = 0;
+  int cube = 0;
+};
+
+bool bit_identical(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+
+TEST(WorldTest, TwoWorldsFedTheSameCommandsStayBitIdenticalFor10000Steps) {
+  ModelCache cache;
+  Scene a(cache);
+  Scene b(cache);
+  Commands ca(7);
+  Commands cb(7);
+  for (int chunk = 0; chunk < 100; ++chunk) {
+    a.drive(ca, 100);
+    b.drive(cb, 100);
+    ASSERT_TRUE(bit_identical(a.state(), b.state())) << "diverged by step " << (chunk + 1) * 100;
+  }
+  EXPECT_EQ(a.world.step_count(), 10000);
+}
+
+TEST(WorldTest, AResetWorldMatchesAFreshOneBitForBit) {
+  ModelCache cache;
+  Scene used(cache);
+  Commands history(1);
+  used.drive(history, 700);  // contacts, warm-started solver, moved cube
+  used.world.reset();
+  EXPECT_EQ(used.world.step_count(), 0);
+
+  Scene fresh(cache);
+  ASSERT_TRUE(bit_identical(used.state(), fresh.state()));
+  Commands c1(2);
+  Commands c2(2);
+  for (int chunk = 0; chunk < 10; ++chunk) {
+    used.drive(c1, 100);
+    fresh.drive(c2, 100);
+    ASSERT_TRUE(bit_identical(used.state(), fresh.state())) << "diverged by step " << (chunk + 1) * 100;
+  }
+}
+
+TEST(WorldTest, WorldsInTwoThreadsMatchOneThread) {
+  ModelCache cache;
+  const auto run = [&cache](std::vector<double>& out) {
+    Scene scene(cache);
+    Commands commands(3);
+    scene.drive(commands, 1000);
+    out = scene.state();
+  };
+  std::vector<double> sequential;
+  run(sequential);
+  std::vector<double> first;
+  std::vector<double> second;
+  std::thread t1(run, std::ref(first));
+  std::thread t2(run, std::ref(second));
+  t1.join();
+  t2.join();
+  EXPECT_TRUE(bit_identical(first, sequential));
+  EXPECT_TRUE(bit_identical(second, sequential));
+}
+
+TEST(WorldTest, SixteenWorldsShareOneParsedModelAndReadMeshesOnce) {
+  ModelCache cache;
+  std::vector<std::unique_ptr<World>> worlds;
+  for (int i = 0; i < 16; ++i) {
+    worlds.push_back(std::make_unique<World>());
+    worlds.back()->add_robot(cache.load_urdf(asset_path("arm/arm.urdf")));
+  }
+  EXPECT_EQ(cache.urdfs_parsed(), 1);
+  EXPECT_EQ(cache.meshes().files_read(), 16);  // each distinct mesh file once, not 16 times
+  worlds[3]->step(10);
+  EXPECT_EQ(worlds[4]->step_count(), 0);
+}
+
+TEST(WorldTest, LinkPosesFollowTheJoints) {
+  ModelCache cache;
+  World world;
+  const int cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
+  const int pole = world.robot_model(cartpole).link_index("pole");
+  Eigen::VectorXd q(2);
+  q << 0.5, M_PI / 2;  // cart 0.5 m along x, pole tipped 90 degrees about y (towards +x)
+  world.set_joint_state(cartpole, q, Eigen::VectorXd::Zero(2));
+  const Eigen::Isometry3d X_world_pole = world.link_pose(cartpole, pole);
+  EXPECT_TRUE(X_world_pole.translation().isApprox(Eigen::Vector3d(0.5, 0, 1.1), 1e-9));
+  const Eigen::Vector3d tip = X_world_pole * Eigen::Vector3d(0, 0, 1.0);
+  EXPECT_TRUE(tip.isApprox(Eigen::Vector3d(1.5, 0, 1.1), 1e-9)) << tip.transpose();
+  EXPECT_TRUE(world.joint_positions(cartpole).isApprox(q));
+}
+
+TEST(WorldTest, LinkVelocityMatchesJointRates) {
+  ModelCache cache;
+  World world;
+  const int cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
+  Eigen::VectorXd qd(2);
+  qd << 0.3, 2.0;
+  world.set_joint_state(cartpole, Eigen::VectorXd::Zero(2), qd);
+  // The pole frame sits on the cart's pivot: it moves with the cart only.
+  const Eigen::Vector3d v = world.link_linear_velocity(cartpole, world.robot_model(cartpole).link_index("pole"));
+  EXPECT_TRUE(v.isApprox(Eigen::Vector3d(0.3, 0, 0), 1e-9)) << v.transpose();
+}
+
+TEST(WorldTest, VelocityControlReachesItsTarget) {
+  ModelCache cache;
+  WorldConfig config;
+  config.gravity_m_s2.setZero();
+  World world(config);
+  const int arm = world.add_robot(cache.load_urdf(asset_path("arm/arm.urdf")));
+  world.set_control_mode(arm, ControlMode::kVelocity);
+  Eigen::VectorXd target = Eigen::VectorXd::Zero(7);
+  target[0] = 0.5;
+  world.set_joint_commands(arm, target);
+  world.step(240);
+  EXPECT_NEAR(world.joint_velocities(arm)[0], 0.5, 1e-3);
+}
+
+TEST(WorldTest, JointLimitsHold) {
+  ModelCache cache;
+  WorldConfig config;
+  World world(config);
+  const int cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
+  world.set_joint_commands(cartpole, (Eigen::VectorXd(2) << 10.0, 0.0).finished());
+  world.step(2400);
+  EXPECT_LT(world.joint_positions(cartpole)[0], 2.0 + 0.02);
+}
+
+TEST(WorldTest, VisualShapesListEveryVisualWithItsPose) {
+  ModelCache cache;
+  World world;
+  world.add_robot(cache.load_urdf(asset_path("arm/arm.urdf")));
+  BodyOptions marker;
+  marker.name = "marker";
+  marker.geometry.type = GeometryType::kSphere;
+  marker.geometry.radius_m = 0.03;
+  marker.mass_kg = 0;
+  marker.collides = false;
+  marker.X_world_body.translation() = Eigen::Vector3d(0.5, 0.2, 0.3);
+  world.add_body(marker);
+  ASSERT_EQ(world.visual_shapes().size(), 10U);  // pedestal, 7 links, hand, marker
+  EXPECT_EQ(world.visual_shapes().front().owner, "arm/base");
+  EXPECT_EQ(world.visual_shapes().back().owner, "marker");
+  std::vector<Eigen::Isometry3d> poses;
+  world.visual_poses(poses);
+  ASSERT_EQ(poses.size(), 10U);
+  EXPECT_TRUE(poses.back().translation().isApprox(Eigen::Vector3d(0.5, 0.2, 0.3)));
+  EXPECT_NEAR(poses[1].translation().z(), 0.16, 1e-9);  // link1 starts on the pedestal
+  world.step(100);
+  std::vector<Eigen::Isometry3d> later;
+  world.visual_poses(later);
+  EXPECT_TRUE(later.back().isApprox(poses.back())) << "a static marker does not move";
+}
+
+TEST(WorldTest, MarkerHasNoCollision) {
+  ModelCache cache;
+  World world;
+  BodyOptions marker;
+  marker.name = "marker";
+  marker.geometry.type = GeometryType::kSphere;
+  marker.geometry.radius_m = 0.5;
+  marker.mass_kg = 0;
+  marker.collides = false;
+  world.add_body(marker);  // overlaps the ground
+  BodyOptions ball;
+  ball.name = "ball";
+  ball.geometry.type = GeometryType::kSphere;
+  ball.geometry.radius_m = 0.1;
+  ball.X_world_body.translation() = Eigen::Vector3d(0, 0, 0.3);  // inside the marker
+  const int b = world.add_body(ball);
+  world.step(240);
+  EXPECT_NEAR(world.body_pose(b).translation().z(), 0.1, 2e-3) << "fell through the marker";
+  for (const Contact& contact : world.contacts()) {
+    EXPECT_NE(contact.a, "marker");
+    EXPECT_NE(contact.b, "marker");
+  }
+}
+
+TEST(WorldTest, NonFiniteStateRaisesNamingTheRobot) {
+  ModelCache cache;
+  World world;
+  const int cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
+  world.set_joint_commands(cartpole, (Eigen::VectorXd(2) << 0.0, 1e308).finished());
+  try {
+    world.step(10);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& error) {
+    EXPECT_THAT(error.what(), HasSubstr("robot \"cartpole\" has a non-finite state"));
+  }
+}
+
+TEST(WorldTest, BadArgumentsAreRejected) {
+  WorldConfig config;
+  config.timestep_s = 0;
+  EXPECT_THROW(World{config}, std::invalid_argument);
+  ModelCache cache;
+  World world;
+  EXPECT_THROW(world.add_robot(nullptr), std::invalid_argument);
+  const int cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
+  EXPECT_THROW(world.set_joint_commands(cartpole, Eigen::VectorXd::Zero(3)), std::invalid_argument);
+  EXPECT_THROW(world.set_joint_commands(cartpole, Eigen::VectorXd::Constant(2, NAN)), std::invalid_argument);
+  EXPECT_THROW(world.set_joint_state(cartpole, Eigen::VectorXd::Zero(1), Eigen::VectorXd::Zero(2)),
+               std::invalid_argument);
+  EXPECT_THROW(world.link_pose(cartpole, 9), std::out_of_range);
+  EXPECT_THROW(world.joint_positions(5), std::out_of_range);
+  RobotOptions floating;
+  floating.fixed_base = false;
+  EXPECT_THROW(world.add_robot(cache.load_urdf(asset_path("objects/table.urdf")), floating),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace pixelgym::engine
