@@ -30,6 +30,7 @@ test: build
 
 bench: build
 	$(BUILD_DIR)/bench/envs_bench
+	$(BUILD_DIR)/bench/engine_bench
 
 clean:
 	rm -rf $(BUILD_DIR)

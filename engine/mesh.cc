@@ -1,10 +1,11 @@
 #include "engine/mesh.h"
 
-#include <algorithm>
-#include <assimp/Importer.hpp>
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+
+#include <algorithm>
+#include <assimp/Importer.hpp>
 #include <cctype>
 #include <filesystem>
 #include <stdexcept>
@@ -31,7 +32,8 @@ void append_node(const aiScene& scene, const aiNode& node, const aiMatrix4x4& pa
     for (unsigned v = 0; v < source.mNumVertices; ++v) {
       const aiVector3D p = transform * source.mVertices[v];
       mesh.positions.emplace_back(p.x, p.y, p.z);
-      aiVector3D n = source.HasNormals() ? normal_transform * source.mNormals[v] : aiVector3D(0, 0, 1);
+      aiVector3D n =
+          source.HasNormals() ? normal_transform * source.mNormals[v] : aiVector3D(0, 0, 1);
       n.Normalize();
       mesh.normals.emplace_back(n.x, n.y, n.z);
     }
@@ -74,9 +76,9 @@ std::shared_ptr<const Mesh> load_mesh(const std::string& path) {
   // URDF meshes are in their file's coordinates: keep a Collada file's Z_UP as authored instead of
   // letting assimp turn the scene to its own Y-up convention.
   importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
-  const aiScene* scene = importer.ReadFile(
-      path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_GenSmoothNormals |
-                aiProcess_SortByPType);
+  const aiScene* scene =
+      importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                  aiProcess_GenSmoothNormals | aiProcess_SortByPType);
   if (scene == nullptr || scene->mRootNode == nullptr) {
     throw std::runtime_error("mesh " + path + ": cannot be read: " + importer.GetErrorString());
   }

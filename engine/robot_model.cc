@@ -27,7 +27,8 @@ class CapturedLog : public console_bridge::OutputHandler {
  public:
   void log(const std::string& text, console_bridge::LogLevel level, const char* /*file*/,
            int /*line*/) override {
-    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_WARN) messages += (messages.empty() ? "" : "; ") + text;
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_WARN)
+      messages += (messages.empty() ? "" : "; ") + text;
   }
   std::string messages;
 };
@@ -40,9 +41,10 @@ std::mutex& urdfdom_mutex() {
 Eigen::Isometry3d to_isometry(const urdf::Pose& pose) {
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
   X.translation() = Eigen::Vector3d(pose.position.x, pose.position.y, pose.position.z);
-  X.linear() = Eigen::Quaterniond(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z)
-                   .normalized()
-                   .toRotationMatrix();
+  X.linear() =
+      Eigen::Quaterniond(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z)
+          .normalized()
+          .toRotationMatrix();
   return X;
 }
 
@@ -90,7 +92,8 @@ XmlFacts inspect_xml(const std::string& path) {
       for (TiXmlElement* element = link->FirstChildElement(kind); element != nullptr;
            element = element->NextSiblingElement(kind), ++index) {
         TiXmlElement* geometry = element->FirstChildElement("geometry");
-        TiXmlElement* capsule = geometry != nullptr ? geometry->FirstChildElement("capsule") : nullptr;
+        TiXmlElement* capsule =
+            geometry != nullptr ? geometry->FirstChildElement("capsule") : nullptr;
         if (capsule != nullptr) {
           capsule->SetValue("cylinder");
           facts.capsules.emplace(name, kind, index);
@@ -200,12 +203,12 @@ Geometry convert_geometry(const urdf::Geometry& source, bool is_capsule, const s
       break;
     }
   }
-  const bool positive = geometry.type == GeometryType::kBox
-                            ? (geometry.box_size_m.array() > 0).all()
-                        : geometry.type == GeometryType::kMesh
-                            ? (geometry.mesh_scale.array() != 0).all()
-                            : geometry.radius_m > 0 && geometry.length_m >= 0;
-  if (!positive) fail(path, where + ": " + geometry_type_name(geometry.type) + " has a zero or negative size");
+  const bool positive =
+      geometry.type == GeometryType::kBox    ? (geometry.box_size_m.array() > 0).all()
+      : geometry.type == GeometryType::kMesh ? (geometry.mesh_scale.array() != 0).all()
+                                             : geometry.radius_m > 0 && geometry.length_m >= 0;
+  if (!positive)
+    fail(path, where + ": " + geometry_type_name(geometry.type) + " has a zero or negative size");
   return geometry;
 }
 
@@ -213,28 +216,40 @@ Geometry convert_geometry(const urdf::Geometry& source, bool is_capsule, const s
 
 const char* geometry_type_name(GeometryType type) {
   switch (type) {
-    case GeometryType::kBox: return "box";
-    case GeometryType::kSphere: return "sphere";
-    case GeometryType::kCylinder: return "cylinder";
-    case GeometryType::kCapsule: return "capsule";
-    case GeometryType::kMesh: return "mesh";
+    case GeometryType::kBox:
+      return "box";
+    case GeometryType::kSphere:
+      return "sphere";
+    case GeometryType::kCylinder:
+      return "cylinder";
+    case GeometryType::kCapsule:
+      return "capsule";
+    case GeometryType::kMesh:
+      return "mesh";
   }
   return "unknown";
 }
 
 const char* joint_type_name(JointType type) {
   switch (type) {
-    case JointType::kRevolute: return "revolute";
-    case JointType::kContinuous: return "continuous";
-    case JointType::kPrismatic: return "prismatic";
-    case JointType::kFixed: return "fixed";
+    case JointType::kRevolute:
+      return "revolute";
+    case JointType::kContinuous:
+      return "continuous";
+    case JointType::kPrismatic:
+      return "prismatic";
+    case JointType::kFixed:
+      return "fixed";
   }
   return "unknown";
 }
 
 RobotModel::RobotModel(std::string name, std::string path, std::vector<LinkModel> links,
                        std::vector<JointModel> joints)
-    : name_(std::move(name)), path_(std::move(path)), links_(std::move(links)), joints_(std::move(joints)) {
+    : name_(std::move(name)),
+      path_(std::move(path)),
+      links_(std::move(links)),
+      joints_(std::move(joints)) {
   for (std::size_t i = 0; i < joints_.size(); ++i) {
     if (joints_[i].movable()) movable_joints_.push_back(static_cast<int>(i));
   }
@@ -286,7 +301,8 @@ std::string resolve_uri(const std::string& uri, const std::string& urdf_path) {
   const fs::path urdf_folder = fs::absolute(urdf_path).parent_path();
   const std::string kFile = "file://";
   const std::string kPackage = "package://";
-  if (uri.rfind(kFile, 0) == 0) return fs::path(uri.substr(kFile.size())).lexically_normal().string();
+  if (uri.rfind(kFile, 0) == 0)
+    return fs::path(uri.substr(kFile.size())).lexically_normal().string();
   if (uri.rfind(kPackage, 0) != 0) {
     const fs::path file(uri);
     return (file.is_absolute() ? file : urdf_folder / file).lexically_normal().string();
@@ -323,7 +339,8 @@ std::shared_ptr<const RobotModel> parse_urdf(const std::string& path, MeshCache&
     console_bridge::useOutputHandler(previous);
     urdfdom_messages = log.messages;
   }
-  if (urdf == nullptr) fail(path, urdfdom_messages.empty() ? "urdfdom could not parse it" : urdfdom_messages);
+  if (urdf == nullptr)
+    fail(path, urdfdom_messages.empty() ? "urdfdom could not parse it" : urdfdom_messages);
 
   // Tree order: depth first from the root, children in the order urdfdom lists them.
   std::vector<urdf::LinkConstSharedPtr> order;
@@ -383,9 +400,10 @@ std::shared_ptr<const RobotModel> parse_urdf(const std::string& path, MeshCache&
       if (!collision.geometry) fail(path, where + " has no geometry");
       CollisionElement element;
       element.X_link_geometry = to_isometry(collision.origin);
-      element.geometry = convert_geometry(
-          *collision.geometry,
-          facts.capsules.count({link.name, "collision", static_cast<int>(i)}) != 0, path, where, meshes);
+      element.geometry =
+          convert_geometry(*collision.geometry,
+                           facts.capsules.count({link.name, "collision", static_cast<int>(i)}) != 0,
+                           path, where, meshes);
       link.collisions.push_back(std::move(element));
     }
     links.push_back(std::move(link));
@@ -400,11 +418,20 @@ std::shared_ptr<const RobotModel> parse_urdf(const std::string& path, MeshCache&
     joint.X_parent_joint = to_isometry(source.parent_to_joint_origin_transform);
     const std::string where = "joint \"" + joint.name + "\"";
     switch (source.type) {
-      case urdf::Joint::REVOLUTE: joint.type = JointType::kRevolute; break;
-      case urdf::Joint::CONTINUOUS: joint.type = JointType::kContinuous; break;
-      case urdf::Joint::PRISMATIC: joint.type = JointType::kPrismatic; break;
-      case urdf::Joint::FIXED: joint.type = JointType::kFixed; break;
-      default: fail(path, where + " has an unsupported type");
+      case urdf::Joint::REVOLUTE:
+        joint.type = JointType::kRevolute;
+        break;
+      case urdf::Joint::CONTINUOUS:
+        joint.type = JointType::kContinuous;
+        break;
+      case urdf::Joint::PRISMATIC:
+        joint.type = JointType::kPrismatic;
+        break;
+      case urdf::Joint::FIXED:
+        joint.type = JointType::kFixed;
+        break;
+      default:
+        fail(path, where + " has an unsupported type");
     }
     if (joint.movable()) {
       const Eigen::Vector3d axis(source.axis.x, source.axis.y, source.axis.z);
@@ -420,7 +447,8 @@ std::shared_ptr<const RobotModel> parse_urdf(const std::string& path, MeshCache&
         joint.upper = source.limits->upper;
         if (joint.lower > joint.upper) {
           std::ostringstream message;
-          message << where << " has lower limit " << joint.lower << " > upper limit " << joint.upper;
+          message << where << " has lower limit " << joint.lower << " > upper limit "
+                  << joint.upper;
           fail(path, message.str());
         }
       }
@@ -429,7 +457,8 @@ std::shared_ptr<const RobotModel> parse_urdf(const std::string& path, MeshCache&
       joint.damping = source.dynamics->damping;
       joint.friction = source.dynamics->friction;
     }
-    links[static_cast<std::size_t>(joint.child_link)].parent_joint = static_cast<int>(joints.size());
+    links[static_cast<std::size_t>(joint.child_link)].parent_joint =
+        static_cast<int>(joints.size());
     joints.push_back(joint);
   }
 
@@ -441,7 +470,8 @@ std::shared_ptr<const RobotModel> parse_urdf(const std::string& path, MeshCache&
     const std::string where = "link \"" + link.name + "\" (moved by joint \"" + joint.name + "\")";
     if (!(link.inertial.mass_kg > 0)) {
       std::ostringstream message;
-      message << where << " has mass " << link.inertial.mass_kg << " kg; moving links need mass > 0";
+      message << where << " has mass " << link.inertial.mass_kg
+              << " kg; moving links need mass > 0";
       fail(path, message.str());
     }
     const Eigen::Vector3d eigenvalues =
@@ -453,7 +483,8 @@ std::shared_ptr<const RobotModel> parse_urdf(const std::string& path, MeshCache&
       fail(path, message.str());
     }
   }
-  return std::make_shared<const RobotModel>(urdf->getName(), fs::absolute(path).lexically_normal().string(),
+  return std::make_shared<const RobotModel>(urdf->getName(),
+                                            fs::absolute(path).lexically_normal().string(),
                                             std::move(links), std::move(joints));
 }
 

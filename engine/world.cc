@@ -1,6 +1,5 @@
 #include "engine/world.h"
 
-#include <btBulletDynamicsCommon.h>
 #include <BulletCollision/CollisionShapes/btShapeHull.h>
 #include <BulletDynamics/Featherstone/btMultiBody.h>
 #include <BulletDynamics/Featherstone/btMultiBodyConstraintSolver.h>
@@ -8,6 +7,7 @@
 #include <BulletDynamics/Featherstone/btMultiBodyJointLimitConstraint.h>
 #include <BulletDynamics/Featherstone/btMultiBodyJointMotor.h>
 #include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
+#include <btBulletDynamicsCommon.h>
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
@@ -18,8 +18,8 @@
 namespace pixelgym::engine {
 namespace {
 
-constexpr double kHullMargin = 0.001;          // m; Bullet's 0.04 default inflates small parts
-constexpr double kUnboundedForce = 1e9;         // N or N m, for motors without a limit
+constexpr double kHullMargin = 0.001;    // m; Bullet's 0.04 default inflates small parts
+constexpr double kUnboundedForce = 1e9;  // N or N m, for motors without a limit
 
 btVector3 to_bt(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 Eigen::Vector3d from_bt(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
@@ -123,8 +123,8 @@ struct World::Impl {
   struct Robot {
     std::shared_ptr<const RobotModel> model;
     RobotOptions options;
-    std::vector<PrincipalFrame> frames;         // per model link
-    std::vector<ShapeHolder> shapes;            // per model link; shape null when none
+    std::vector<PrincipalFrame> frames;  // per model link
+    std::vector<ShapeHolder> shapes;     // per model link; shape null when none
     std::vector<Dof> dofs;
     // Rebuilt by build():
     std::unique_ptr<btMultiBody> body;
@@ -217,7 +217,8 @@ struct World::Impl {
       const LinkModel& link = links[static_cast<std::size_t>(joint.child_link)];
       // The joint frame in the parent's and in the child's centre-of-mass frames (the child's
       // URDF frame is the joint frame at zero position).
-      const Eigen::Isometry3d X_parentcom_joint = parent.X_link_com.inverse() * joint.X_parent_joint;
+      const Eigen::Isometry3d X_parentcom_joint =
+          parent.X_link_com.inverse() * joint.X_parent_joint;
       const Eigen::Isometry3d X_childcom_joint = child.X_link_com.inverse();
       const btQuaternion rot_parent_to_this =
           to_bt_rotation(X_childcom_joint.linear() * X_parentcom_joint.linear().transpose());
@@ -261,8 +262,9 @@ struct World::Impl {
       collider->setFriction(0.8);
       const bool is_static_base = l == 0 && robot.options.fixed_base;
       const int link_group = l == 0 ? group : btBroadphaseProxy::DefaultFilter;
-      const int mask = is_static_base ? btBroadphaseProxy::AllFilter ^ btBroadphaseProxy::StaticFilter
-                                      : btBroadphaseProxy::AllFilter;
+      const int mask = is_static_base
+                           ? btBroadphaseProxy::AllFilter ^ btBroadphaseProxy::StaticFilter
+                           : btBroadphaseProxy::AllFilter;
       dynamics->addCollisionObject(collider.get(), link_group, mask);
       if (l == 0) {
         body.setBaseCollider(collider.get());
@@ -289,8 +291,8 @@ struct World::Impl {
       robot.motors[d] = motor.get();
       robot.constraints.push_back(std::move(motor));
       if (joint.friction > 0) {
-        auto friction = std::make_unique<btMultiBodyJointMotor>(
-            &body, dof.bullet_link, 0.0, joint.friction * config.timestep_s);
+        auto friction = std::make_unique<btMultiBodyJointMotor>(&body, dof.bullet_link, 0.0,
+                                                                joint.friction * config.timestep_s);
         dynamics->addMultiBodyConstraint(friction.get());
         robot.friction_motors[d] = friction.get();
         robot.constraints.push_back(std::move(friction));
@@ -335,11 +337,12 @@ struct World::Impl {
       btMultiBodyJointMotor& motor = *robot.motors[d];
       if (dof.mode == ControlMode::kTorque) {
         double command = dof.command;
-        if (joint.effort_limit > 0) command = std::clamp(command, -joint.effort_limit, joint.effort_limit);
+        if (joint.effort_limit > 0)
+          command = std::clamp(command, -joint.effort_limit, joint.effort_limit);
         torque += command;
         motor.setMaxAppliedImpulse(0.0);
       } else {
-        const double max_force = dof.max_force > 0    ? dof.max_force
+        const double max_force = dof.max_force > 0        ? dof.max_force
                                  : joint.effort_limit > 0 ? joint.effort_limit
                                                           : kUnboundedForce;
         motor.setMaxAppliedImpulse(max_force * config.timestep_s);
@@ -367,7 +370,8 @@ struct World::Impl {
         if (!std::isfinite(body.getJointPos(dof.bullet_link)) ||
             !std::isfinite(body.getJointVel(dof.bullet_link))) {
           finite = false;
-          where = "joint \"" + robot.model->joints()[static_cast<std::size_t>(dof.joint)].name + "\"";
+          where =
+              "joint \"" + robot.model->joints()[static_cast<std::size_t>(dof.joint)].name + "\"";
         }
       }
       if (!finite) {
@@ -378,7 +382,8 @@ struct World::Impl {
     }
     for (const Body& body : bodies) {
       const btVector3 origin = body.rigid->getWorldTransform().getOrigin();
-      if (!std::isfinite(origin.length2()) || !std::isfinite(body.rigid->getLinearVelocity().length2()) ||
+      if (!std::isfinite(origin.length2()) ||
+          !std::isfinite(body.rigid->getLinearVelocity().length2()) ||
           !std::isfinite(body.rigid->getAngularVelocity().length2())) {
         throw std::runtime_error("World: body \"" + body.options.name +
                                  "\" has a non-finite state after step " + std::to_string(step));
@@ -387,8 +392,9 @@ struct World::Impl {
   }
 
   Eigen::Isometry3d link_pose(const Robot& robot, int link) const {
-    const btTransform X_world_com = link == 0 ? robot.body->getBaseWorldTransform()
-                                              : robot.body->getLink(link - 1).m_cachedWorldTransform;
+    const btTransform X_world_com = link == 0
+                                        ? robot.body->getBaseWorldTransform()
+                                        : robot.body->getLink(link - 1).m_cachedWorldTransform;
     return from_bt(X_world_com) * robot.frames[static_cast<std::size_t>(link)].X_link_com.inverse();
   }
 
@@ -420,8 +426,9 @@ int World::add_robot(std::shared_ptr<const RobotModel> model, RobotOptions optio
   const auto& links = model->links();
   if (!options.fixed_base) {
     const Inertial& root = links[0].inertial;
-    if (!(root.mass_kg > 0) ||
-        !(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(root.inertia_kg_m2).eigenvalues().minCoeff() > 0)) {
+    if (!(root.mass_kg > 0) || !(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(root.inertia_kg_m2)
+                                     .eigenvalues()
+                                     .minCoeff() > 0)) {
       throw std::invalid_argument("World::add_robot: robot \"" + model->name() + "\" root link \"" +
                                   links[0].name +
                                   "\" needs positive mass and inertia for a floating base");
@@ -446,11 +453,11 @@ int World::add_robot(std::shared_ptr<const RobotModel> model, RobotOptions optio
       holder.shape = std::move(compound);
     }
     robot.shapes.push_back(std::move(holder));
-    const int segmentation_id = static_cast<int>(impl_->names.size()) + 1 +
-                                static_cast<int>(visual_shapes_.size());
+    const int segmentation_id =
+        static_cast<int>(impl_->names.size()) + 1 + static_cast<int>(visual_shapes_.size());
     for (const VisualElement& visual : link.visuals) {
-      visual_shapes_.push_back({visual.geometry, visual.material, model->name() + "/" + link.name,
-                                segmentation_id});
+      visual_shapes_.push_back(
+          {visual.geometry, visual.material, model->name() + "/" + link.name, segmentation_id});
       impl_->visual_refs.push_back({robot_index, static_cast<int>(l), visual.X_link_geometry});
     }
   }
@@ -501,7 +508,8 @@ int World::add_body(BodyOptions options) {
 }
 
 void World::step(int steps) {
-  if (steps < 0) throw std::invalid_argument("World::step: steps must be >= 0, got " + std::to_string(steps));
+  if (steps < 0)
+    throw std::invalid_argument("World::step: steps must be >= 0, got " + std::to_string(steps));
   for (int s = 0; s < steps; ++s) {
     for (Impl::Robot& robot : impl_->robots) impl_->apply_controls(robot);
     impl_->dynamics->stepSimulation(config_.timestep_s, 0, config_.timestep_s);
@@ -567,7 +575,8 @@ Eigen::VectorXd World::joint_velocities(int robot) const {
   return qd;
 }
 
-void World::set_joint_state(int robot, const Eigen::VectorXd& positions, const Eigen::VectorXd& velocities) {
+void World::set_joint_state(int robot, const Eigen::VectorXd& positions,
+                            const Eigen::VectorXd& velocities) {
   check_robot(robot);
   Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot)];
   const auto n = static_cast<Eigen::Index>(r.dofs.size());
@@ -578,7 +587,8 @@ void World::set_joint_state(int robot, const Eigen::VectorXd& positions, const E
                                 std::to_string(velocities.size()) + " velocities");
   }
   if (!positions.allFinite() || !velocities.allFinite()) {
-    throw std::invalid_argument("World::set_joint_state: non-finite value for robot \"" + r.model->name() + "\"");
+    throw std::invalid_argument("World::set_joint_state: non-finite value for robot \"" +
+                                r.model->name() + "\"");
   }
   for (Eigen::Index d = 0; d < n; ++d) {
     r.body->setJointPos(r.dofs[static_cast<std::size_t>(d)].bullet_link, positions[d]);
@@ -592,8 +602,8 @@ void World::set_control_mode(int robot, int dof, ControlMode mode, double max_fo
   check_robot(robot);
   Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot)];
   if (dof < 0 || dof >= static_cast<int>(r.dofs.size())) {
-    throw std::out_of_range("World::set_control_mode: robot \"" + r.model->name() + "\" has no dof " +
-                            std::to_string(dof));
+    throw std::out_of_range("World::set_control_mode: robot \"" + r.model->name() +
+                            "\" has no dof " + std::to_string(dof));
   }
   if (!(max_force >= 0) || !(position_gain >= 0) || !(velocity_gain >= 0)) {
     throw std::invalid_argument("World::set_control_mode: max_force and gains must be >= 0");
@@ -622,15 +632,17 @@ void World::set_joint_commands(int robot, const Eigen::VectorXd& commands) {
   check_robot(robot);
   Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot)];
   if (commands.size() != static_cast<Eigen::Index>(r.dofs.size())) {
-    throw std::invalid_argument("World::set_joint_commands: robot \"" + r.model->name() + "\" has " +
-                                std::to_string(r.dofs.size()) + " degrees of freedom, got " +
-                                std::to_string(commands.size()) + " commands");
+    throw std::invalid_argument("World::set_joint_commands: robot \"" + r.model->name() +
+                                "\" has " + std::to_string(r.dofs.size()) +
+                                " degrees of freedom, got " + std::to_string(commands.size()) +
+                                " commands");
   }
   if (!commands.allFinite()) {
     throw std::invalid_argument("World::set_joint_commands: non-finite command for robot \"" +
                                 r.model->name() + "\"");
   }
-  for (std::size_t d = 0; d < r.dofs.size(); ++d) r.dofs[d].command = commands[static_cast<Eigen::Index>(d)];
+  for (std::size_t d = 0; d < r.dofs.size(); ++d)
+    r.dofs[d].command = commands[static_cast<Eigen::Index>(d)];
 }
 
 Eigen::Isometry3d World::link_pose(int robot, int link) const {
@@ -730,8 +742,10 @@ void World::visual_poses(std::vector<Eigen::Isometry3d>& poses) const {
   for (std::size_t i = 0; i < impl_->visual_refs.size(); ++i) {
     const Impl::VisualRef& ref = impl_->visual_refs[i];
     const Eigen::Isometry3d X_world_owner =
-        ref.robot >= 0 ? impl_->link_pose(impl_->robots[static_cast<std::size_t>(ref.robot)], ref.index)
-                       : from_bt(impl_->bodies[static_cast<std::size_t>(ref.index)].rigid->getWorldTransform());
+        ref.robot >= 0
+            ? impl_->link_pose(impl_->robots[static_cast<std::size_t>(ref.robot)], ref.index)
+            : from_bt(
+                  impl_->bodies[static_cast<std::size_t>(ref.index)].rigid->getWorldTransform());
     poses[i] = X_world_owner * ref.X_owner_geometry;
   }
 }

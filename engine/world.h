@@ -124,7 +124,8 @@ class World {
   Eigen::VectorXd joint_velocities(int robot) const;
   /// Sets positions and velocities of every degree of freedom. Throws std::invalid_argument on a
   /// size mismatch or a non-finite value.
-  void set_joint_state(int robot, const Eigen::VectorXd& positions, const Eigen::VectorXd& velocities);
+  void set_joint_state(int robot, const Eigen::VectorXd& positions,
+                       const Eigen::VectorXd& velocities);
 
   /// Switches degree of freedom `dof` to `mode`. For kVelocity and kPosition, `max_force` bounds
   /// the motor (0: the URDF effort limit, or unbounded when it has none); `position_gain` and

@@ -47,4 +47,7 @@ struct Command {
 /// long as the returned commands.
 std::vector<Command> add_env_commands(CLI::App& app);
 
+/// Adds inspect to `app`.
+std::vector<Command> add_engine_commands(CLI::App& app);
+
 }  // namespace pixelgym::cli

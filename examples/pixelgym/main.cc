@@ -1,4 +1,4 @@
-// pixelgym — the command-line front door: list, info, check, snapshot, rollout.
+// pixelgym — the command-line front door: list, info, check, snapshot, rollout, inspect.
 #include <exception>
 #include <iostream>
 #include <string>
@@ -12,7 +12,9 @@ int main(int argc, char** argv) {
       "pixelgym"};
   app.require_subcommand(1, 1);
   app.fallthrough(false);
-  const std::vector<pixelgym::cli::Command> commands = pixelgym::cli::add_env_commands(app);
+  std::vector<pixelgym::cli::Command> commands = pixelgym::cli::add_env_commands(app);
+  for (auto& command : pixelgym::cli::add_engine_commands(app))
+    commands.push_back(std::move(command));
 
   // CLI11 reports an unknown first word only as "a subcommand is required"; name it instead.
   if (argc > 1 && argv[1][0] != '-') {

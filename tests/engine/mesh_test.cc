@@ -10,7 +10,9 @@ namespace {
 
 using ::testing::HasSubstr;
 
-std::string data(const std::string& name) { return std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/" + name; }
+std::string data(const std::string& name) {
+  return std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/" + name;
+}
 
 std::string error_of(const std::string& path) {
   try {
@@ -58,7 +60,8 @@ TEST(MeshTest, BadFilesAreRefusedNamingFileAndProblem) {
 TEST(MeshCacheTest, ReadsEachFileOnce) {
   MeshCache cache;
   const auto a = cache.get(asset_path("arm/meshes/link3.obj"));
-  const auto b = cache.get(std::string(PIXELGYM_SOURCE_DIR) + "/assets/arm/../arm/meshes/link3.obj");
+  const auto b =
+      cache.get(std::string(PIXELGYM_SOURCE_DIR) + "/assets/arm/../arm/meshes/link3.obj");
   EXPECT_EQ(a.get(), b.get());
   EXPECT_EQ(cache.files_read(), 1);
 }

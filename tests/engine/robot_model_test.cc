@@ -42,19 +42,18 @@ TEST_P(AssetTest, LoadsWithTheExpectedStructure) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(EveryAsset, AssetTest,
-                         ::testing::Values(AssetCase{"cartpole/cartpole.urdf", 3, 2},
-                                           AssetCase{"pendulum/pendulum.urdf", 2, 1},
-                                           AssetCase{"acrobot/acrobot.urdf", 3, 2},
-                                           AssetCase{"reacher/reacher.urdf", 4, 2},
-                                           AssetCase{"arm/arm.urdf", 10, 7},
-                                           AssetCase{"objects/table.urdf", 1, 0},
-                                           AssetCase{"objects/cube.urdf", 1, 0},
-                                           AssetCase{"objects/target.urdf", 1, 0}),
-                         [](const ::testing::TestParamInfo<AssetCase>& param_info) {
-                           std::string name = std::filesystem::path(param_info.param.file).stem().string();
-                           return name;
-                         });
+INSTANTIATE_TEST_SUITE_P(
+    EveryAsset, AssetTest,
+    ::testing::Values(AssetCase{"cartpole/cartpole.urdf", 3, 2},
+                      AssetCase{"pendulum/pendulum.urdf", 2, 1},
+                      AssetCase{"acrobot/acrobot.urdf", 3, 2},
+                      AssetCase{"reacher/reacher.urdf", 4, 2}, AssetCase{"arm/arm.urdf", 10, 7},
+                      AssetCase{"objects/table.urdf", 1, 0}, AssetCase{"objects/cube.urdf", 1, 0},
+                      AssetCase{"objects/target.urdf", 1, 0}),
+    [](const ::testing::TestParamInfo<AssetCase>& param_info) {
+      std::string name = std::filesystem::path(param_info.param.file).stem().string();
+      return name;
+    });
 
 TEST(RobotModelTest, EveryUrdfUnderAssetsIsCovered) {
   int count = 0;
@@ -96,10 +95,12 @@ TEST(RobotModelTest, CapsulesMaterialsAndJointDetails) {
   EXPECT_DOUBLE_EQ(pole.visuals[0].geometry.length_m, 1.0);
   EXPECT_TRUE(pole.visuals[0].material.has_rgba);
   EXPECT_NEAR(pole.visuals[0].material.rgba.x(), 0.95, 1e-6);  // urdfdom keeps colours as float
-  const JointModel& slider = cartpole->joints()[static_cast<std::size_t>(cartpole->joint_index("slider"))];
+  const JointModel& slider =
+      cartpole->joints()[static_cast<std::size_t>(cartpole->joint_index("slider"))];
   EXPECT_EQ(slider.type, JointType::kPrismatic);
   EXPECT_DOUBLE_EQ(slider.lower, -2.0);
-  const JointModel& hinge = cartpole->joints()[static_cast<std::size_t>(cartpole->joint_index("hinge"))];
+  const JointModel& hinge =
+      cartpole->joints()[static_cast<std::size_t>(cartpole->joint_index("hinge"))];
   EXPECT_EQ(hinge.type, JointType::kContinuous);
   EXPECT_FALSE(hinge.has_limits);
   EXPECT_EQ(hinge.axis, Eigen::Vector3d(0, 1, 0));
@@ -152,7 +153,8 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(RobotModelTest, EveryBadFileHasACase) {
   int count = 0;
   for (const auto& entry : std::filesystem::directory_iterator(data(""))) {
-    if (entry.path().extension() == ".urdf" && entry.path().filename() != "minimal_valid.urdf") ++count;
+    if (entry.path().extension() == ".urdf" && entry.path().filename() != "minimal_valid.urdf")
+      ++count;
   }
   EXPECT_EQ(count, 18);
 }
@@ -170,7 +172,8 @@ TEST(RobotModelTest, ResolvesRelativeFileAndPackageUris) {
 TEST(ModelCacheTest, ParsesOnceAndReadsEachMeshOnce) {
   ModelCache cache;
   const auto first = cache.load_urdf(asset_path("arm/arm.urdf"));
-  for (int i = 0; i < 15; ++i) EXPECT_EQ(cache.load_urdf(asset_path("arm/arm.urdf")).get(), first.get());
+  for (int i = 0; i < 15; ++i)
+    EXPECT_EQ(cache.load_urdf(asset_path("arm/arm.urdf")).get(), first.get());
   EXPECT_EQ(cache.urdfs_parsed(), 1);
   EXPECT_EQ(cache.meshes().files_read(), 16);  // 7 visuals + 7 hulls + pedestal + hand
 }

@@ -48,8 +48,10 @@ TEST(WorldPhysicsTest, PendulumSmallAnglePeriodWithinOnePercent) {
     previous = q;
   }
   ASSERT_GE(crossings.size(), 5U);
-  const double measured = (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
-  EXPECT_NEAR(measured / expected, 1.0, 0.01) << "measured " << measured << " s, expected " << expected << " s";
+  const double measured =
+      (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
+  EXPECT_NEAR(measured / expected, 1.0, 0.01)
+      << "measured " << measured << " s, expected " << expected << " s";
   std::cout << "pendulum period: measured " << measured << " s, analytic " << expected
             << " s, ratio " << measured / expected << "\n";
 }
@@ -131,7 +133,8 @@ TEST(WorldPhysicsTest, CubeRestsOnTheGroundWithItsWeightInContacts) {
   EXPECT_NEAR(world.base_pose(cube).translation().z(), 0.025, 2e-3);
   double normal_force = 0.0;
   for (const Contact& contact : world.contacts()) {
-    if ((contact.a == "cube/cube" && contact.b == "ground") || (contact.b == "cube/cube" && contact.a == "ground")) {
+    if ((contact.a == "cube/cube" && contact.b == "ground") ||
+        (contact.b == "cube/cube" && contact.a == "ground")) {
       normal_force += contact.normal_force_n;
     }
   }

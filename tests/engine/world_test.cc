@@ -58,7 +58,8 @@ struct Scene {
       const Eigen::Isometry3d base = world.base_pose(robot);
       values.insert(values.end(), base.data(), base.data() + 16);
     }
-    const Eigen::Isometry3d tip = world.link_pose(arm, world.robot_model(arm).link_index("end_effector"));
+    const Eigen::Isometry3d tip =
+        world.link_pose(arm, world.robot_model(arm).link_index("end_effector"));
     values.insert(values.end(), tip.data(), tip.data() + 16);
     return values;
   }
@@ -101,7 +102,8 @@ TEST(WorldTest, AResetWorldMatchesAFreshOneBitForBit) {
   for (int chunk = 0; chunk < 10; ++chunk) {
     used.drive(c1, 100);
     fresh.drive(c2, 100);
-    ASSERT_TRUE(bit_identical(used.state(), fresh.state())) << "diverged by step " << (chunk + 1) * 100;
+    ASSERT_TRUE(bit_identical(used.state(), fresh.state()))
+        << "diverged by step " << (chunk + 1) * 100;
   }
 }
 
@@ -161,7 +163,8 @@ TEST(WorldTest, LinkVelocityMatchesJointRates) {
   qd << 0.3, 2.0;
   world.set_joint_state(cartpole, Eigen::VectorXd::Zero(2), qd);
   // The pole frame sits on the cart's pivot: it moves with the cart only.
-  const Eigen::Vector3d v = world.link_linear_velocity(cartpole, world.robot_model(cartpole).link_index("pole"));
+  const Eigen::Vector3d v =
+      world.link_linear_velocity(cartpole, world.robot_model(cartpole).link_index("pole"));
   EXPECT_TRUE(v.isApprox(Eigen::Vector3d(0.3, 0, 0), 1e-9)) << v.transpose();
 }
 
@@ -261,7 +264,8 @@ TEST(WorldTest, BadArgumentsAreRejected) {
   EXPECT_THROW(world.add_robot(nullptr), std::invalid_argument);
   const int cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
   EXPECT_THROW(world.set_joint_commands(cartpole, Eigen::VectorXd::Zero(3)), std::invalid_argument);
-  EXPECT_THROW(world.set_joint_commands(cartpole, Eigen::VectorXd::Constant(2, NAN)), std::invalid_argument);
+  EXPECT_THROW(world.set_joint_commands(cartpole, Eigen::VectorXd::Constant(2, NAN)),
+               std::invalid_argument);
   EXPECT_THROW(world.set_joint_state(cartpole, Eigen::VectorXd::Zero(1), Eigen::VectorXd::Zero(2)),
                std::invalid_argument);
   EXPECT_THROW(world.link_pose(cartpole, 9), std::out_of_range);

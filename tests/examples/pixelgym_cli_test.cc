@@ -116,5 +116,40 @@ TEST(PixelgymCliTest, RolloutPrintsReturns) {
   EXPECT_THAT(result.output, HasSubstr("mean_return="));
 }
 
+TEST(PixelgymCliTest, InspectWorksOnEveryAsset) {
+  int count = 0;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(
+           std::string(PIXELGYM_SOURCE_DIR) + "/assets")) {
+    if (entry.path().extension() != ".urdf") continue;
+    ++count;
+    const CliRun result = run("inspect " + entry.path().string());
+    EXPECT_EQ(result.exit_code, 0) << entry.path() << ": " << result.output;
+    EXPECT_THAT(result.output, HasSubstr("simulates:"));
+  }
+  EXPECT_EQ(count, 8);
+  const CliRun arm = run("inspect " + std::string(PIXELGYM_SOURCE_DIR) + "/assets/arm/arm.urdf");
+  EXPECT_THAT(arm.output, HasSubstr("link3.obj   1152 triangles"));
+  EXPECT_THAT(arm.output, HasSubstr("limits [-2.090, 2.090] rad"));
+  EXPECT_THAT(arm.output, HasSubstr("total mass 23.200 kg"));
+}
+
+TEST(PixelgymCliTest, InspectRefusesEveryBadFileNamingTheProblem) {
+  int count = 0;
+  for (const auto& entry :
+       std::filesystem::directory_iterator(std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/urdf")) {
+    if (entry.path().extension() != ".urdf" || entry.path().filename() == "minimal_valid.urdf")
+      continue;
+    ++count;
+    const CliRun result = run("inspect " + entry.path().string());
+    EXPECT_EQ(result.exit_code, 1) << entry.path() << ": " << result.output;
+    EXPECT_THAT(result.output, HasSubstr("pixelgym: error: URDF " + entry.path().string() + ": "));
+  }
+  EXPECT_EQ(count, 18);
+  EXPECT_EQ(
+      run("inspect " + std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/urdf/minimal_valid.urdf")
+          .exit_code,
+      0);
+}
+
 }  // namespace
 }  // namespace pixelgym
