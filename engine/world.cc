@@ -149,6 +149,7 @@ struct World::Impl {
 
   explicit Impl(const WorldConfig& world_config) : config(world_config) {
     ground_shape = std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0);
+    island_anchor_shape = std::make_unique<btSphereShape>(1e-3);
     build();
   }
 
@@ -255,17 +256,26 @@ struct World::Impl {
                                                : btBroadphaseProxy::DefaultFilter;
     for (std::size_t l = 0; l < links.size(); ++l) {
       btCollisionShape* shape = robot.shapes[l].shape.get();
-      if (shape == nullptr) continue;
       const int bullet_link = static_cast<int>(l) - 1;
       auto collider = std::make_unique<btMultiBodyLinkCollider>(&body, bullet_link);
-      collider->setCollisionShape(shape);
-      collider->setFriction(0.8);
-      const bool is_static_base = l == 0 && robot.options.fixed_base;
-      const int link_group = l == 0 ? group : btBroadphaseProxy::DefaultFilter;
-      const int mask = is_static_base
-                           ? btBroadphaseProxy::AllFilter ^ btBroadphaseProxy::StaticFilter
-                           : btBroadphaseProxy::AllFilter;
-      dynamics->addCollisionObject(collider.get(), link_group, mask);
+      if (shape != nullptr) {
+        collider->setCollisionShape(shape);
+        collider->setFriction(0.8);
+        const bool is_static_base = l == 0 && robot.options.fixed_base;
+        const int link_group = l == 0 ? group : btBroadphaseProxy::DefaultFilter;
+        const int mask = is_static_base
+                             ? btBroadphaseProxy::AllFilter ^ btBroadphaseProxy::StaticFilter
+                             : btBroadphaseProxy::AllFilter;
+        dynamics->addCollisionObject(collider.get(), link_group, mask);
+      } else {
+        // Bullet solves joint limits and motors per simulation island, found through the
+        // colliders of the links they act on; a link without one has no island, and its limits,
+        // motors and friction would silently do nothing. A tiny collider that collides with
+        // nothing (group and mask 0) gives it one. (Turning island splitting off instead hits a
+        // Bullet 3.24 bug that passes no multibody constraint to the solver.)
+        collider->setCollisionShape(island_anchor_shape.get());
+        dynamics->addCollisionObject(collider.get(), 0, 0);
+      }
       if (l == 0) {
         body.setBaseCollider(collider.get());
       } else {
@@ -400,6 +410,7 @@ struct World::Impl {
 
   WorldConfig config;
   std::unique_ptr<btCollisionShape> ground_shape;
+  std::unique_ptr<btCollisionShape> island_anchor_shape;  // see build_robot
   std::vector<Robot> robots;
   std::vector<Body> bodies;
   std::vector<VisualRef> visual_refs;

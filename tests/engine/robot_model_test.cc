@@ -159,6 +159,21 @@ TEST(RobotModelTest, EveryBadFileHasACase) {
   EXPECT_EQ(count, 18);
 }
 
+TEST(RobotModelTest, InlineColoursAndTextureFileNames) {
+  MeshCache meshes;
+  const auto model = parse_urdf(
+      std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/urdf_good/inline_material.urdf", meshes);
+  const LinkModel& base = model->links()[0];
+  ASSERT_EQ(base.visuals.size(), 2U);
+  EXPECT_TRUE(base.visuals[0].material.has_rgba);
+  EXPECT_TRUE(base.visuals[0].material.rgba.isApprox(Eigen::Vector4d(0.1, 0.2, 0.3, 0.4), 1e-6));
+  EXPECT_EQ(base.visuals[0].material.name, "painted");
+  EXPECT_TRUE(base.visuals[0].material.texture_path.empty());
+  EXPECT_EQ(base.visuals[1].material.texture_path,
+            std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/urdf_good/checker.png");
+  EXPECT_EQ(base.visuals[0].geometry.box_size_m, Eigen::Vector3d(0.1, 0.2, 0.3));
+}
+
 TEST(RobotModelTest, ResolvesRelativeFileAndPackageUris) {
   const std::string urdf = asset_path("arm/arm.urdf");
   const std::string link1 = asset_path("arm/meshes/link1.obj");

@@ -155,5 +155,37 @@ TEST(WorldPhysicsTest, TorqueOnAFreeJointGivesTheExpectedAcceleration) {
   EXPECT_NEAR(world.joint_velocities(robot)[0] / expected_velocity, 1.0, 1e-3);
 }
 
+std::shared_ptr<const RobotModel> good_urdf(ModelCache& cache, const std::string& name) {
+  return cache.load_urdf(std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/urdf_good/" + name);
+}
+
+TEST(WorldPhysicsTest, JointDampingDecaysVelocityExponentially) {
+  ModelCache cache;
+  World world;
+  const int wheel = world.add_robot(good_urdf(cache, "damped_wheel.urdf"));
+  world.set_joint_state(wheel, Eigen::VectorXd::Zero(1), Eigen::VectorXd::Constant(1, 2.0));
+  world.step(120);  // 0.5 s = one time constant I / c
+  EXPECT_NEAR(world.joint_velocities(wheel)[0] / (2.0 * std::exp(-1.0)), 1.0, 0.01);
+}
+
+TEST(WorldPhysicsTest, JointFrictionStopsTheJointAndHoldsIt) {
+  ModelCache cache;
+  World world;
+  const int wheel = world.add_robot(good_urdf(cache, "rubbing_wheel.urdf"));
+  world.set_joint_state(wheel, Eigen::VectorXd::Zero(1), Eigen::VectorXd::Constant(1, 1.0));
+  world.step(24);  // 0.1 s: friction 0.05 N m on I = 0.01 decelerates at 5 rad/s^2
+  EXPECT_NEAR(world.joint_velocities(wheel)[0], 0.5, 0.02);
+  world.step(48);  // stopped at 0.2 s
+  EXPECT_NEAR(world.joint_velocities(wheel)[0], 0.0, 1e-6);
+  // A torque below the friction does not move it; above, it does.
+  world.set_joint_commands(wheel, Eigen::VectorXd::Constant(1, 0.04));
+  world.step(240);
+  EXPECT_NEAR(world.joint_velocities(wheel)[0], 0.0, 1e-6);
+  world.set_joint_commands(wheel, Eigen::VectorXd::Constant(1, 0.06));
+  world.step(240);
+  EXPECT_NEAR(world.joint_velocities(wheel)[0], 0.01 / 0.01 * 1.0,
+              0.02);  // (0.06 - 0.05) / I * 1 s
+}
+
 }  // namespace
 }  // namespace pixelgym::engine

@@ -192,6 +192,27 @@ TEST(WorldTest, JointLimitsHold) {
   EXPECT_LT(world.joint_positions(cartpole)[0], 2.0 + 0.02);
 }
 
+TEST(WorldTest, LimitsAndMotorsWorkOnRobotsWithoutCollisionShapes) {
+  // The reacher has no collision geometry; Bullet solves joint limits and motors per collision
+  // island, which such a robot would not have without the world's help.
+  ModelCache cache;
+  World world;
+  const int reacher = world.add_robot(cache.load_urdf(asset_path("reacher/reacher.urdf")));
+  // Push the wrist into its 2.8 rad limit. Without an island for its links the limit is ignored
+  // and the wrist spins on (18.9 rad after 2 s). Bullet's limits are soft (error reduction per
+  // step), so a light link under full torque rests slightly inside the limit.
+  world.set_joint_commands(reacher, (Eigen::VectorXd(2) << 0.0, 0.05).finished());
+  world.step(480);
+  EXPECT_GT(world.joint_positions(reacher)[1], 2.7);
+  EXPECT_LT(world.joint_positions(reacher)[1], 3.0) << "the wrist limit did not hold";
+  EXPECT_NEAR(world.joint_velocities(reacher)[1], 0.0, 0.05)
+      << "the wrist is not resting on its limit";
+  world.set_control_mode(reacher, 0, ControlMode::kVelocity);
+  world.set_joint_commands(reacher, (Eigen::VectorXd(2) << 1.0, 0.0).finished());
+  world.step(240);
+  EXPECT_NEAR(world.joint_velocities(reacher)[0], 1.0, 1e-3);
+}
+
 TEST(WorldTest, VisualShapesListEveryVisualWithItsPose) {
   ModelCache cache;
   World world;
