@@ -101,8 +101,9 @@ class World {
   /// Adds a robot built from `model`; returns its index. Throws std::invalid_argument for a null
   /// model or a floating base whose root link has no positive mass and inertia.
   int add_robot(std::shared_ptr<const RobotModel> model, RobotOptions options = {});
-  /// Adds a free body; returns its index. Throws std::invalid_argument for a negative mass, a
-  /// dynamic mesh body, or a geometry of zero size.
+  /// Adds a free body; returns its index. A static mesh body collides as its triangles, a moving
+  /// one as its convex hull. Throws std::invalid_argument for a negative mass or a mesh geometry
+  /// without a mesh.
   int add_body(BodyOptions options);
 
   /// Advances `steps` physics steps of config().timestep_s with the current controls.

@@ -263,6 +263,35 @@ TEST(WorldTest, MarkerHasNoCollision) {
   }
 }
 
+TEST(WorldTest, StaticMeshBodiesCollideAsTriangles) {
+  // A ball dropped into the pedestal's open top ring lands on its cap, 0.16 m up: the triangles,
+  // not a bounding box, hold it.
+  ModelCache cache;
+  World world;
+  BodyOptions pedestal;
+  pedestal.name = "pedestal";
+  pedestal.geometry.type = GeometryType::kMesh;
+  pedestal.geometry.mesh = cache.meshes().get(asset_path("arm/meshes/pedestal.dae"));
+  pedestal.mass_kg = 0;
+  world.add_body(pedestal);
+  BodyOptions ball;
+  ball.name = "ball";
+  ball.geometry.type = GeometryType::kSphere;
+  ball.geometry.radius_m = 0.03;
+  ball.X_world_body.translation() = Eigen::Vector3d(0.02, 0.01, 0.5);
+  const int b = world.add_body(ball);
+  world.step(480);
+  EXPECT_NEAR(world.body_pose(b).translation().z(), 0.16 + 0.03, 3e-3);
+  BodyOptions scaled = pedestal;
+  scaled.name = "scaled";
+  scaled.mass_kg = 1.0;  // a moving mesh: its convex hull, scaled
+  scaled.geometry.mesh_scale = Eigen::Vector3d(0.5, 0.5, 0.5);
+  scaled.X_world_body.translation() = Eigen::Vector3d(2, 0, 0.3);
+  const int s = world.add_body(scaled);
+  world.step(480);
+  EXPECT_NEAR(world.body_pose(s).translation().z(), 0.0, 3e-3) << "the 0.08 m hull rests on the ground";
+}
+
 TEST(WorldTest, NonFiniteStateRaisesNamingTheRobot) {
   ModelCache cache;
   World world;
