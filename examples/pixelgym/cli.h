@@ -50,4 +50,7 @@ std::vector<Command> add_env_commands(CLI::App& app);
 /// Adds inspect to `app`.
 std::vector<Command> add_engine_commands(CLI::App& app);
 
+/// Adds view to `app`.
+std::vector<Command> add_render_commands(CLI::App& app);
+
 }  // namespace pixelgym::cli

@@ -1,4 +1,4 @@
-// pixelgym — the command-line front door: list, info, check, snapshot, rollout, inspect.
+// pixelgym — the command-line front door: list, info, check, snapshot, rollout, inspect, view.
 #include <exception>
 #include <iostream>
 #include <string>
@@ -13,8 +13,9 @@ int main(int argc, char** argv) {
   app.require_subcommand(1, 1);
   app.fallthrough(false);
   std::vector<pixelgym::cli::Command> commands = pixelgym::cli::add_env_commands(app);
-  for (auto& command : pixelgym::cli::add_engine_commands(app))
-    commands.push_back(std::move(command));
+  for (auto* add : {pixelgym::cli::add_engine_commands, pixelgym::cli::add_render_commands}) {
+    for (auto& command : add(app)) commands.push_back(std::move(command));
+  }
 
   // CLI11 reports an unknown first word only as "a subcommand is required"; name it instead.
   if (argc > 1 && argv[1][0] != '-') {

@@ -1,0 +1,159 @@
+#include "envs/world_scene.h"
+
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <stdexcept>
+
+namespace pixelgym {
+namespace {
+
+constexpr float kPi = 3.14159265358979323846F;
+
+// Engine meshes converted for drawing, shared process-wide; the engine mesh is kept alive so its
+// address stays a valid key.
+struct ConvertedMesh {
+  std::shared_ptr<const engine::Mesh> source;
+  std::shared_ptr<const MeshData> with_colors;
+  std::shared_ptr<const MeshData> without_colors;
+};
+
+std::shared_ptr<const MeshData> convert(const std::shared_ptr<const engine::Mesh>& mesh,
+                                        bool keep_part_colors) {
+  static std::mutex mutex;
+  static std::map<const engine::Mesh*, ConvertedMesh> converted;
+  std::lock_guard<std::mutex> lock(mutex);
+  ConvertedMesh& entry = converted[mesh.get()];
+  std::shared_ptr<const MeshData>& slot =
+      keep_part_colors ? entry.with_colors : entry.without_colors;
+  if (slot == nullptr) {
+    entry.source = mesh;
+    auto data = std::make_shared<MeshData>();
+    data->positions = mesh->positions;
+    data->normals = mesh->normals;
+    data->indices = mesh->indices;
+    for (const engine::Mesh::Part& part : mesh->parts) {
+      MeshData::Part out;
+      out.first_index = part.first_index;
+      out.index_count = part.index_count;
+      out.rgba = part.rgba;
+      out.has_color = keep_part_colors && part.has_color;
+      data->parts.push_back(out);
+    }
+    slot = std::move(data);
+  }
+  return slot;
+}
+
+// Unit primitives shared by every scene.
+std::shared_ptr<const MeshData> shared_primitive(engine::GeometryType type) {
+  static const auto box = make_box_mesh();
+  static const auto sphere = make_sphere_mesh(24);
+  static const auto cylinder = make_cylinder_mesh(24);
+  switch (type) {
+    case engine::GeometryType::kBox:
+      return box;
+    case engine::GeometryType::kSphere:
+      return sphere;
+    default:
+      return cylinder;
+  }
+}
+
+std::shared_ptr<const MeshData> shared_capsule(double length_over_radius) {
+  static std::mutex mutex;
+  static std::map<long, std::shared_ptr<const MeshData>> capsules;  // by ratio in thousandths
+  const long key = std::lround(length_over_radius * 1000.0);
+  std::lock_guard<std::mutex> lock(mutex);
+  auto& slot = capsules[key];
+  if (slot == nullptr) slot = make_capsule_mesh(static_cast<double>(key) / 1000.0, 24);
+  return slot;
+}
+
+}  // namespace
+
+WorldScene::WorldScene(const engine::World& world) {
+  for (const engine::VisualShape& shape : world.visual_shapes()) {
+    Instance instance;
+    const engine::Geometry& geometry = shape.geometry;
+    switch (geometry.type) {
+      case engine::GeometryType::kBox:
+        instance.mesh = shared_primitive(geometry.type);
+        instance.scale = geometry.box_size_m.cast<float>();
+        break;
+      case engine::GeometryType::kSphere:
+        instance.mesh = shared_primitive(geometry.type);
+        instance.scale = Eigen::Vector3f::Constant(static_cast<float>(geometry.radius_m));
+        break;
+      case engine::GeometryType::kCylinder:
+        instance.mesh = shared_primitive(geometry.type);
+        instance.scale = Eigen::Vector3f(static_cast<float>(geometry.radius_m),
+                                         static_cast<float>(geometry.radius_m),
+                                         static_cast<float>(geometry.length_m));
+        break;
+      case engine::GeometryType::kCapsule:
+        instance.mesh = shared_capsule(geometry.length_m / geometry.radius_m);
+        instance.scale = Eigen::Vector3f::Constant(static_cast<float>(geometry.radius_m));
+        break;
+      case engine::GeometryType::kMesh:
+        // A URDF colour overrides the mesh file's own colours (as in ROS and PyBullet).
+        instance.mesh = convert(geometry.mesh, !shape.material.has_rgba);
+        instance.scale = geometry.mesh_scale.cast<float>();
+        break;
+    }
+    instance.material.base_color = shape.material.rgba.cast<float>();
+    instance.material.texture_path = shape.material.texture_path;
+    instance.segmentation_id = shape.segmentation_id;
+    scene_.instances.push_back(std::move(instance));
+  }
+  update(world);
+}
+
+void WorldScene::update(const engine::World& world) {
+  world.visual_poses(poses_);
+  if (poses_.size() != scene_.instances.size()) {
+    throw std::invalid_argument(
+        "WorldScene::update: the world has " + std::to_string(poses_.size()) +
+        " visual shapes, the scene was built for " + std::to_string(scene_.instances.size()));
+  }
+  for (std::size_t i = 0; i < poses_.size(); ++i) {
+    scene_.instances[i].X_world_instance = poses_[i].cast<float>();
+  }
+}
+
+Eigen::AlignedBox3f WorldScene::bounds() const {
+  Eigen::AlignedBox3f box;
+  for (const Instance& instance : scene_.instances) {
+    for (const Eigen::Vector3f& p : instance.mesh->positions) {
+      box.extend(instance.X_world_instance * p.cwiseProduct(instance.scale));
+    }
+  }
+  return box;
+}
+
+Camera frame_box(const Eigen::AlignedBox3f& box, float azimuth_deg, float elevation_deg, int width,
+                 int height, float fov_y_deg) {
+  if (box.isEmpty()) throw std::invalid_argument("frame_box: nothing to frame (the box is empty)");
+  const Eigen::Vector3f centre = box.center();
+  const float radius = std::max(0.5F * box.diagonal().norm(), 1e-3F);
+  const float azimuth = azimuth_deg * kPi / 180.0F;
+  const float elevation = elevation_deg * kPi / 180.0F;
+  const Eigen::Vector3f direction(std::cos(elevation) * std::cos(azimuth),
+                                  std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+  // Far enough that the bounding sphere fits the narrower field of view.
+  const float aspect = static_cast<float>(width) / static_cast<float>(height);
+  const float half_fov_y = fov_y_deg * kPi / 360.0F;
+  const float half_fov = std::min(half_fov_y, std::atan(std::tan(half_fov_y) * aspect));
+  const float distance = radius / std::sin(half_fov) * 1.05F;
+  const Eigen::Vector3f up =
+      std::abs(direction.z()) > 0.99F ? Eigen::Vector3f::UnitY() : Eigen::Vector3f::UnitZ();
+  Camera camera = Camera::look_at(centre + distance * direction, centre, up);
+  camera.width = width;
+  camera.height = height;
+  camera.fov_y_deg = fov_y_deg;
+  camera.near_m = std::max(0.01F, distance - 2.0F * radius) * 0.5F;
+  camera.far_m = distance + 20.0F * radius + 10.0F;
+  return camera;
+}
+
+}  // namespace pixelgym

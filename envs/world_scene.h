@@ -1,0 +1,41 @@
+// WorldScene: the render Scene of an engine World, kept in step with it.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <vector>
+
+#include "engine/world.h"
+#include "render/camera.h"
+#include "render/scene.h"
+
+namespace pixelgym {
+
+/// Builds a Scene with one Instance per visual shape of a World (meshes with their materials,
+/// primitives scaled from shared unit meshes) and updates the instance poses from the world.
+/// Meshes are converted once per process and shared by every WorldScene.
+class WorldScene {
+ public:
+  explicit WorldScene(const engine::World& world);
+
+  /// Copies the current visual poses of `world` (the one it was built from) into the scene.
+  void update(const engine::World& world);
+
+  Scene& scene() { return scene_; }
+  const Scene& scene() const { return scene_; }
+
+  /// The world-aligned box around every instance (at the last update).
+  Eigen::AlignedBox3f bounds() const;
+
+ private:
+  Scene scene_;
+  std::vector<Eigen::Vector3f> local_scale_;
+  std::vector<Eigen::Isometry3d> poses_;  // scratch for World::visual_poses
+};
+
+/// A camera that frames `box` whole, looking from the direction given by azimuth (degrees,
+/// counter-clockwise from +x) and elevation (degrees above the horizon). Throws
+/// std::invalid_argument for an empty box.
+Camera frame_box(const Eigen::AlignedBox3f& box, float azimuth_deg, float elevation_deg, int width,
+                 int height, float fov_y_deg = 40.0F);
+
+}  // namespace pixelgym

@@ -1,0 +1,46 @@
+// Context: an off-screen OpenGL 3.3 core context.
+#pragma once
+
+#include <memory>
+#include <string>
+
+namespace pixelgym {
+
+/// Which OpenGL implementation a context comes from.
+enum class GlBackend {
+  /// Mesa's off-screen GL (libOSMesa, llvmpipe): no display, no GPU. The default.
+  kOSMesa,
+};
+
+/// An RAII OpenGL 3.3 core context. One context belongs to one renderer and is used by one
+/// thread at a time (any thread, one after the other); contexts in different threads are
+/// independent.
+///
+/// llvmpipe threads: Mesa's software rasterizer starts LP_NUM_THREADS worker threads per context
+/// (by default one per core). For the small images of pixel observations they cost more than they
+/// give (measured in bench/render_bench), so the first context pixelgym creates in a process sets
+/// LP_NUM_THREADS=0 unless the variable is already set. Set it yourself (e.g. to the core count)
+/// before the first render to override this.
+class Context {
+ public:
+  /// Creates a context. Throws std::runtime_error naming the backend and Mesa's reason when it
+  /// cannot be created.
+  explicit Context(GlBackend backend = GlBackend::kOSMesa);
+  ~Context();
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+  /// Makes this context current on the calling thread (cheap when it already is).
+  void make_current();
+  GlBackend backend() const { return backend_; }
+  /// GL_RENDERER and GL_VERSION, e.g. "llvmpipe (LLVM 15.0.6, 256 bits), 4.5 (Core Profile)
+  /// Mesa 22.3.6".
+  std::string description();
+
+ private:
+  struct Impl;
+  GlBackend backend_;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace pixelgym

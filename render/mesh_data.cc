@@ -1,0 +1,134 @@
+#include "render/mesh_data.h"
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+namespace pixelgym {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+void add_vertex(MeshData& mesh, const Eigen::Vector3f& p, const Eigen::Vector3f& n,
+                const Eigen::Vector2f& uv) {
+  mesh.positions.push_back(p);
+  mesh.normals.push_back(n);
+  mesh.texcoords.push_back(uv);
+}
+
+// A surface of revolution about z: `profile` gives (radius, z, normal radial part, normal z) for
+// each ring from bottom to top.
+void add_revolution(MeshData& mesh, const std::vector<Eigen::Vector4f>& profile, int segments) {
+  const auto base = static_cast<std::uint32_t>(mesh.positions.size());
+  for (std::size_t r = 0; r < profile.size(); ++r) {
+    for (int k = 0; k <= segments; ++k) {
+      const double t = 2 * kPi * k / segments;
+      const float c = static_cast<float>(std::cos(t));
+      const float s = static_cast<float>(std::sin(t));
+      const Eigen::Vector4f& ring = profile[r];
+      add_vertex(mesh, {ring[0] * c, ring[0] * s, ring[1]},
+                 Eigen::Vector3f(ring[2] * c, ring[2] * s, ring[3]).normalized(),
+                 {static_cast<float>(k) / static_cast<float>(segments),
+                  static_cast<float>(r) / static_cast<float>(profile.size() - 1)});
+    }
+  }
+  const auto stride = static_cast<std::uint32_t>(segments + 1);
+  for (std::uint32_t r = 0; r + 1 < profile.size(); ++r) {
+    for (std::uint32_t k = 0; k < static_cast<std::uint32_t>(segments); ++k) {
+      const std::uint32_t a = base + r * stride + k;
+      const std::uint32_t b = a + stride;
+      mesh.indices.insert(mesh.indices.end(), {a, a + 1, b + 1, a, b + 1, b});
+    }
+  }
+}
+
+// A flat disc at height z facing `up` (+1) or down (-1).
+void add_disc(MeshData& mesh, float z, float up, int segments) {
+  const auto centre = static_cast<std::uint32_t>(mesh.positions.size());
+  add_vertex(mesh, {0, 0, z}, {0, 0, up}, {0.5F, 0.5F});
+  for (int k = 0; k <= segments; ++k) {
+    const double t = 2 * kPi * k / segments;
+    const float c = static_cast<float>(std::cos(t));
+    const float s = static_cast<float>(std::sin(t));
+    add_vertex(mesh, {c, s, z}, {0, 0, up}, {0.5F + 0.5F * c, 0.5F + 0.5F * s});
+  }
+  for (std::uint32_t k = 0; k < static_cast<std::uint32_t>(segments); ++k) {
+    if (up > 0) {
+      mesh.indices.insert(mesh.indices.end(), {centre, centre + 1 + k, centre + 2 + k});
+    } else {
+      mesh.indices.insert(mesh.indices.end(), {centre, centre + 2 + k, centre + 1 + k});
+    }
+  }
+}
+
+}  // namespace
+
+std::shared_ptr<const MeshData> make_box_mesh() {
+  auto mesh = std::make_shared<MeshData>();
+  const Eigen::Vector3f normals[6] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                      {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+  for (const Eigen::Vector3f& n : normals) {
+    // Two axes spanning the face, ordered so that u x v = n (counter-clockwise from outside).
+    Eigen::Vector3f u =
+        n.cross(std::abs(n.z()) < 0.5F ? Eigen::Vector3f(0, 0, 1) : Eigen::Vector3f(1, 0, 0));
+    Eigen::Vector3f v = n.cross(u);
+    const auto base = static_cast<std::uint32_t>(mesh->positions.size());
+    const float corners[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+    for (const auto& c : corners) {
+      add_vertex(*mesh, 0.5F * (n + c[0] * u + c[1] * v), n,
+                 {0.5F + 0.5F * c[0], 0.5F + 0.5F * c[1]});
+    }
+    if (u.cross(v).dot(n) > 0) {
+      mesh->indices.insert(mesh->indices.end(),
+                           {base, base + 1, base + 2, base, base + 2, base + 3});
+    } else {
+      mesh->indices.insert(mesh->indices.end(),
+                           {base, base + 2, base + 1, base, base + 3, base + 2});
+    }
+  }
+  return mesh;
+}
+
+std::shared_ptr<const MeshData> make_sphere_mesh(int segments) {
+  auto mesh = std::make_shared<MeshData>();
+  std::vector<Eigen::Vector4f> profile;
+  const int rings = std::max(4, segments / 2);
+  for (int i = 0; i <= rings; ++i) {
+    const double a = -kPi / 2 + kPi * i / rings;
+    const auto c = static_cast<float>(std::cos(a));
+    const auto s = static_cast<float>(std::sin(a));
+    profile.emplace_back(c, s, c, s);
+  }
+  add_revolution(*mesh, profile, segments);
+  return mesh;
+}
+
+std::shared_ptr<const MeshData> make_cylinder_mesh(int segments) {
+  auto mesh = std::make_shared<MeshData>();
+  add_revolution(*mesh, {{1, -0.5F, 1, 0}, {1, 0.5F, 1, 0}}, segments);
+  add_disc(*mesh, 0.5F, 1.0F, segments);
+  add_disc(*mesh, -0.5F, -1.0F, segments);
+  return mesh;
+}
+
+std::shared_ptr<const MeshData> make_capsule_mesh(double length_over_radius, int segments) {
+  auto mesh = std::make_shared<MeshData>();
+  const auto half = static_cast<float>(length_over_radius / 2);
+  std::vector<Eigen::Vector4f> profile;
+  const int rings = std::max(3, segments / 4);
+  for (int i = 0; i <= rings; ++i) {  // bottom hemisphere
+    const double a = -kPi / 2 + (kPi / 2) * i / rings;
+    const auto c = static_cast<float>(std::cos(a));
+    const auto s = static_cast<float>(std::sin(a));
+    profile.emplace_back(c, -half + s, c, s);
+  }
+  for (int i = 0; i <= rings; ++i) {  // top hemisphere
+    const double a = (kPi / 2) * i / rings;
+    const auto c = static_cast<float>(std::cos(a));
+    const auto s = static_cast<float>(std::sin(a));
+    profile.emplace_back(c, half + s, c, s);
+  }
+  add_revolution(*mesh, profile, segments);
+  return mesh;
+}
+
+}  // namespace pixelgym

@@ -1,0 +1,43 @@
+// MeshData: triangles as the renderer draws them, and the primitive shapes.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace pixelgym {
+
+/// An immutable triangle mesh for drawing. Shared by every instance and scene that uses it; the
+/// renderer uploads it to the GPU once per context.
+struct MeshData {
+  /// A run of triangles with one colour (a mesh file's material); `has_color` false means the
+  /// instance's material colour applies.
+  struct Part {
+    std::uint32_t first_index = 0;
+    std::uint32_t index_count = 0;
+    Eigen::Vector4f rgba{1.0F, 1.0F, 1.0F, 1.0F};
+    bool has_color = false;
+  };
+
+  std::vector<Eigen::Vector3f> positions;
+  std::vector<Eigen::Vector3f> normals;
+  /// Empty, or one per position (for textured materials).
+  std::vector<Eigen::Vector2f> texcoords;
+  std::vector<std::uint32_t> indices;
+  /// Empty means one part covering every index.
+  std::vector<Part> parts;
+
+  std::size_t triangle_count() const { return indices.size() / 3; }
+};
+
+/// Unit primitives, centred at the origin; instances scale them. Cylinders and capsules lie along
+/// z. `segments` sets the smoothness of round shapes.
+std::shared_ptr<const MeshData> make_box_mesh();                        // 1 x 1 x 1
+std::shared_ptr<const MeshData> make_sphere_mesh(int segments = 24);    // radius 1
+std::shared_ptr<const MeshData> make_cylinder_mesh(int segments = 24);  // radius 1, length 1
+/// A capsule of radius 1 whose cylindrical part is `length / radius` long (capsules do not scale
+/// uniformly, so each aspect ratio is its own mesh).
+std::shared_ptr<const MeshData> make_capsule_mesh(double length_over_radius, int segments = 24);
+
+}  // namespace pixelgym

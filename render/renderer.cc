@@ -1,0 +1,715 @@
+#include "render/renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+#include <unordered_map>
+#include <vector>
+
+#include "render/gl.h"
+#include "render/image_io.h"
+
+namespace pixelgym {
+namespace {
+
+// --- shaders ---------------------------------------------------------------------------------
+
+constexpr const char* kLitVertex = R"(#version 330 core
+layout(location = 0) in vec3 position;
+layout(location = 1) in vec3 normal;
+layout(location = 2) in vec2 uv;
+uniform mat4 model;
+uniform mat3 normal_matrix;
+uniform mat4 view_projection;
+uniform mat4 light_matrix;
+out vec3 world_position;
+out vec3 world_normal;
+out vec2 texcoord;
+out vec4 light_position;
+void main() {
+  vec4 world = model * vec4(position, 1.0);
+  world_position = world.xyz;
+  world_normal = normal_matrix * normal;
+  texcoord = uv;
+  light_position = light_matrix * world;
+  gl_Position = view_projection * world;
+}
+)";
+
+constexpr const char* kLitFragment = R"(#version 330 core
+in vec3 world_position;
+in vec3 world_normal;
+in vec2 texcoord;
+in vec4 light_position;
+uniform vec4 base_color;
+uniform float specular;
+uniform float shininess;
+uniform vec3 to_light;
+uniform vec3 light_color;
+uniform vec3 ambient;
+uniform vec3 camera_position;
+uniform bool use_texture;
+uniform sampler2D albedo;
+uniform bool checker;
+uniform float tile;
+uniform vec3 color_a;
+uniform vec3 color_b;
+uniform bool use_shadows;
+uniform sampler2DShadow shadow_map;
+uniform float shadow_texel;
+out vec4 fragment;
+
+float lit_fraction() {
+  vec3 p = light_position.xyz / light_position.w * 0.5 + 0.5;
+  if (p.x <= 0.0 || p.x >= 1.0 || p.y <= 0.0 || p.y >= 1.0 || p.z >= 1.0) return 1.0;
+  // 2 x 2 percentage-closer filtering on hardware comparisons.
+  float sum = 0.0;
+  for (int i = 0; i < 2; ++i) {
+    for (int j = 0; j < 2; ++j) {
+      vec2 offset = (vec2(i, j) - 0.5) * shadow_texel;
+      sum += texture(shadow_map, vec3(p.xy + offset, p.z));
+    }
+  }
+  return sum * 0.25;
+}
+
+void main() {
+  vec3 n = normalize(world_normal);
+  if (!gl_FrontFacing) n = -n;
+  vec3 color = base_color.rgb;
+  if (checker) {
+    // The checker averaged over the pixel's footprint (a box filter integrated in closed form),
+    // so that distant tiles blend smoothly instead of flickering into moire.
+    vec2 p = world_position.xy / tile;
+    vec2 w = fwidth(p) + 1e-4;
+    vec2 i = 2.0 * (abs(fract((p - 0.5 * w) * 0.5) - 0.5) - abs(fract((p + 0.5 * w) * 0.5) - 0.5)) / w;
+    color = mix(color_a, color_b, 0.5 - 0.5 * i.x * i.y);
+  }
+  if (use_texture) color *= texture(albedo, texcoord).rgb;
+  float diffuse = max(dot(n, to_light), 0.0);
+  vec3 view = normalize(camera_position - world_position);
+  float highlight = diffuse > 0.0 ? pow(max(dot(n, normalize(to_light + view)), 0.0), shininess) : 0.0;
+  float light = use_shadows ? lit_fraction() : 1.0;
+  vec3 shaded = color * (ambient + light_color * diffuse * light) + light_color * specular * highlight * light;
+  fragment = vec4(clamp(shaded, 0.0, 1.0), 1.0);
+}
+)";
+
+// A full-screen triangle whose fragments find their view ray's elevation for the sky gradient.
+constexpr const char* kSkyVertex = R"(#version 330 core
+uniform mat4 inverse_view_projection;
+out vec3 ray;
+void main() {
+  vec2 corner = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2)) * 2.0 - 1.0;
+  vec4 far_point = inverse_view_projection * vec4(corner, 1.0, 1.0);
+  vec4 near_point = inverse_view_projection * vec4(corner, -1.0, 1.0);
+  ray = far_point.xyz / far_point.w - near_point.xyz / near_point.w;
+  gl_Position = vec4(corner, 1.0, 1.0);
+}
+)";
+
+constexpr const char* kSkyFragment = R"(#version 330 core
+in vec3 ray;
+uniform vec3 horizon;
+uniform vec3 zenith;
+out vec4 fragment;
+void main() {
+  float elevation = clamp(normalize(ray).z, 0.0, 1.0);
+  fragment = vec4(mix(horizon, zenith, sqrt(elevation)), 1.0);
+}
+)";
+
+constexpr const char* kDepthVertex = R"(#version 330 core
+layout(location = 0) in vec3 position;
+uniform mat4 model_view_projection;
+void main() { gl_Position = model_view_projection * vec4(position, 1.0); }
+)";
+
+constexpr const char* kDepthFragment = R"(#version 330 core
+void main() {}
+)";
+
+constexpr const char* kSegmentationFragment = R"(#version 330 core
+uniform int segmentation_id;
+out int fragment;
+void main() { fragment = segmentation_id; }
+)";
+
+GLuint compile(GLenum type, const char* source) {
+  const GLuint shader = glCreateShader(type);
+  glShaderSource(shader, 1, &source, nullptr);
+  glCompileShader(shader);
+  GLint ok = 0;
+  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    char log[2048];
+    glGetShaderInfoLog(shader, sizeof log, nullptr, log);
+    throw std::runtime_error(std::string("Renderer: shader does not compile: ") + log);
+  }
+  return shader;
+}
+
+GLuint link(const char* vertex, const char* fragment) {
+  const GLuint program = glCreateProgram();
+  const GLuint v = compile(GL_VERTEX_SHADER, vertex);
+  const GLuint f = compile(GL_FRAGMENT_SHADER, fragment);
+  glAttachShader(program, v);
+  glAttachShader(program, f);
+  glLinkProgram(program);
+  glDeleteShader(v);
+  glDeleteShader(f);
+  GLint ok = 0;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    char log[2048];
+    glGetProgramInfoLog(program, sizeof log, nullptr, log);
+    throw std::runtime_error(std::string("Renderer: shaders do not link: ") + log);
+  }
+  return program;
+}
+
+// Uniform locations of the lit program, looked up once.
+struct LitUniforms {
+  GLint model, normal_matrix, view_projection, light_matrix, base_color, specular, shininess,
+      to_light, light_color, ambient, camera_position, use_texture, albedo, checker, tile, color_a,
+      color_b, use_shadows, shadow_map, shadow_texel;
+};
+
+struct GpuMesh {
+  std::shared_ptr<const MeshData> keep_alive;
+  GLuint vao = 0;
+  GLuint vertices = 0;
+  GLuint indices = 0;
+  std::vector<MeshData::Part> parts;
+  float radius = 0.0F;  // of a sphere about the origin that holds every vertex
+};
+
+// Render targets for one image size and sample count.
+struct Target {
+  GLuint framebuffer = 0;  // what is drawn into (multisampled when samples > 0)
+  GLuint color = 0;
+  GLuint depth = 0;
+  GLuint resolve_framebuffer = 0;  // single-sampled copy to read from when multisampled
+  GLuint resolve_color = 0;
+  GLuint resolve_depth = 0;
+};
+
+struct SegmentationTarget {
+  GLuint framebuffer = 0;
+  GLuint ids = 0;
+  GLuint depth = 0;
+};
+
+void check_framebuffer(const char* what) {
+  const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  if (status != GL_FRAMEBUFFER_COMPLETE) {
+    throw std::runtime_error(std::string("Renderer: ") + what + " framebuffer incomplete (status " +
+                             std::to_string(status) + ")");
+  }
+}
+
+GLuint make_renderbuffer(GLenum format, int width, int height, int samples) {
+  GLuint renderbuffer = 0;
+  glGenRenderbuffers(1, &renderbuffer);
+  glBindRenderbuffer(GL_RENDERBUFFER, renderbuffer);
+  if (samples > 0) {
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, format, width, height);
+  } else {
+    glRenderbufferStorage(GL_RENDERBUFFER, format, width, height);
+  }
+  return renderbuffer;
+}
+
+int shadow_map_size(const Camera& camera) {
+  // About two shadow texels per image pixel, as a power of two in [256, 2048].
+  int size = 256;
+  while (size < 2 * std::max(camera.width, camera.height) && size < 2048) size *= 2;
+  return size;
+}
+
+Eigen::Matrix4f orthographic(float half_width, float near_m, float far_m) {
+  Eigen::Matrix4f m = Eigen::Matrix4f::Identity();
+  m(0, 0) = 1.0F / half_width;
+  m(1, 1) = 1.0F / half_width;
+  m(2, 2) = -2.0F / (far_m - near_m);
+  m(2, 3) = -(far_m + near_m) / (far_m - near_m);
+  return m;
+}
+
+Eigen::Matrix4f look_from(const Eigen::Vector3f& eye, const Eigen::Vector3f& direction) {
+  const Eigen::Vector3f back = -direction.normalized();
+  const Eigen::Vector3f helper =
+      std::abs(back.z()) > 0.9F ? Eigen::Vector3f::UnitX() : Eigen::Vector3f::UnitZ();
+  const Eigen::Vector3f right = helper.cross(back).normalized();
+  const Eigen::Vector3f up = back.cross(right);
+  Eigen::Matrix4f view = Eigen::Matrix4f::Identity();
+  view.block<1, 3>(0, 0) = right.transpose();
+  view.block<1, 3>(1, 0) = up.transpose();
+  view.block<1, 3>(2, 0) = back.transpose();
+  view(0, 3) = -right.dot(eye);
+  view(1, 3) = -up.dot(eye);
+  view(2, 3) = -back.dot(eye);
+  return view;
+}
+
+Eigen::Matrix4f model_matrix(const Instance& instance) {
+  Eigen::Affine3f model = Eigen::Affine3f(instance.X_world_instance.matrix());
+  model.scale(instance.scale);
+  return model.matrix();
+}
+
+}  // namespace
+
+struct Renderer::Impl {
+  explicit Impl(GlBackend backend) : context(backend) {
+    lit = link(kLitVertex, kLitFragment);
+    sky = link(kSkyVertex, kSkyFragment);
+    depth_only = link(kDepthVertex, kDepthFragment);
+    segmentation = link(kDepthVertex, kSegmentationFragment);
+    const auto at = [this](const char* name) { return glGetUniformLocation(lit, name); };
+    u = {at("model"),        at("normal_matrix"),   at("view_projection"),
+         at("light_matrix"), at("base_color"),      at("specular"),
+         at("shininess"),    at("to_light"),        at("light_color"),
+         at("ambient"),      at("camera_position"), at("use_texture"),
+         at("albedo"),       at("checker"),         at("tile"),
+         at("color_a"),      at("color_b"),         at("use_shadows"),
+         at("shadow_map"),   at("shadow_texel")};
+    glGenVertexArrays(1, &empty_vao);
+    // The floor: a large square (its checker pattern comes from world coordinates).
+    auto floor_mesh = std::make_shared<MeshData>();
+    const float half = 500.0F;
+    floor_mesh->positions = {
+        {-half, -half, 0}, {half, -half, 0}, {half, half, 0}, {-half, half, 0}};
+    floor_mesh->normals.assign(4, Eigen::Vector3f::UnitZ());
+    floor_mesh->indices = {0, 1, 2, 0, 2, 3};
+    floor = std::move(floor_mesh);
+    // A white texel for untextured draws, so that the sampler always has a complete texture.
+    glGenTextures(1, &white_texture);
+    glBindTexture(GL_TEXTURE_2D, white_texture);
+    const unsigned char white[4] = {255, 255, 255, 255};
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, 1, 1, 0, GL_RGBA, GL_UNSIGNED_BYTE, white);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glFrontFace(GL_CW);  // the flipped projection mirrors the winding
+  }
+
+  ~Impl() {
+    context.make_current();
+    for (auto& [key, mesh] : meshes) {
+      glDeleteVertexArrays(1, &mesh.vao);
+      glDeleteBuffers(1, &mesh.vertices);
+      glDeleteBuffers(1, &mesh.indices);
+    }
+    for (auto& [key, target] : targets) {
+      const GLuint framebuffers[] = {target.framebuffer, target.resolve_framebuffer};
+      glDeleteFramebuffers(2, framebuffers);
+      const GLuint renderbuffers[] = {target.color, target.depth, target.resolve_color,
+                                      target.resolve_depth};
+      glDeleteRenderbuffers(4, renderbuffers);
+    }
+    for (auto& [key, target] : segmentation_targets) {
+      glDeleteFramebuffers(1, &target.framebuffer);
+      const GLuint renderbuffers[] = {target.ids, target.depth};
+      glDeleteRenderbuffers(2, renderbuffers);
+    }
+    for (auto& [path, texture] : textures) glDeleteTextures(1, &texture);
+    glDeleteTextures(1, &white_texture);
+    if (shadow_framebuffer != 0) glDeleteFramebuffers(1, &shadow_framebuffer);
+    if (shadow_texture != 0) glDeleteTextures(1, &shadow_texture);
+    glDeleteVertexArrays(1, &empty_vao);
+    for (GLuint program : {lit, sky, depth_only, segmentation}) glDeleteProgram(program);
+  }
+
+  const GpuMesh& upload(const std::shared_ptr<const MeshData>& mesh) {
+    auto found = meshes.find(mesh.get());
+    if (found != meshes.end()) return found->second;
+    GpuMesh gpu;
+    gpu.keep_alive = mesh;
+    std::vector<float> interleaved;
+    interleaved.reserve(mesh->positions.size() * 8);
+    for (std::size_t i = 0; i < mesh->positions.size(); ++i) {
+      const Eigen::Vector3f& p = mesh->positions[i];
+      const Eigen::Vector3f n =
+          i < mesh->normals.size() ? mesh->normals[i] : Eigen::Vector3f::UnitZ();
+      const Eigen::Vector2f t =
+          i < mesh->texcoords.size() ? mesh->texcoords[i] : Eigen::Vector2f::Zero();
+      interleaved.insert(interleaved.end(),
+                         {p.x(), p.y(), p.z(), n.x(), n.y(), n.z(), t.x(), t.y()});
+      gpu.radius = std::max(gpu.radius, p.norm());
+    }
+    glGenVertexArrays(1, &gpu.vao);
+    glBindVertexArray(gpu.vao);
+    glGenBuffers(1, &gpu.vertices);
+    glBindBuffer(GL_ARRAY_BUFFER, gpu.vertices);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(interleaved.size() * sizeof(float)),
+                 interleaved.data(), GL_STATIC_DRAW);
+    glGenBuffers(1, &gpu.indices);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, gpu.indices);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER,
+                 static_cast<GLsizeiptr>(mesh->indices.size() * sizeof(std::uint32_t)),
+                 mesh->indices.data(), GL_STATIC_DRAW);
+    constexpr GLsizei kStride = 8 * sizeof(float);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, kStride, reinterpret_cast<void*>(0));
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, kStride,
+                          reinterpret_cast<void*>(3 * sizeof(float)));
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, kStride,
+                          reinterpret_cast<void*>(6 * sizeof(float)));
+    glEnableVertexAttribArray(2);
+    glBindVertexArray(0);
+    gpu.parts = mesh->parts;
+    if (gpu.parts.empty()) {
+      MeshData::Part all;
+      all.index_count = static_cast<std::uint32_t>(mesh->indices.size());
+      gpu.parts.push_back(all);
+    }
+    return meshes.emplace(mesh.get(), std::move(gpu)).first->second;
+  }
+
+  GLuint texture(const std::string& path) {
+    auto found = textures.find(path);
+    if (found != textures.end()) return found->second;
+    Image image;
+    try {
+      image = read_png(path);
+    } catch (const std::runtime_error& error) {
+      throw std::runtime_error(std::string("Renderer: texture cannot be used: ") + error.what());
+    }
+    std::vector<std::uint8_t> rgba(static_cast<std::size_t>(image.width) *
+                                   static_cast<std::size_t>(image.height) * 4);
+    for (std::size_t p = 0; p < rgba.size() / 4; ++p) {
+      const std::uint8_t* source =
+          image.pixels.data() + p * static_cast<std::size_t>(image.channels);
+      for (std::size_t c = 0; c < 3; ++c)
+        rgba[p * 4 + c] = image.channels >= 3 ? source[c] : source[0];
+      rgba[p * 4 + 3] = image.channels == 4 ? source[3] : 255;
+    }
+    GLuint handle = 0;
+    glGenTextures(1, &handle);
+    glBindTexture(GL_TEXTURE_2D, handle);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, image.width, image.height, 0, GL_RGBA,
+                 GL_UNSIGNED_BYTE, rgba.data());
+    glGenerateMipmap(GL_TEXTURE_2D);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+    textures.emplace(path, handle);
+    return handle;
+  }
+
+  Target& target(const Camera& camera) {
+    const auto key = std::make_tuple(camera.width, camera.height, camera.msaa_samples);
+    auto found = targets.find(key);
+    if (found != targets.end()) return found->second;
+    Target t;
+    glGenFramebuffers(1, &t.framebuffer);
+    glBindFramebuffer(GL_FRAMEBUFFER, t.framebuffer);
+    t.color = make_renderbuffer(GL_RGBA8, camera.width, camera.height, camera.msaa_samples);
+    t.depth =
+        make_renderbuffer(GL_DEPTH_COMPONENT24, camera.width, camera.height, camera.msaa_samples);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, t.color);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t.depth);
+    check_framebuffer("colour");
+    if (camera.msaa_samples > 0) {
+      glGenFramebuffers(1, &t.resolve_framebuffer);
+      glBindFramebuffer(GL_FRAMEBUFFER, t.resolve_framebuffer);
+      t.resolve_color = make_renderbuffer(GL_RGBA8, camera.width, camera.height, 0);
+      t.resolve_depth = make_renderbuffer(GL_DEPTH_COMPONENT24, camera.width, camera.height, 0);
+      glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
+                                t.resolve_color);
+      glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
+                                t.resolve_depth);
+      check_framebuffer("resolve");
+    }
+    return targets.emplace(key, t).first->second;
+  }
+
+  SegmentationTarget& segmentation_target(const Camera& camera) {
+    const auto key = std::make_pair(camera.width, camera.height);
+    auto found = segmentation_targets.find(key);
+    if (found != segmentation_targets.end()) return found->second;
+    SegmentationTarget t;
+    glGenFramebuffers(1, &t.framebuffer);
+    glBindFramebuffer(GL_FRAMEBUFFER, t.framebuffer);
+    t.ids = make_renderbuffer(GL_R32I, camera.width, camera.height, 0);
+    t.depth = make_renderbuffer(GL_DEPTH_COMPONENT24, camera.width, camera.height, 0);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, t.ids);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t.depth);
+    check_framebuffer("segmentation");
+    return segmentation_targets.emplace(key, t).first->second;
+  }
+
+  void ensure_shadow_map(int size) {
+    if (shadow_size == size) return;
+    if (shadow_framebuffer == 0) {
+      glGenFramebuffers(1, &shadow_framebuffer);
+      glGenTextures(1, &shadow_texture);
+    }
+    glBindTexture(GL_TEXTURE_2D, shadow_texture);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, size, size, 0, GL_DEPTH_COMPONENT,
+                 GL_FLOAT, nullptr);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    glBindFramebuffer(GL_FRAMEBUFFER, shadow_framebuffer);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, shadow_texture, 0);
+    glDrawBuffer(GL_NONE);
+    glReadBuffer(GL_NONE);
+    check_framebuffer("shadow");
+    shadow_size = size;
+  }
+
+  // Renders the casters' depth from the light; returns the matrix from world to shadow-map clip.
+  Eigen::Matrix4f shadow_pass(const Scene& scene, const std::vector<const GpuMesh*>& gpu,
+                              int size) {
+    // A sphere around every shadow caster bounds what the light must see.
+    Eigen::Vector3f low = Eigen::Vector3f::Constant(1e30F);
+    Eigen::Vector3f high = Eigen::Vector3f::Constant(-1e30F);
+    for (std::size_t i = 0; i < scene.instances.size(); ++i) {
+      const Instance& instance = scene.instances[i];
+      if (!instance.casts_shadow) continue;
+      const float r = gpu[i]->radius * instance.scale.cwiseAbs().maxCoeff();
+      low = low.cwiseMin(instance.X_world_instance.translation() - Eigen::Vector3f::Constant(r));
+      high = high.cwiseMax(instance.X_world_instance.translation() + Eigen::Vector3f::Constant(r));
+    }
+    if (low.x() > high.x()) return Eigen::Matrix4f::Zero();  // nothing casts
+    const Eigen::Vector3f centre = 0.5F * (low + high);
+    const float radius = std::max(0.5F * (high - low).norm(), 1e-3F);
+    const Eigen::Vector3f direction = scene.light.direction.normalized();
+    const Eigen::Matrix4f light = orthographic(radius, 0.0F, 4.0F * radius) *
+                                  look_from(centre - 2.0F * radius * direction, direction);
+
+    ensure_shadow_map(size);
+    glBindFramebuffer(GL_FRAMEBUFFER, shadow_framebuffer);
+    glViewport(0, 0, size, size);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glUseProgram(depth_only);
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(2.0F, 4.0F);  // slope-scaled bias against shadow acne
+    const GLint mvp = glGetUniformLocation(depth_only, "model_view_projection");
+    for (std::size_t i = 0; i < scene.instances.size(); ++i) {
+      if (!scene.instances[i].casts_shadow) continue;
+      const Eigen::Matrix4f m = light * model_matrix(scene.instances[i]);
+      glUniformMatrix4fv(mvp, 1, GL_FALSE, m.data());
+      draw_all(*gpu[i]);
+    }
+    glDisable(GL_POLYGON_OFFSET_FILL);
+    // Clip [-1, 1] to texture [0, 1] happens in the shader.
+    return light;
+  }
+
+  static void draw_all(const GpuMesh& mesh) {
+    glBindVertexArray(mesh.vao);
+    for (const MeshData::Part& part : mesh.parts) {
+      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(part.index_count), GL_UNSIGNED_INT,
+                     reinterpret_cast<void*>(static_cast<std::uintptr_t>(part.first_index) *
+                                             sizeof(std::uint32_t)));
+    }
+  }
+
+  void render(const Scene& scene, const Camera& camera, const RenderTargets& out) {
+    camera.validate();
+    context.make_current();
+    std::vector<const GpuMesh*> gpu(scene.instances.size());
+    for (std::size_t i = 0; i < scene.instances.size(); ++i) {
+      if (scene.instances[i].mesh == nullptr) {
+        throw std::invalid_argument("Renderer: instance " + std::to_string(i) + " has no mesh");
+      }
+      gpu[i] = &upload(scene.instances[i].mesh);
+    }
+    const GpuMesh& floor_mesh = upload(floor);
+    const Eigen::Matrix4f view_projection = camera.projection_matrix() * camera.view_matrix();
+
+    // Every pass below depth-tests (without it GL writes no depth, and the first frame's shadow
+    // map would stay empty).
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    const bool shadows = scene.shadows;
+    Eigen::Matrix4f light_matrix = Eigen::Matrix4f::Zero();
+    const int map_size = shadow_map_size(camera);
+    if (shadows) light_matrix = shadow_pass(scene, gpu, map_size);
+
+    Target& t = target(camera);
+    glBindFramebuffer(GL_FRAMEBUFFER, t.framebuffer);
+    glViewport(0, 0, camera.width, camera.height);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+
+    // The sky, behind everything: neither tested against nor written to the depth buffer.
+    glDisable(GL_DEPTH_TEST);
+    glDepthMask(GL_FALSE);
+    glUseProgram(sky);
+    const Eigen::Matrix4f inverse = view_projection.inverse();
+    glUniformMatrix4fv(glGetUniformLocation(sky, "inverse_view_projection"), 1, GL_FALSE,
+                       inverse.data());
+    glUniform3fv(glGetUniformLocation(sky, "horizon"), 1, scene.sky.horizon.data());
+    glUniform3fv(glGetUniformLocation(sky, "zenith"), 1, scene.sky.zenith.data());
+    glBindVertexArray(empty_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glDepthMask(GL_TRUE);
+    glEnable(GL_DEPTH_TEST);
+
+    glUseProgram(lit);
+    const Eigen::Vector3f to_light = -scene.light.direction.normalized();
+    const Eigen::Vector3f eye = camera.X_world_camera.translation();
+    glUniformMatrix4fv(u.view_projection, 1, GL_FALSE, view_projection.data());
+    // Shadow-map clip coordinates; the shader maps them to texture space.
+    glUniformMatrix4fv(u.light_matrix, 1, GL_FALSE, light_matrix.data());
+    glUniform3fv(u.to_light, 1, to_light.data());
+    glUniform3fv(u.light_color, 1, scene.light.color.data());
+    glUniform3fv(u.ambient, 1, scene.light.ambient.data());
+    glUniform3fv(u.camera_position, 1, eye.data());
+    glUniform1i(u.use_shadows, shadows && light_matrix(3, 3) != 0.0F ? 1 : 0);
+    glUniform1i(u.albedo, 0);
+    glUniform1i(u.shadow_map, 1);
+    glUniform1f(u.shadow_texel, 1.0F / static_cast<float>(map_size));
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, shadows ? shadow_texture : 0);
+    glActiveTexture(GL_TEXTURE0);
+
+    if (scene.floor.enabled) {
+      Eigen::Matrix4f model = Eigen::Matrix4f::Identity();
+      model(2, 3) = scene.floor.height_m;
+      const Eigen::Matrix3f normal_matrix = Eigen::Matrix3f::Identity();
+      glUniformMatrix4fv(u.model, 1, GL_FALSE, model.data());
+      glUniformMatrix3fv(u.normal_matrix, 1, GL_FALSE, normal_matrix.data());
+      glUniform1i(u.checker, 1);
+      glUniform1f(u.tile, scene.floor.tile_m);
+      glUniform3fv(u.color_a, 1, scene.floor.color_a.data());
+      glUniform3fv(u.color_b, 1, scene.floor.color_b.data());
+      glUniform1f(u.specular, 0.0F);
+      glUniform1f(u.shininess, 1.0F);
+      glUniform1i(u.use_texture, 0);
+      glBindTexture(GL_TEXTURE_2D, white_texture);
+      // Pushed back a little so that shapes resting on the floor never fight it for depth.
+      glEnable(GL_POLYGON_OFFSET_FILL);
+      glPolygonOffset(1.0F, 1.0F);
+      draw_all(floor_mesh);
+      glDisable(GL_POLYGON_OFFSET_FILL);
+      glUniform1i(u.checker, 0);
+    }
+
+    for (std::size_t i = 0; i < scene.instances.size(); ++i) {
+      const Instance& instance = scene.instances[i];
+      const Eigen::Matrix4f model = model_matrix(instance);
+      const Eigen::Matrix3f normal_matrix = model.block<3, 3>(0, 0).inverse().transpose();
+      glUniformMatrix4fv(u.model, 1, GL_FALSE, model.data());
+      glUniformMatrix3fv(u.normal_matrix, 1, GL_FALSE, normal_matrix.data());
+      glUniform1f(u.specular, instance.material.specular);
+      glUniform1f(u.shininess, instance.material.shininess);
+      const bool textured = !instance.material.texture_path.empty();
+      glUniform1i(u.use_texture, textured ? 1 : 0);
+      glBindTexture(GL_TEXTURE_2D,
+                    textured ? texture(instance.material.texture_path) : white_texture);
+      glBindVertexArray(gpu[i]->vao);
+      for (const MeshData::Part& part : gpu[i]->parts) {
+        const Eigen::Vector4f& color = part.has_color ? part.rgba : instance.material.base_color;
+        glUniform4fv(u.base_color, 1, color.data());
+        glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(part.index_count), GL_UNSIGNED_INT,
+                       reinterpret_cast<void*>(static_cast<std::uintptr_t>(part.first_index) *
+                                               sizeof(std::uint32_t)));
+      }
+    }
+
+    GLuint read_from = t.framebuffer;
+    if (camera.msaa_samples > 0) {
+      glBindFramebuffer(GL_READ_FRAMEBUFFER, t.framebuffer);
+      glBindFramebuffer(GL_DRAW_FRAMEBUFFER, t.resolve_framebuffer);
+      glBlitFramebuffer(0, 0, camera.width, camera.height, 0, 0, camera.width, camera.height,
+                        GL_COLOR_BUFFER_BIT, GL_LINEAR);
+      glBlitFramebuffer(0, 0, camera.width, camera.height, 0, 0, camera.width, camera.height,
+                        GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+      read_from = t.resolve_framebuffer;
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, read_from);
+    if (out.rgb != nullptr)
+      glReadPixels(0, 0, camera.width, camera.height, GL_RGB, GL_UNSIGNED_BYTE, out.rgb);
+    if (out.depth != nullptr) {
+      glReadPixels(0, 0, camera.width, camera.height, GL_DEPTH_COMPONENT, GL_FLOAT, out.depth);
+      const float n = camera.near_m;
+      const float f = camera.far_m;
+      const std::size_t count =
+          static_cast<std::size_t>(camera.width) * static_cast<std::size_t>(camera.height);
+      for (std::size_t p = 0; p < count; ++p) {
+        const float ndc = 2.0F * out.depth[p] - 1.0F;
+        out.depth[p] = out.depth[p] >= 1.0F ? f : 2.0F * n * f / ((f + n) - ndc * (f - n));
+      }
+    }
+    if (out.segmentation != nullptr)
+      render_segmentation(scene, camera, view_projection, gpu, floor_mesh, out.segmentation);
+  }
+
+  void render_segmentation(const Scene& scene, const Camera& camera,
+                           const Eigen::Matrix4f& view_projection,
+                           const std::vector<const GpuMesh*>& gpu, const GpuMesh& floor_mesh,
+                           std::int32_t* out) {
+    SegmentationTarget& t = segmentation_target(camera);
+    glBindFramebuffer(GL_FRAMEBUFFER, t.framebuffer);
+    glViewport(0, 0, camera.width, camera.height);
+    const GLint background[4] = {0, 0, 0, 0};
+    glClearBufferiv(GL_COLOR, 0, background);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glUseProgram(segmentation);
+    const GLint mvp = glGetUniformLocation(segmentation, "model_view_projection");
+    const GLint id = glGetUniformLocation(segmentation, "segmentation_id");
+    if (scene.floor.enabled) {
+      Eigen::Matrix4f model = Eigen::Matrix4f::Identity();
+      model(2, 3) = scene.floor.height_m;
+      const Eigen::Matrix4f m = view_projection * model;
+      glUniformMatrix4fv(mvp, 1, GL_FALSE, m.data());
+      glUniform1i(id, -1);
+      glEnable(GL_POLYGON_OFFSET_FILL);
+      glPolygonOffset(1.0F, 1.0F);
+      draw_all(floor_mesh);
+      glDisable(GL_POLYGON_OFFSET_FILL);
+    }
+    for (std::size_t i = 0; i < scene.instances.size(); ++i) {
+      const Eigen::Matrix4f m = view_projection * model_matrix(scene.instances[i]);
+      glUniformMatrix4fv(mvp, 1, GL_FALSE, m.data());
+      glUniform1i(id, scene.instances[i].segmentation_id);
+      draw_all(*gpu[i]);
+    }
+    glReadPixels(0, 0, camera.width, camera.height, GL_RED_INTEGER, GL_INT, out);
+  }
+
+  Context context;
+  GLuint lit = 0;
+  GLuint sky = 0;
+  GLuint depth_only = 0;
+  GLuint segmentation = 0;
+  LitUniforms u{};
+  GLuint empty_vao = 0;
+  GLuint white_texture = 0;
+  std::shared_ptr<const MeshData> floor;
+  std::unordered_map<const MeshData*, GpuMesh> meshes;
+  std::map<std::string, GLuint> textures;
+  std::map<std::tuple<int, int, int>, Target> targets;
+  std::map<std::pair<int, int>, SegmentationTarget> segmentation_targets;
+  GLuint shadow_framebuffer = 0;
+  GLuint shadow_texture = 0;
+  int shadow_size = 0;
+};
+
+Renderer::Renderer(GlBackend backend) : impl_(std::make_unique<Impl>(backend)) {}
+
+Renderer::~Renderer() = default;
+
+void Renderer::render(const Scene& scene, const Camera& camera, const RenderTargets& targets) {
+  impl_->render(scene, camera, targets);
+}
+
+std::string Renderer::description() { return impl_->context.description(); }
+
+}  // namespace pixelgym

@@ -1,0 +1,70 @@
+// Scene: what to draw — plain data, no OpenGL (the renderer turns it into pixels).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "render/mesh_data.h"
+
+namespace pixelgym {
+
+/// How a surface looks. Colours are linear RGB in [0, 1].
+struct RenderMaterial {
+  Eigen::Vector4f base_color{0.7F, 0.7F, 0.7F, 1.0F};
+  /// Strength of the white highlight, 0 (matte) to 1.
+  float specular = 0.3F;
+  float shininess = 32.0F;
+  /// A PNG multiplied into the base colour through the mesh's texture coordinates; empty for none.
+  std::string texture_path;
+};
+
+/// One drawn copy of a mesh.
+struct Instance {
+  std::shared_ptr<const MeshData> mesh;
+  /// Applied before the pose: primitives are unit-sized and scaled here.
+  Eigen::Vector3f scale{1.0F, 1.0F, 1.0F};
+  Eigen::Isometry3f X_world_instance = Eigen::Isometry3f::Identity();
+  RenderMaterial material;
+  /// Written to segmentation images; 0 is the background.
+  int segmentation_id = 0;
+  /// False for things that should not darken others (markers).
+  bool casts_shadow = true;
+};
+
+/// A directional light with an ambient term.
+struct Light {
+  /// Direction the light travels (from the light towards the scene), in world coordinates.
+  Eigen::Vector3f direction{-0.4F, 0.3F, -1.0F};
+  Eigen::Vector3f color{0.75F, 0.75F, 0.72F};
+  Eigen::Vector3f ambient{0.35F, 0.35F, 0.38F};
+};
+
+/// The ground: an infinite checkerboard in the plane z = height.
+struct Floor {
+  bool enabled = true;
+  float height_m = 0.0F;
+  float tile_m = 0.25F;
+  Eigen::Vector3f color_a{0.32F, 0.36F, 0.42F};
+  Eigen::Vector3f color_b{0.42F, 0.46F, 0.52F};
+};
+
+/// The background: a vertical gradient from the horizon colour to the zenith colour.
+struct Sky {
+  Eigen::Vector3f horizon{0.78F, 0.84F, 0.92F};
+  Eigen::Vector3f zenith{0.38F, 0.55F, 0.78F};
+};
+
+/// Everything a frame shows.
+struct Scene {
+  std::vector<Instance> instances;
+  Light light;
+  Floor floor;
+  Sky sky;
+  /// Shadows of instances from the light onto everything (the floor included).
+  bool shadows = true;
+};
+
+}  // namespace pixelgym
