@@ -296,6 +296,7 @@ struct Renderer::Impl {
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     glFrontFace(GL_CW);  // the flipped projection mirrors the winding
+    glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
   }
 
   ~Impl() {
@@ -520,6 +521,11 @@ struct Renderer::Impl {
   void render(const Scene& scene, const Camera& camera, const RenderTargets& out) {
     camera.validate();
     context.make_current();
+    if (camera.msaa_samples > max_samples) {
+      throw std::invalid_argument("Renderer: msaa_samples " + std::to_string(camera.msaa_samples) +
+                                  " is more than this OpenGL offers: at most " +
+                                  std::to_string(max_samples) + " (" + context.description() + ")");
+    }
     std::vector<const GpuMesh*> gpu(scene.instances.size());
     for (std::size_t i = 0; i < scene.instances.size(); ++i) {
       if (scene.instances[i].mesh == nullptr) {
@@ -700,6 +706,7 @@ struct Renderer::Impl {
   GLuint shadow_framebuffer = 0;
   GLuint shadow_texture = 0;
   int shadow_size = 0;
+  GLint max_samples = 0;
 };
 
 Renderer::Renderer(GlBackend backend) : impl_(std::make_unique<Impl>(backend)) {}

@@ -1,0 +1,294 @@
+#include "render/renderer.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <array>
+#include <thread>
+
+namespace pixelgym {
+namespace {
+
+using ::testing::HasSubstr;
+
+constexpr int kSize = 64;
+
+struct Pixel {
+  int r, g, b;
+};
+
+Pixel at(const std::vector<std::uint8_t>& rgb, int width, int row, int col) {
+  const std::size_t i = (static_cast<std::size_t>(row) * static_cast<std::size_t>(width) + static_cast<std::size_t>(col)) * 3;
+  return {rgb[i], rgb[i + 1], rgb[i + 2]};
+}
+
+void expect_pixel(const Pixel& actual, int r, int g, int b, const std::string& where) {
+  EXPECT_NEAR(actual.r, r, 1) << where;
+  EXPECT_NEAR(actual.g, g, 1) << where;
+  EXPECT_NEAR(actual.b, b, 1) << where;
+}
+
+// Lighting that shows base colours as they are: full ambient, no direct light, no highlights.
+Scene flat_scene() {
+  Scene scene;
+  scene.light.color.setZero();
+  scene.light.ambient.setOnes();
+  scene.shadows = false;
+  scene.floor.enabled = false;
+  scene.sky.horizon = scene.sky.zenith = Eigen::Vector3f(0.2F, 0.4F, 0.6F);
+  return scene;
+}
+
+Instance box(const Eigen::Vector3f& centre, const Eigen::Vector3f& size, const Eigen::Vector4f& color, int id = 0) {
+  Instance instance;
+  instance.mesh = make_box_mesh();
+  instance.scale = size;
+  instance.X_world_instance.translation() = centre;
+  instance.material.base_color = color;
+  instance.material.specular = 0.0F;
+  instance.segmentation_id = id;
+  return instance;
+}
+
+Camera front_camera(int size = kSize) {
+  Camera camera = Camera::look_at({0, -3, 0.5F}, {0, 0, 0.5F});
+  camera.width = size;
+  camera.height = size;
+  return camera;
+}
+
+TEST(RendererTest, KnownColourBoxAtTheCentreAndBackgroundAtTheCorners) {
+  Renderer renderer;
+  Scene scene = flat_scene();
+  scene.instances.push_back(box({0, 0, 0.5F}, {0.5F, 0.5F, 0.5F}, {0.8F, 0.25F, 0.5F, 1.0F}));
+  std::vector<std::uint8_t> rgb(kSize * kSize * 3);
+  renderer.render(scene, front_camera(), {rgb.data()});
+  expect_pixel(at(rgb, kSize, kSize / 2, kSize / 2), 204, 64, 128, "centre");
+  for (const auto& [row, col] : std::vector<std::pair<int, int>>{{0, 0}, {0, kSize - 1}, {kSize - 1, 0}, {kSize - 1, kSize - 1}}) {
+    expect_pixel(at(rgb, kSize, row, col), 51, 102, 153, "corner");
+  }
+}
+
+TEST(RendererTest, RowZeroIsTheTopOfTheImage) {
+  Renderer renderer;
+  Scene scene = flat_scene();
+  scene.instances.push_back(box({0, 0, 1.2F}, {0.4F, 0.4F, 0.4F}, {1, 0, 0, 1}));   // high: red
+  scene.instances.push_back(box({0, 0, -0.2F}, {0.4F, 0.4F, 0.4F}, {0, 1, 0, 1}));  // low: green
+  std::vector<std::uint8_t> rgb(kSize * kSize * 3);
+  renderer.render(scene, front_camera(), {rgb.data()});
+  bool red_above_green = false;
+  for (int row = 0; row < kSize / 2; ++row) {
+    if (at(rgb, kSize, row, kSize / 2).r > 200) red_above_green = true;
+  }
+  EXPECT_TRUE(red_above_green) << "the high box is not in the top half";
+  expect_pixel(at(rgb, kSize, kSize * 3 / 4, kSize / 2), 0, 255, 0, "low box in the bottom half");
+}
+
+TEST(RendererTest, DepthOfAPlaneAtAKnownDistanceWithinOneMillimetre) {
+  Renderer renderer;
+  Scene scene = flat_scene();
+  // A wall whose front face is 2 m in front of the camera, square to its view.
+  scene.instances.push_back(box({0, 4.0F, 0.5F}, {20, 10, 20}, {1, 1, 1, 1}));  // face at y = -1
+  std::vector<float> depth(kSize * kSize);
+  Camera camera = front_camera();
+  renderer.render(scene, camera, {nullptr, depth.data()});
+  for (int p = 0; p < kSize * kSize; ++p) ASSERT_NEAR(depth[static_cast<std::size_t>(p)], 2.0F, 1e-3F) << p;
+  // Where nothing is drawn, depth is the far plane.
+  Scene empty = flat_scene();
+  renderer.render(empty, camera, {nullptr, depth.data()});
+  EXPECT_EQ(depth[0], camera.far_m);
+}
+
+TEST(RendererTest, SegmentationIdsAreExact) {
+  Renderer renderer;
+  Scene scene = flat_scene();
+  scene.floor.enabled = true;
+  scene.instances.push_back(box({-0.5F, 0, 0.5F}, {0.4F, 0.4F, 0.4F}, {1, 0, 0, 1}, 5));
+  scene.instances.push_back(box({0.5F, 0, 0.5F}, {0.4F, 0.4F, 0.4F}, {0, 0, 1, 1}, 9));
+  std::vector<std::int32_t> ids(kSize * kSize);
+  std::vector<std::uint8_t> rgb(kSize * kSize * 3);
+  renderer.render(scene, front_camera(), {rgb.data(), nullptr, ids.data()});
+  const auto id_at = [&](int row, int col) { return ids[static_cast<std::size_t>(row * kSize + col)]; };
+  EXPECT_EQ(id_at(kSize / 2, kSize / 2 - 11), 5);
+  EXPECT_EQ(id_at(kSize / 2, kSize / 2 + 11), 9);
+  EXPECT_EQ(id_at(0, 0), 0);            // sky
+  EXPECT_EQ(id_at(kSize - 1, 0), -1);  // floor
+  for (std::int32_t id : ids) ASSERT_TRUE(id == 0 || id == -1 || id == 5 || id == 9) << id;
+  // Every red pixel is id 5, every blue one id 9.
+  for (int p = 0; p < kSize * kSize; ++p) {
+    const Pixel px{rgb[static_cast<std::size_t>(p) * 3], rgb[static_cast<std::size_t>(p) * 3 + 1], rgb[static_cast<std::size_t>(p) * 3 + 2]};
+    if (px.r > 250 && px.g < 5 && px.b < 5) {
+      ASSERT_EQ(ids[static_cast<std::size_t>(p)], 5);
+    }
+    if (px.b > 250 && px.r < 5 && px.g < 5) {
+      ASSERT_EQ(ids[static_cast<std::size_t>(p)], 9);
+    }
+  }
+}
+
+TEST(RendererTest, ShadowsDarkenTheFloorUnderAnObject) {
+  Renderer renderer;
+  Scene scene;
+  scene.light.direction = {0, 0, -1};  // straight down
+  scene.instances.push_back(box({0, 0, 0.6F}, {0.5F, 0.5F, 0.1F}, {0.8F, 0.8F, 0.8F, 1}));
+  Camera camera = Camera::look_at({0.01F, -2.5F, 2.5F}, {0, 0, 0});
+  camera.width = camera.height = kSize;
+  std::vector<std::uint8_t> with(kSize * kSize * 3);
+  std::vector<std::uint8_t> without(kSize * kSize * 3);
+  renderer.render(scene, camera, {with.data()});
+  scene.shadows = false;
+  renderer.render(scene, camera, {without.data()});
+  // The floor at the origin is below the slab; it is hidden from the camera by nothing but the
+  // slab's shadow. Find a floor pixel that changed and one that did not.
+  int darker = 0;
+  int unchanged = 0;
+  for (std::size_t i = 0; i < with.size(); i += 3) {
+    const int delta = int{without[i]} - int{with[i]};
+    if (delta > 20) ++darker;
+    if (delta == 0) ++unchanged;
+  }
+  EXPECT_GT(darker, 50) << "no shadow on the floor";
+  EXPECT_GT(unchanged, kSize * kSize / 2) << "shadows darkened more than the shadow";
+}
+
+TEST(RendererTest, TexturesModulateTheBaseColour) {
+  Renderer renderer;
+  Scene scene = flat_scene();
+  Instance textured = box({0, 0, 0.5F}, {1.5F, 0.1F, 1.5F}, {1, 1, 1, 1});
+  textured.material.texture_path = std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/urdf_good/checker.png";
+  scene.instances.push_back(textured);
+  std::vector<std::uint8_t> rgb(kSize * kSize * 3);
+  renderer.render(scene, front_camera(), {rgb.data()});
+  // The 8x8 texture's two grays (60 and 200) both appear on the face (texel centres are exact;
+  // linear filtering blends between them).
+  bool dark = false;
+  bool light = false;
+  for (std::size_t i = 0; i < rgb.size(); i += 3) {
+    dark = dark || std::abs(int{rgb[i]} - 60) <= 1;
+    light = light || std::abs(int{rgb[i]} - 200) <= 1;
+  }
+  EXPECT_TRUE(dark && light);
+  scene.instances[0].material.texture_path = "/nonexistent/texture.png";
+  try {
+    renderer.render(scene, front_camera(), {rgb.data()});
+    FAIL() << "no error";
+  } catch (const std::runtime_error& error) {
+    EXPECT_THAT(error.what(), HasSubstr("/nonexistent/texture.png"));
+  }
+}
+
+Scene busy_scene(float offset) {
+  Scene scene;
+  scene.instances.push_back(box({offset, 0, 0.3F}, {0.4F, 0.4F, 0.6F}, {0.8F, 0.3F, 0.2F, 1}, 1));
+  Instance ball;
+  ball.mesh = make_sphere_mesh();
+  ball.scale = Eigen::Vector3f::Constant(0.25F);
+  ball.X_world_instance.translation() = Eigen::Vector3f(0.6F - offset, 0.4F, 0.25F);
+  ball.material.base_color = {0.2F, 0.5F, 0.9F, 1};
+  scene.instances.push_back(ball);
+  return scene;
+}
+
+TEST(RendererTest, SameSceneTwiceGivesIdenticalBytes) {
+  Renderer renderer;
+  const Scene scene = busy_scene(0.0F);
+  Camera camera = front_camera(96);
+  std::vector<std::uint8_t> a(96 * 96 * 3);
+  std::vector<std::uint8_t> b(96 * 96 * 3);
+  renderer.render(scene, camera, {a.data()});
+  renderer.render(busy_scene(0.3F), camera, {b.data()});  // something else in between
+  renderer.render(scene, camera, {b.data()});
+  EXPECT_EQ(a, b);
+  Renderer other;  // a fresh renderer's first frame matches too
+  other.render(scene, camera, {b.data()});
+  EXPECT_EQ(a, b);
+}
+
+TEST(RendererTest, TwoThreadsGiveTheBytesOfOneThread) {
+  const Scene first = busy_scene(0.0F);
+  const Scene second = busy_scene(0.4F);
+  Camera camera = front_camera(84);
+  const std::size_t bytes = 84 * 84 * 3;
+  std::vector<std::uint8_t> seq_first(bytes), seq_second(bytes), par_first(bytes), par_second(bytes);
+  {
+    Renderer renderer;
+    renderer.render(first, camera, {seq_first.data()});
+    renderer.render(second, camera, {seq_second.data()});
+  }
+  const auto draw = [&camera](const Scene& scene, std::vector<std::uint8_t>& out) {
+    Renderer renderer;
+    for (int i = 0; i < 20; ++i) renderer.render(scene, camera, {out.data()});
+  };
+  std::thread a(draw, std::cref(first), std::ref(par_first));
+  std::thread b(draw, std::cref(second), std::ref(par_second));
+  a.join();
+  b.join();
+  EXPECT_EQ(par_first, seq_first);
+  EXPECT_EQ(par_second, seq_second);
+  EXPECT_NE(seq_first, seq_second);
+}
+
+TEST(RendererTest, MultisamplingSmoothsEdgesOnly) {
+  Renderer renderer;
+  Scene scene = flat_scene();
+  Instance ball;
+  ball.mesh = make_sphere_mesh();
+  ball.scale = Eigen::Vector3f::Constant(0.4F);
+  ball.X_world_instance.translation() = Eigen::Vector3f(0, 0, 0.5F);
+  ball.material.base_color = {0.8F, 0.25F, 0.5F, 1.0F};
+  ball.material.specular = 0.0F;
+  scene.instances.push_back(ball);
+  Camera camera = front_camera();
+  std::vector<std::uint8_t> plain(kSize * kSize * 3);
+  std::vector<std::uint8_t> smooth(kSize * kSize * 3);
+  renderer.render(scene, camera, {plain.data()});
+  camera.msaa_samples = 4;
+  renderer.render(scene, camera, {smooth.data()});
+  expect_pixel(at(smooth, kSize, kSize / 2, kSize / 2), 204, 64, 128, "centre with MSAA");
+  // Without MSAA every pixel is the ball's or the sky's colour; with it the rim blends the two.
+  const auto blended = [](const std::vector<std::uint8_t>& rgb) {
+    int count = 0;
+    for (std::size_t i = 0; i < rgb.size(); i += 3) {
+      if (std::abs(int{rgb[i]} - 204) > 1 && std::abs(int{rgb[i]} - 51) > 1) ++count;
+    }
+    return count;
+  };
+  EXPECT_EQ(blended(plain), 0);
+  EXPECT_GT(blended(smooth), 20);
+  camera.msaa_samples = 8;  // llvmpipe offers at most 4
+  int max_samples = 0;
+  try {
+    renderer.render(scene, camera, {smooth.data()});
+    max_samples = 8;
+  } catch (const std::invalid_argument& error) {
+    EXPECT_THAT(error.what(), HasSubstr("at most"));
+  }
+  EXPECT_TRUE(max_samples == 0 || max_samples == 8);
+}
+
+TEST(RendererTest, BadInputIsRejected) {
+  Renderer renderer;
+  Scene scene = flat_scene();
+  std::vector<std::uint8_t> rgb(kSize * kSize * 3);
+  Camera camera = front_camera();
+  camera.width = 0;
+  EXPECT_THROW(renderer.render(scene, camera, {rgb.data()}), std::invalid_argument);
+  camera = front_camera();
+  camera.far_m = camera.near_m;
+  EXPECT_THROW(renderer.render(scene, camera, {rgb.data()}), std::invalid_argument);
+  scene.instances.push_back(Instance{});
+  try {
+    renderer.render(scene, front_camera(), {rgb.data()});
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_THAT(error.what(), HasSubstr("instance 0 has no mesh"));
+  }
+}
+
+TEST(RendererTest, DescribesItsBackend) {
+  Renderer renderer;
+  EXPECT_THAT(renderer.description(), HasSubstr("Core Profile"));
+}
+
+}  // namespace
+}  // namespace pixelgym
