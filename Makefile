@@ -7,7 +7,7 @@ BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 PIXELGYM := $(BUILD_DIR)/examples/pixelgym
 
-.PHONY: all deps configure build demo test bench clean
+.PHONY: all deps configure build demo test goldens bench clean
 
 all: build
 
@@ -27,6 +27,10 @@ demo: build
 
 test: build
 	ctest --test-dir $(BUILD_DIR) --output-on-failure --parallel $(JOBS)
+
+goldens: build
+	PIXELGYM_UPDATE_GOLDENS=1 ctest --test-dir $(BUILD_DIR) -R Golden --output-on-failure
+	@echo "goldens rewritten under tests/golden/: look at each PNG before committing it"
 
 bench: build
 	$(BUILD_DIR)/bench/envs_bench

@@ -1,0 +1,85 @@
+#include "envs/world_scene.h"
+
+#include <gtest/gtest.h>
+
+#include "envs/array.h"
+#include "render/renderer.h"
+#include "tests/envs/scene_fixtures.h"
+#include "tests/golden.h"
+
+namespace pixelgym {
+namespace {
+
+using testing::FixtureScene;
+
+Array draw(FixtureScene& f, Renderer& renderer) {
+  Array frame(DType::kUInt8, {f.camera.height, f.camera.width, 3});
+  renderer.render(f.view->scene(), f.camera, {frame.data<std::uint8_t>()});
+  return frame;
+}
+
+TEST(WorldSceneTest, OneInstancePerVisualShapeWithSegmentationIds) {
+  FixtureScene f = testing::arm_scene(84, 84);
+  ASSERT_EQ(f.view->scene().instances.size(), f.world->visual_shapes().size());
+  EXPECT_EQ(f.view->scene().instances.size(), 9U + 5U + 1U + 1U);  // arm, table, cube, target
+  for (std::size_t i = 0; i < f.view->scene().instances.size(); ++i) {
+    EXPECT_EQ(f.view->scene().instances[i].segmentation_id, f.world->visual_shapes()[i].segmentation_id);
+    EXPECT_GT(f.view->scene().instances[i].segmentation_id, 0);
+  }
+}
+
+TEST(WorldSceneTest, UpdateFollowsTheWorld) {
+  FixtureScene f = testing::cartpole_scene(84, 84);
+  const Eigen::Isometry3f before = f.view->scene().instances.back().X_world_instance;  // the pole
+  f.world->set_joint_state(0, (Eigen::VectorXd(2) << -0.5, 0.0).finished(), Eigen::VectorXd::Zero(2));
+  f.view->update(*f.world);
+  const Eigen::Isometry3f after = f.view->scene().instances.back().X_world_instance;
+  EXPECT_NEAR(after.translation().x() - before.translation().x(), -0.8F - 0.5F * std::sin(0.4F), 1e-4F);
+}
+
+TEST(WorldSceneTest, UrdfColoursOverrideMeshColoursOnlyWhenGiven) {
+  FixtureScene f = testing::arm_scene(84, 84);
+  // The arm's links are meshes without a URDF colour: their parts keep the .mtl colours.
+  const Instance& link1 = f.view->scene().instances[1];
+  ASSERT_FALSE(link1.mesh->parts.empty());
+  EXPECT_TRUE(link1.mesh->parts[0].has_color);
+}
+
+TEST(WorldSceneTest, FrameBoxShowsTheWholeBox) {
+  FixtureScene f = testing::arm_scene(64, 48);
+  const Eigen::AlignedBox3f box = f.view->bounds();
+  const Camera camera = frame_box(box, -50.0F, 25.0F, 64, 48);
+  const Eigen::Matrix4f vp = camera.projection_matrix() * camera.view_matrix();
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3f p = box.corner(static_cast<Eigen::AlignedBox3f::CornerType>(corner));
+    const Eigen::Vector4f clip = vp * p.homogeneous();
+    EXPECT_LE(std::abs(clip.x() / clip.w()), 1.0F) << corner;
+    EXPECT_LE(std::abs(clip.y() / clip.w()), 1.0F) << corner;
+  }
+  EXPECT_THROW(frame_box(Eigen::AlignedBox3f(), 0, 0, 64, 64), std::invalid_argument);
+}
+
+struct GoldenCase {
+  const char* name;
+  bool arm;
+  int size;
+  friend void PrintTo(const GoldenCase& c, std::ostream* out) { *out << c.name; }
+};
+
+class GoldenTest : public ::testing::TestWithParam<GoldenCase> {};
+
+TEST_P(GoldenTest, MatchesTheReferenceFrame) {
+  const GoldenCase& c = GetParam();
+  FixtureScene f = c.arm ? testing::arm_scene(c.size, c.size) : testing::cartpole_scene(c.size, c.size);
+  Renderer renderer;
+  const Array frame = draw(f, renderer);
+  EXPECT_TRUE(testing::matches_golden(c.name, frame.data<std::uint8_t>(), c.size, c.size));
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, GoldenTest,
+                         ::testing::Values(GoldenCase{"cartpole_84", false, 84}, GoldenCase{"cartpole_256", false, 256},
+                                           GoldenCase{"arm_84", true, 84}, GoldenCase{"arm_256", true, 256}),
+                         [](const ::testing::TestParamInfo<GoldenCase>& param_info) { return std::string(param_info.param.name); });
+
+}  // namespace
+}  // namespace pixelgym
