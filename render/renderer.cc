@@ -53,10 +53,6 @@ uniform vec3 ambient;
 uniform vec3 camera_position;
 uniform bool use_texture;
 uniform sampler2D albedo;
-uniform bool checker;
-uniform float tile;
-uniform vec3 color_a;
-uniform vec3 color_b;
 uniform bool use_shadows;
 uniform sampler2DShadow shadow_map;
 uniform float shadow_texel;
@@ -80,14 +76,6 @@ void main() {
   vec3 n = normalize(world_normal);
   if (!gl_FrontFacing) n = -n;
   vec3 color = base_color.rgb;
-  if (checker) {
-    // The checker averaged over the pixel's footprint (a box filter integrated in closed form),
-    // so that distant tiles blend smoothly instead of flickering into moire.
-    vec2 p = world_position.xy / tile;
-    vec2 w = fwidth(p) + 1e-4;
-    vec2 i = 2.0 * (abs(fract((p - 0.5 * w) * 0.5) - 0.5) - abs(fract((p + 0.5 * w) * 0.5) - 0.5)) / w;
-    color = mix(color_a, color_b, 0.5 - 0.5 * i.x * i.y);
-  }
   if (use_texture) color *= texture(albedo, texcoord).rgb;
   float diffuse = max(dot(n, to_light), 0.0);
   vec3 view = normalize(camera_position - world_position);
@@ -119,6 +107,60 @@ out vec4 fragment;
 void main() {
   float elevation = clamp(normalize(ray).z, 0.0, 1.0);
   fragment = vec4(mix(horizon, zenith, sqrt(elevation)), 1.0);
+}
+)";
+
+// The floor: flat, so its light (ambient + diffuse, from the CPU) is one value per frame; only the
+// filtered checker and the shadow vary per pixel.
+constexpr const char* kFloorVertex = R"(#version 330 core
+layout(location = 0) in vec3 position;
+uniform mat4 model;
+uniform mat4 view_projection;
+uniform mat4 light_matrix;
+out vec2 floor_position;
+out vec4 light_position;
+void main() {
+  vec4 world = model * vec4(position, 1.0);
+  floor_position = world.xy;
+  light_position = light_matrix * world;
+  gl_Position = view_projection * world;
+}
+)";
+
+constexpr const char* kFloorFragment = R"(#version 330 core
+in vec2 floor_position;
+in vec4 light_position;
+uniform float tile;
+uniform vec3 color_a;
+uniform vec3 color_b;
+uniform vec3 ambient;
+uniform vec3 direct;
+uniform bool use_shadows;
+uniform sampler2DShadow shadow_map;
+uniform float shadow_texel;
+out vec4 fragment;
+
+float lit_fraction() {
+  vec3 p = light_position.xyz / light_position.w * 0.5 + 0.5;
+  if (p.x <= 0.0 || p.x >= 1.0 || p.y <= 0.0 || p.y >= 1.0 || p.z >= 1.0) return 1.0;
+  float sum = 0.0;
+  for (int i = 0; i < 2; ++i) {
+    for (int j = 0; j < 2; ++j) {
+      sum += texture(shadow_map, vec3(p.xy + (vec2(i, j) - 0.5) * shadow_texel, p.z));
+    }
+  }
+  return sum * 0.25;
+}
+
+void main() {
+  // The checker averaged over the pixel's footprint (a box filter integrated in closed form),
+  // so that distant tiles blend smoothly instead of flickering into moire.
+  vec2 p = floor_position / tile;
+  vec2 w = fwidth(p) + 1e-4;
+  vec2 i = 2.0 * (abs(fract((p - 0.5 * w) * 0.5) - 0.5) - abs(fract((p + 0.5 * w) * 0.5) - 0.5)) / w;
+  vec3 color = mix(color_a, color_b, 0.5 - 0.5 * i.x * i.y);
+  float light = use_shadows ? lit_fraction() : 1.0;
+  fragment = vec4(clamp(color * (ambient + direct * light), 0.0, 1.0), 1.0);
 }
 )";
 
@@ -174,15 +216,19 @@ GLuint link(const char* vertex, const char* fragment) {
 // Uniform locations of the lit program, looked up once.
 struct LitUniforms {
   GLint model, normal_matrix, view_projection, light_matrix, base_color, specular, shininess,
-      to_light, light_color, ambient, camera_position, use_texture, albedo, checker, tile, color_a,
-      color_b, use_shadows, shadow_map, shadow_texel;
+      to_light, light_color, ambient, camera_position, use_texture, albedo, use_shadows, shadow_map,
+      shadow_texel;
+};
+
+struct FloorUniforms {
+  GLint model, view_projection, light_matrix, tile, color_a, color_b, ambient, direct, use_shadows,
+      shadow_map, shadow_texel;
 };
 
 struct GpuMesh {
   std::shared_ptr<const MeshData> keep_alive;
-  GLuint vao = 0;
-  GLuint vertices = 0;
-  GLuint indices = 0;
+  GLint base_vertex = 0;          // of its first vertex in the arena
+  std::uint32_t first_index = 0;  // of its first index in the arena
   std::vector<MeshData::Part> parts;
   float radius = 0.0F;  // of a sphere about the origin that holds every vertex
 };
@@ -270,14 +316,37 @@ struct Renderer::Impl {
     depth_only = link(kDepthVertex, kDepthFragment);
     segmentation = link(kDepthVertex, kSegmentationFragment);
     const auto at = [this](const char* name) { return glGetUniformLocation(lit, name); };
-    u = {at("model"),        at("normal_matrix"),   at("view_projection"),
-         at("light_matrix"), at("base_color"),      at("specular"),
-         at("shininess"),    at("to_light"),        at("light_color"),
-         at("ambient"),      at("camera_position"), at("use_texture"),
-         at("albedo"),       at("checker"),         at("tile"),
-         at("color_a"),      at("color_b"),         at("use_shadows"),
-         at("shadow_map"),   at("shadow_texel")};
+    u = {at("model"),       at("normal_matrix"), at("view_projection"), at("light_matrix"),
+         at("base_color"),  at("specular"),      at("shininess"),       at("to_light"),
+         at("light_color"), at("ambient"),       at("camera_position"), at("use_texture"),
+         at("albedo"),      at("use_shadows"),   at("shadow_map"),      at("shadow_texel")};
+    floor_program = link(kFloorVertex, kFloorFragment);
+    const auto floor_at = [this](const char* name) {
+      return glGetUniformLocation(floor_program, name);
+    };
+    fu = {floor_at("model"),      floor_at("view_projection"), floor_at("light_matrix"),
+          floor_at("tile"),       floor_at("color_a"),         floor_at("color_b"),
+          floor_at("ambient"),    floor_at("direct"),          floor_at("use_shadows"),
+          floor_at("shadow_map"), floor_at("shadow_texel")};
+    sky_inverse_view_projection = glGetUniformLocation(sky, "inverse_view_projection");
+    sky_horizon = glGetUniformLocation(sky, "horizon");
+    sky_zenith = glGetUniformLocation(sky, "zenith");
     glGenVertexArrays(1, &empty_vao);
+    glGenVertexArrays(1, &arena_vao);
+    glBindVertexArray(arena_vao);
+    glGenBuffers(1, &arena_vbo);
+    glGenBuffers(1, &arena_ebo);
+    glBindBuffer(GL_ARRAY_BUFFER, arena_vbo);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, arena_ebo);
+    constexpr GLsizei kStride = 8 * sizeof(float);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, kStride, reinterpret_cast<void*>(0));
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, kStride,
+                          reinterpret_cast<void*>(3 * sizeof(float)));
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, kStride,
+                          reinterpret_cast<void*>(6 * sizeof(float)));
+    glEnableVertexAttribArray(2);
     // The floor: a large square (its checker pattern comes from world coordinates).
     auto floor_mesh = std::make_shared<MeshData>();
     const float half = 500.0F;
@@ -301,11 +370,9 @@ struct Renderer::Impl {
 
   ~Impl() {
     context.make_current();
-    for (auto& [key, mesh] : meshes) {
-      glDeleteVertexArrays(1, &mesh.vao);
-      glDeleteBuffers(1, &mesh.vertices);
-      glDeleteBuffers(1, &mesh.indices);
-    }
+    glDeleteVertexArrays(1, &arena_vao);
+    const GLuint buffers[] = {arena_vbo, arena_ebo};
+    glDeleteBuffers(2, buffers);
     for (auto& [key, target] : targets) {
       const GLuint framebuffers[] = {target.framebuffer, target.resolve_framebuffer};
       glDeleteFramebuffers(2, framebuffers);
@@ -323,47 +390,32 @@ struct Renderer::Impl {
     if (shadow_framebuffer != 0) glDeleteFramebuffers(1, &shadow_framebuffer);
     if (shadow_texture != 0) glDeleteTextures(1, &shadow_texture);
     glDeleteVertexArrays(1, &empty_vao);
-    for (GLuint program : {lit, sky, depth_only, segmentation}) glDeleteProgram(program);
+    for (GLuint program : {lit, sky, depth_only, segmentation, floor_program})
+      glDeleteProgram(program);
   }
 
+  // Adds a mesh to the arena: every mesh shares one vertex buffer, one index buffer and one
+  // vertex array, so that drawing another mesh changes no GL state but offsets (llvmpipe
+  // revalidates much of its state when the vertex array changes, which dominated small frames).
   const GpuMesh& upload(const std::shared_ptr<const MeshData>& mesh) {
     auto found = meshes.find(mesh.get());
     if (found != meshes.end()) return found->second;
     GpuMesh gpu;
     gpu.keep_alive = mesh;
-    std::vector<float> interleaved;
-    interleaved.reserve(mesh->positions.size() * 8);
+    gpu.base_vertex = static_cast<GLint>(arena_vertices.size() / 8);
+    gpu.first_index = static_cast<std::uint32_t>(arena_indices.size());
     for (std::size_t i = 0; i < mesh->positions.size(); ++i) {
       const Eigen::Vector3f& p = mesh->positions[i];
       const Eigen::Vector3f n =
           i < mesh->normals.size() ? mesh->normals[i] : Eigen::Vector3f::UnitZ();
       const Eigen::Vector2f t =
           i < mesh->texcoords.size() ? mesh->texcoords[i] : Eigen::Vector2f::Zero();
-      interleaved.insert(interleaved.end(),
-                         {p.x(), p.y(), p.z(), n.x(), n.y(), n.z(), t.x(), t.y()});
+      arena_vertices.insert(arena_vertices.end(),
+                            {p.x(), p.y(), p.z(), n.x(), n.y(), n.z(), t.x(), t.y()});
       gpu.radius = std::max(gpu.radius, p.norm());
     }
-    glGenVertexArrays(1, &gpu.vao);
-    glBindVertexArray(gpu.vao);
-    glGenBuffers(1, &gpu.vertices);
-    glBindBuffer(GL_ARRAY_BUFFER, gpu.vertices);
-    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(interleaved.size() * sizeof(float)),
-                 interleaved.data(), GL_STATIC_DRAW);
-    glGenBuffers(1, &gpu.indices);
-    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, gpu.indices);
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER,
-                 static_cast<GLsizeiptr>(mesh->indices.size() * sizeof(std::uint32_t)),
-                 mesh->indices.data(), GL_STATIC_DRAW);
-    constexpr GLsizei kStride = 8 * sizeof(float);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, kStride, reinterpret_cast<void*>(0));
-    glEnableVertexAttribArray(0);
-    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, kStride,
-                          reinterpret_cast<void*>(3 * sizeof(float)));
-    glEnableVertexAttribArray(1);
-    glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, kStride,
-                          reinterpret_cast<void*>(6 * sizeof(float)));
-    glEnableVertexAttribArray(2);
-    glBindVertexArray(0);
+    arena_indices.insert(arena_indices.end(), mesh->indices.begin(), mesh->indices.end());
+    arena_dirty = true;
     gpu.parts = mesh->parts;
     if (gpu.parts.empty()) {
       MeshData::Part all;
@@ -371,6 +423,26 @@ struct Renderer::Impl {
       gpu.parts.push_back(all);
     }
     return meshes.emplace(mesh.get(), std::move(gpu)).first->second;
+  }
+
+  // Sends the arena to the GPU when meshes were added since the last frame.
+  void sync_arena() {
+    glBindVertexArray(arena_vao);
+    if (!arena_dirty) return;
+    glBindBuffer(GL_ARRAY_BUFFER, arena_vbo);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(arena_vertices.size() * sizeof(float)),
+                 arena_vertices.data(), GL_STATIC_DRAW);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, arena_ebo);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER,
+                 static_cast<GLsizeiptr>(arena_indices.size() * sizeof(std::uint32_t)),
+                 arena_indices.data(), GL_STATIC_DRAW);
+    arena_dirty = false;
+  }
+
+  void bind_albedo(GLuint handle) {
+    if (bound_albedo == handle) return;
+    glBindTexture(GL_TEXTURE_2D, handle);
+    bound_albedo = handle;
   }
 
   GLuint texture(const std::string& path) {
@@ -393,7 +465,9 @@ struct Renderer::Impl {
     }
     GLuint handle = 0;
     glGenTextures(1, &handle);
+    glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, handle);
+    bound_albedo = handle;
     glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, image.width, image.height, 0, GL_RGBA,
                  GL_UNSIGNED_BYTE, rgba.data());
     glGenerateMipmap(GL_TEXTURE_2D);
@@ -509,13 +583,16 @@ struct Renderer::Impl {
     return light;
   }
 
+  static void draw_part(const GpuMesh& mesh, const MeshData::Part& part) {
+    glDrawElementsBaseVertex(
+        GL_TRIANGLES, static_cast<GLsizei>(part.index_count), GL_UNSIGNED_INT,
+        reinterpret_cast<void*>(static_cast<std::uintptr_t>(mesh.first_index + part.first_index) *
+                                sizeof(std::uint32_t)),
+        mesh.base_vertex);
+  }
+
   static void draw_all(const GpuMesh& mesh) {
-    glBindVertexArray(mesh.vao);
-    for (const MeshData::Part& part : mesh.parts) {
-      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(part.index_count), GL_UNSIGNED_INT,
-                     reinterpret_cast<void*>(static_cast<std::uintptr_t>(part.first_index) *
-                                             sizeof(std::uint32_t)));
-    }
+    for (const MeshData::Part& part : mesh.parts) draw_part(mesh, part);
   }
 
   void render(const Scene& scene, const Camera& camera, const RenderTargets& out) {
@@ -534,6 +611,8 @@ struct Renderer::Impl {
       gpu[i] = &upload(scene.instances[i].mesh);
     }
     const GpuMesh& floor_mesh = upload(floor);
+    sync_arena();
+    bound_albedo = 0;  // texture creation and the shadow map may have changed unit 0's binding
     const Eigen::Matrix4f view_projection = camera.projection_matrix() * camera.view_matrix();
 
     // Every pass below depth-tests (without it GL writes no depth, and the first frame's shadow
@@ -552,20 +631,6 @@ struct Renderer::Impl {
     glDepthFunc(GL_LESS);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
 
-    // The sky, behind everything: neither tested against nor written to the depth buffer.
-    glDisable(GL_DEPTH_TEST);
-    glDepthMask(GL_FALSE);
-    glUseProgram(sky);
-    const Eigen::Matrix4f inverse = view_projection.inverse();
-    glUniformMatrix4fv(glGetUniformLocation(sky, "inverse_view_projection"), 1, GL_FALSE,
-                       inverse.data());
-    glUniform3fv(glGetUniformLocation(sky, "horizon"), 1, scene.sky.horizon.data());
-    glUniform3fv(glGetUniformLocation(sky, "zenith"), 1, scene.sky.zenith.data());
-    glBindVertexArray(empty_vao);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    glDepthMask(GL_TRUE);
-    glEnable(GL_DEPTH_TEST);
-
     glUseProgram(lit);
     const Eigen::Vector3f to_light = -scene.light.direction.normalized();
     const Eigen::Vector3f eye = camera.X_world_camera.translation();
@@ -576,35 +641,14 @@ struct Renderer::Impl {
     glUniform3fv(u.light_color, 1, scene.light.color.data());
     glUniform3fv(u.ambient, 1, scene.light.ambient.data());
     glUniform3fv(u.camera_position, 1, eye.data());
-    glUniform1i(u.use_shadows, shadows && light_matrix(3, 3) != 0.0F ? 1 : 0);
+    const bool use_shadows = shadows && light_matrix(3, 3) != 0.0F;
+    glUniform1i(u.use_shadows, use_shadows ? 1 : 0);
     glUniform1i(u.albedo, 0);
     glUniform1i(u.shadow_map, 1);
     glUniform1f(u.shadow_texel, 1.0F / static_cast<float>(map_size));
     glActiveTexture(GL_TEXTURE1);
     glBindTexture(GL_TEXTURE_2D, shadows ? shadow_texture : 0);
     glActiveTexture(GL_TEXTURE0);
-
-    if (scene.floor.enabled) {
-      Eigen::Matrix4f model = Eigen::Matrix4f::Identity();
-      model(2, 3) = scene.floor.height_m;
-      const Eigen::Matrix3f normal_matrix = Eigen::Matrix3f::Identity();
-      glUniformMatrix4fv(u.model, 1, GL_FALSE, model.data());
-      glUniformMatrix3fv(u.normal_matrix, 1, GL_FALSE, normal_matrix.data());
-      glUniform1i(u.checker, 1);
-      glUniform1f(u.tile, scene.floor.tile_m);
-      glUniform3fv(u.color_a, 1, scene.floor.color_a.data());
-      glUniform3fv(u.color_b, 1, scene.floor.color_b.data());
-      glUniform1f(u.specular, 0.0F);
-      glUniform1f(u.shininess, 1.0F);
-      glUniform1i(u.use_texture, 0);
-      glBindTexture(GL_TEXTURE_2D, white_texture);
-      // Pushed back a little so that shapes resting on the floor never fight it for depth.
-      glEnable(GL_POLYGON_OFFSET_FILL);
-      glPolygonOffset(1.0F, 1.0F);
-      draw_all(floor_mesh);
-      glDisable(GL_POLYGON_OFFSET_FILL);
-      glUniform1i(u.checker, 0);
-    }
 
     for (std::size_t i = 0; i < scene.instances.size(); ++i) {
       const Instance& instance = scene.instances[i];
@@ -616,17 +660,50 @@ struct Renderer::Impl {
       glUniform1f(u.shininess, instance.material.shininess);
       const bool textured = !instance.material.texture_path.empty();
       glUniform1i(u.use_texture, textured ? 1 : 0);
-      glBindTexture(GL_TEXTURE_2D,
-                    textured ? texture(instance.material.texture_path) : white_texture);
-      glBindVertexArray(gpu[i]->vao);
+      bind_albedo(textured ? texture(instance.material.texture_path) : white_texture);
       for (const MeshData::Part& part : gpu[i]->parts) {
         const Eigen::Vector4f& color = part.has_color ? part.rgba : instance.material.base_color;
         glUniform4fv(u.base_color, 1, color.data());
-        glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(part.index_count), GL_UNSIGNED_INT,
-                       reinterpret_cast<void*>(static_cast<std::uintptr_t>(part.first_index) *
-                                               sizeof(std::uint32_t)));
+        draw_part(*gpu[i], part);
       }
     }
+
+    // The floor after the instances, so that early depth tests skip it where they stand.
+    if (scene.floor.enabled) {
+      Eigen::Matrix4f model = Eigen::Matrix4f::Identity();
+      model(2, 3) = scene.floor.height_m;
+      const Eigen::Vector3f direct = scene.light.color * std::max(0.0F, to_light.z());
+      glUseProgram(floor_program);
+      glUniformMatrix4fv(fu.model, 1, GL_FALSE, model.data());
+      glUniformMatrix4fv(fu.view_projection, 1, GL_FALSE, view_projection.data());
+      glUniformMatrix4fv(fu.light_matrix, 1, GL_FALSE, light_matrix.data());
+      glUniform1f(fu.tile, scene.floor.tile_m);
+      glUniform3fv(fu.color_a, 1, scene.floor.color_a.data());
+      glUniform3fv(fu.color_b, 1, scene.floor.color_b.data());
+      glUniform3fv(fu.ambient, 1, scene.light.ambient.data());
+      glUniform3fv(fu.direct, 1, direct.data());
+      glUniform1i(fu.use_shadows, use_shadows ? 1 : 0);
+      glUniform1i(fu.shadow_map, 1);
+      glUniform1f(fu.shadow_texel, 1.0F / static_cast<float>(map_size));
+      // Pushed back a little so that shapes resting on the floor never fight it for depth.
+      glEnable(GL_POLYGON_OFFSET_FILL);
+      glPolygonOffset(1.0F, 1.0F);
+      draw_all(floor_mesh);
+      glDisable(GL_POLYGON_OFFSET_FILL);
+    }
+
+    // The sky last, at the far plane: depth-tested against what is already drawn (so only its
+    // visible pixels are shaded) and writing no depth.
+    glDepthFunc(GL_LEQUAL);
+    glDepthMask(GL_FALSE);
+    glUseProgram(sky);
+    const Eigen::Matrix4f inverse = view_projection.inverse();
+    glUniformMatrix4fv(sky_inverse_view_projection, 1, GL_FALSE, inverse.data());
+    glUniform3fv(sky_horizon, 1, scene.sky.horizon.data());
+    glUniform3fv(sky_zenith, 1, scene.sky.zenith.data());
+    glDrawArrays(GL_TRIANGLES, 0, 3);  // positions come from gl_VertexID; the arena is bound
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_LESS);
 
     GLuint read_from = t.framebuffer;
     if (camera.msaa_samples > 0) {
@@ -696,6 +773,15 @@ struct Renderer::Impl {
   GLuint depth_only = 0;
   GLuint segmentation = 0;
   LitUniforms u{};
+  std::vector<float> arena_vertices;  // 8 floats per vertex: position, normal, texture coordinate
+  std::vector<std::uint32_t> arena_indices;
+  bool arena_dirty = false;
+  GLuint arena_vao = 0;
+  GLuint arena_vbo = 0;
+  GLuint arena_ebo = 0;
+  GLuint bound_albedo = 0;  // on texture unit 0, to skip redundant binds
+  GLuint floor_program = 0;
+  FloorUniforms fu{};
   GLuint empty_vao = 0;
   GLuint white_texture = 0;
   std::shared_ptr<const MeshData> floor;
@@ -707,6 +793,9 @@ struct Renderer::Impl {
   GLuint shadow_texture = 0;
   int shadow_size = 0;
   GLint max_samples = 0;
+  GLint sky_inverse_view_projection = -1;
+  GLint sky_horizon = -1;
+  GLint sky_zenith = -1;
 };
 
 Renderer::Renderer(GlBackend backend) : impl_(std::make_unique<Impl>(backend)) {}
