@@ -45,11 +45,17 @@ std::shared_ptr<const MeshData> convert(const std::shared_ptr<const engine::Mesh
   return slot;
 }
 
+// Round primitives switch to 10 segments below this radius on screen, where 24 would only add
+// triangles (and llvmpipe pays per triangle, however small).
+constexpr float kLowDetailBelowPx = 6.0F;
+
 // Unit primitives shared by every scene.
 std::shared_ptr<const MeshData> shared_primitive(engine::GeometryType type) {
   static const auto box = make_box_mesh();
-  static const auto sphere = make_sphere_mesh(24);
-  static const auto cylinder = make_cylinder_mesh(24);
+  static const auto sphere =
+      with_low_detail(*make_sphere_mesh(24), make_sphere_mesh(10), kLowDetailBelowPx);
+  static const auto cylinder =
+      with_low_detail(*make_cylinder_mesh(24), make_cylinder_mesh(10), kLowDetailBelowPx);
   switch (type) {
     case engine::GeometryType::kBox:
       return box;
@@ -66,7 +72,11 @@ std::shared_ptr<const MeshData> shared_capsule(double length_over_radius) {
   const long key = std::lround(length_over_radius * 1000.0);
   std::lock_guard<std::mutex> lock(mutex);
   auto& slot = capsules[key];
-  if (slot == nullptr) slot = make_capsule_mesh(static_cast<double>(key) / 1000.0, 24);
+  if (slot == nullptr) {
+    const double ratio = static_cast<double>(key) / 1000.0;
+    slot = with_low_detail(*make_capsule_mesh(ratio, 24), make_capsule_mesh(ratio, 10),
+                           kLowDetailBelowPx);
+  }
   return slot;
 }
 

@@ -131,4 +131,14 @@ std::shared_ptr<const MeshData> make_capsule_mesh(double length_over_radius, int
   return mesh;
 }
 
+std::shared_ptr<const MeshData> with_low_detail(const MeshData& fine,
+                                                std::shared_ptr<const MeshData> coarse,
+                                                float below_px) {
+  auto mesh = std::make_shared<MeshData>(fine);
+  mesh->low_detail = std::move(coarse);
+  mesh->low_detail_radius = 1.0F;
+  mesh->low_detail_below_px = below_px;
+  return mesh;
+}
+
 }  // namespace pixelgym

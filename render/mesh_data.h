@@ -28,6 +28,14 @@ struct MeshData {
   /// Empty means one part covering every index.
   std::vector<Part> parts;
 
+  /// A coarser version drawn instead when the instance is small on screen: when
+  /// `low_detail_radius` (in mesh units) times the smaller of the instance's x and y scales
+  /// covers fewer than `low_detail_below_px` pixels. (The x-y cross-section is what a round
+  /// primitive's segment count must resolve.) Null for none.
+  std::shared_ptr<const MeshData> low_detail;
+  float low_detail_radius = 1.0F;
+  float low_detail_below_px = 0.0F;
+
   std::size_t triangle_count() const { return indices.size() / 3; }
 };
 
@@ -39,5 +47,11 @@ std::shared_ptr<const MeshData> make_cylinder_mesh(int segments = 24);  // radiu
 /// A capsule of radius 1 whose cylindrical part is `length / radius` long (capsules do not scale
 /// uniformly, so each aspect ratio is its own mesh).
 std::shared_ptr<const MeshData> make_capsule_mesh(double length_over_radius, int segments = 24);
+
+/// A copy of `fine` that is drawn as `coarse` when its round cross-section (radius 1 in mesh
+/// units) covers fewer than `below_px` pixels of radius on screen.
+std::shared_ptr<const MeshData> with_low_detail(const MeshData& fine,
+                                                std::shared_ptr<const MeshData> coarse,
+                                                float below_px);
 
 }  // namespace pixelgym

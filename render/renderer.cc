@@ -60,16 +60,12 @@ out vec4 fragment;
 
 float lit_fraction() {
   vec3 p = light_position.xyz / light_position.w * 0.5 + 0.5;
-  if (p.x <= 0.0 || p.x >= 1.0 || p.y <= 0.0 || p.y >= 1.0 || p.z >= 1.0) return 1.0;
-  // 2 x 2 percentage-closer filtering on hardware comparisons.
-  float sum = 0.0;
-  for (int i = 0; i < 2; ++i) {
-    for (int j = 0; j < 2; ++j) {
-      vec2 offset = (vec2(i, j) - 0.5) * shadow_texel;
-      sum += texture(shadow_map, vec3(p.xy + offset, p.z));
-    }
-  }
-  return sum * 0.25;
+  // Outside the casters' footprint nothing can shade it; beyond their far side (the floor under
+  // them) it compares as the farthest depth.
+  if (p.x <= 0.0 || p.x >= 1.0 || p.y <= 0.0 || p.y >= 1.0) return 1.0;
+  p.z = min(p.z, 1.0);
+  // One linear-filtered lookup: the hardware compares the 2 x 2 nearest texels and blends.
+  return texture(shadow_map, p);
 }
 
 void main() {
@@ -142,14 +138,11 @@ out vec4 fragment;
 
 float lit_fraction() {
   vec3 p = light_position.xyz / light_position.w * 0.5 + 0.5;
-  if (p.x <= 0.0 || p.x >= 1.0 || p.y <= 0.0 || p.y >= 1.0 || p.z >= 1.0) return 1.0;
-  float sum = 0.0;
-  for (int i = 0; i < 2; ++i) {
-    for (int j = 0; j < 2; ++j) {
-      sum += texture(shadow_map, vec3(p.xy + (vec2(i, j) - 0.5) * shadow_texel, p.z));
-    }
-  }
-  return sum * 0.25;
+  // Outside the casters' footprint nothing can shade it; beyond their far side (the floor under
+  // them) it compares as the farthest depth.
+  if (p.x <= 0.0 || p.x >= 1.0 || p.y <= 0.0 || p.y >= 1.0) return 1.0;
+  p.z = min(p.z, 1.0);
+  return texture(shadow_map, p);
 }
 
 void main() {
@@ -230,7 +223,8 @@ struct GpuMesh {
   GLint base_vertex = 0;          // of its first vertex in the arena
   std::uint32_t first_index = 0;  // of its first index in the arena
   std::vector<MeshData::Part> parts;
-  float radius = 0.0F;  // of a sphere about the origin that holds every vertex
+  float radius = 0.0F;         // of a sphere about the origin that holds every vertex
+  Eigen::AlignedBox3f bounds;  // in mesh coordinates
 };
 
 // Render targets for one image size and sample count.
@@ -270,17 +264,21 @@ GLuint make_renderbuffer(GLenum format, int width, int height, int samples) {
 }
 
 int shadow_map_size(const Camera& camera) {
-  // About two shadow texels per image pixel, as a power of two in [256, 2048].
-  int size = 256;
-  while (size < 2 * std::max(camera.width, camera.height) && size < 2048) size *= 2;
+  // About one shadow texel per image pixel, as a power of two in [128, 2048]: a shadow map larger
+  // than the image costs more to clear and sample than it shows.
+  int size = 128;
+  while (size < std::max(camera.width, camera.height) && size < 2048) size *= 2;
   return size;
 }
 
-Eigen::Matrix4f orthographic(float half_width, float near_m, float far_m) {
+Eigen::Matrix4f orthographic(float left, float right, float bottom, float top, float near_m,
+                             float far_m) {
   Eigen::Matrix4f m = Eigen::Matrix4f::Identity();
-  m(0, 0) = 1.0F / half_width;
-  m(1, 1) = 1.0F / half_width;
+  m(0, 0) = 2.0F / (right - left);
+  m(1, 1) = 2.0F / (top - bottom);
   m(2, 2) = -2.0F / (far_m - near_m);
+  m(0, 3) = -(right + left) / (right - left);
+  m(1, 3) = -(top + bottom) / (top - bottom);
   m(2, 3) = -(far_m + near_m) / (far_m - near_m);
   return m;
 }
@@ -371,6 +369,11 @@ struct Renderer::Impl {
   ~Impl() {
     context.make_current();
     glDeleteVertexArrays(1, &arena_vao);
+    if (footprint_vao != 0) {
+      glDeleteVertexArrays(1, &footprint_vao);
+      const GLuint footprint_buffers[] = {footprint_vbo, footprint_ebo};
+      glDeleteBuffers(2, footprint_buffers);
+    }
     const GLuint buffers[] = {arena_vbo, arena_ebo};
     glDeleteBuffers(2, buffers);
     for (auto& [key, target] : targets) {
@@ -379,6 +382,11 @@ struct Renderer::Impl {
       const GLuint renderbuffers[] = {target.color, target.depth, target.resolve_color,
                                       target.resolve_depth};
       glDeleteRenderbuffers(4, renderbuffers);
+    }
+    for (auto& [key, target] : backgrounds) {
+      glDeleteFramebuffers(1, &target.framebuffer);
+      const GLuint renderbuffers[] = {target.color, target.depth};
+      glDeleteRenderbuffers(2, renderbuffers);
     }
     for (auto& [key, target] : segmentation_targets) {
       glDeleteFramebuffers(1, &target.framebuffer);
@@ -413,6 +421,7 @@ struct Renderer::Impl {
       arena_vertices.insert(arena_vertices.end(),
                             {p.x(), p.y(), p.z(), n.x(), n.y(), n.z(), t.x(), t.y()});
       gpu.radius = std::max(gpu.radius, p.norm());
+      gpu.bounds.extend(p);
     }
     arena_indices.insert(arena_indices.end(), mesh->indices.begin(), mesh->indices.end());
     arena_dirty = true;
@@ -506,6 +515,23 @@ struct Renderer::Impl {
     return targets.emplace(key, t).first->second;
   }
 
+  // A second target of the same size and samples, holding the cached background.
+  Target& background_target(const Camera& camera) {
+    const auto key = std::make_tuple(camera.width, camera.height, camera.msaa_samples);
+    auto found = backgrounds.find(key);
+    if (found != backgrounds.end()) return found->second;
+    Target t;
+    glGenFramebuffers(1, &t.framebuffer);
+    glBindFramebuffer(GL_FRAMEBUFFER, t.framebuffer);
+    t.color = make_renderbuffer(GL_RGBA8, camera.width, camera.height, camera.msaa_samples);
+    t.depth =
+        make_renderbuffer(GL_DEPTH_COMPONENT24, camera.width, camera.height, camera.msaa_samples);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, t.color);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t.depth);
+    check_framebuffer("background");
+    return backgrounds.emplace(key, t).first->second;
+  }
+
   SegmentationTarget& segmentation_target(const Camera& camera) {
     const auto key = std::make_pair(camera.width, camera.height);
     auto found = segmentation_targets.find(key);
@@ -547,22 +573,29 @@ struct Renderer::Impl {
   // Renders the casters' depth from the light; returns the matrix from world to shadow-map clip.
   Eigen::Matrix4f shadow_pass(const Scene& scene, const std::vector<const GpuMesh*>& gpu,
                               int size) {
-    // A sphere around every shadow caster bounds what the light must see.
+    // The light looks along its direction; its orthographic box is fitted to the casters'
+    // extent in light space, so that the shadow map's texels and the receivers' lookups are
+    // spent only where shadows can fall.
+    const Eigen::Vector3f direction = scene.light.direction.normalized();
+    const Eigen::Matrix4f light_view = look_from(Eigen::Vector3f::Zero(), direction);
     Eigen::Vector3f low = Eigen::Vector3f::Constant(1e30F);
     Eigen::Vector3f high = Eigen::Vector3f::Constant(-1e30F);
     for (std::size_t i = 0; i < scene.instances.size(); ++i) {
       const Instance& instance = scene.instances[i];
       if (!instance.casts_shadow) continue;
-      const float r = gpu[i]->radius * instance.scale.cwiseAbs().maxCoeff();
-      low = low.cwiseMin(instance.X_world_instance.translation() - Eigen::Vector3f::Constant(r));
-      high = high.cwiseMax(instance.X_world_instance.translation() + Eigen::Vector3f::Constant(r));
+      const Eigen::Matrix4f to_light_space = light_view * model_matrix(instance);
+      for (int corner = 0; corner < 8; ++corner) {
+        const Eigen::Vector3f p =
+            gpu[i]->bounds.corner(static_cast<Eigen::AlignedBox3f::CornerType>(corner));
+        const Eigen::Vector3f q = (to_light_space * p.homogeneous()).head<3>();
+        low = low.cwiseMin(q);
+        high = high.cwiseMax(q);
+      }
     }
     if (low.x() > high.x()) return Eigen::Matrix4f::Zero();  // nothing casts
-    const Eigen::Vector3f centre = 0.5F * (low + high);
-    const float radius = std::max(0.5F * (high - low).norm(), 1e-3F);
-    const Eigen::Vector3f direction = scene.light.direction.normalized();
-    const Eigen::Matrix4f light = orthographic(radius, 0.0F, 4.0F * radius) *
-                                  look_from(centre - 2.0F * radius * direction, direction);
+    // Light space looks down -z: the casters lie between depths -high.z() and -low.z().
+    const Eigen::Matrix4f light =
+        orthographic(low.x(), high.x(), low.y(), high.y(), -high.z(), -low.z()) * light_view;
 
     ensure_shadow_map(size);
     glBindFramebuffer(GL_FRAMEBUFFER, shadow_framebuffer);
@@ -595,61 +628,23 @@ struct Renderer::Impl {
     for (const MeshData::Part& part : mesh.parts) draw_part(mesh, part);
   }
 
-  void render(const Scene& scene, const Camera& camera, const RenderTargets& out) {
-    camera.validate();
-    context.make_current();
-    if (camera.msaa_samples > max_samples) {
-      throw std::invalid_argument("Renderer: msaa_samples " + std::to_string(camera.msaa_samples) +
-                                  " is more than this OpenGL offers: at most " +
-                                  std::to_string(max_samples) + " (" + context.description() + ")");
-    }
-    std::vector<const GpuMesh*> gpu(scene.instances.size());
-    for (std::size_t i = 0; i < scene.instances.size(); ++i) {
-      if (scene.instances[i].mesh == nullptr) {
-        throw std::invalid_argument("Renderer: instance " + std::to_string(i) + " has no mesh");
-      }
-      gpu[i] = &upload(scene.instances[i].mesh);
-    }
-    const GpuMesh& floor_mesh = upload(floor);
-    sync_arena();
-    bound_albedo = 0;  // texture creation and the shadow map may have changed unit 0's binding
-    const Eigen::Matrix4f view_projection = camera.projection_matrix() * camera.view_matrix();
+  // Picks the coarse version of a mesh for instances small on screen.
+  const std::shared_ptr<const MeshData>& detail_for(const Instance& instance,
+                                                    const Camera& camera) const {
+    const MeshData& mesh = *instance.mesh;
+    if (mesh.low_detail == nullptr) return instance.mesh;
+    const float distance =
+        (instance.X_world_instance.translation() - camera.X_world_camera.translation()).norm();
+    const float size = std::min(std::abs(instance.scale.x()), std::abs(instance.scale.y())) *
+                       mesh.low_detail_radius;
+    const float pixels_per_metre =
+        0.5F * static_cast<float>(camera.height) /
+        (std::tan(camera.fov_y_deg * 3.14159265F / 360.0F) * std::max(distance, 1e-3F));
+    return size * pixels_per_metre < mesh.low_detail_below_px ? mesh.low_detail : instance.mesh;
+  }
 
-    // Every pass below depth-tests (without it GL writes no depth, and the first frame's shadow
-    // map would stay empty).
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    const bool shadows = scene.shadows;
-    Eigen::Matrix4f light_matrix = Eigen::Matrix4f::Zero();
-    const int map_size = shadow_map_size(camera);
-    if (shadows) light_matrix = shadow_pass(scene, gpu, map_size);
-
-    Target& t = target(camera);
-    glBindFramebuffer(GL_FRAMEBUFFER, t.framebuffer);
-    glViewport(0, 0, camera.width, camera.height);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-
+  void draw_instances(const Scene& scene, const std::vector<const GpuMesh*>& gpu) {
     glUseProgram(lit);
-    const Eigen::Vector3f to_light = -scene.light.direction.normalized();
-    const Eigen::Vector3f eye = camera.X_world_camera.translation();
-    glUniformMatrix4fv(u.view_projection, 1, GL_FALSE, view_projection.data());
-    // Shadow-map clip coordinates; the shader maps them to texture space.
-    glUniformMatrix4fv(u.light_matrix, 1, GL_FALSE, light_matrix.data());
-    glUniform3fv(u.to_light, 1, to_light.data());
-    glUniform3fv(u.light_color, 1, scene.light.color.data());
-    glUniform3fv(u.ambient, 1, scene.light.ambient.data());
-    glUniform3fv(u.camera_position, 1, eye.data());
-    const bool use_shadows = shadows && light_matrix(3, 3) != 0.0F;
-    glUniform1i(u.use_shadows, use_shadows ? 1 : 0);
-    glUniform1i(u.albedo, 0);
-    glUniform1i(u.shadow_map, 1);
-    glUniform1f(u.shadow_texel, 1.0F / static_cast<float>(map_size));
-    glActiveTexture(GL_TEXTURE1);
-    glBindTexture(GL_TEXTURE_2D, shadows ? shadow_texture : 0);
-    glActiveTexture(GL_TEXTURE0);
-
     for (std::size_t i = 0; i < scene.instances.size(); ++i) {
       const Instance& instance = scene.instances[i];
       const Eigen::Matrix4f model = model_matrix(instance);
@@ -667,33 +662,104 @@ struct Renderer::Impl {
         draw_part(*gpu[i], part);
       }
     }
+  }
 
-    // The floor after the instances, so that early depth tests skip it where they stand.
-    if (scene.floor.enabled) {
-      Eigen::Matrix4f model = Eigen::Matrix4f::Identity();
-      model(2, 3) = scene.floor.height_m;
-      const Eigen::Vector3f direct = scene.light.color * std::max(0.0F, to_light.z());
-      glUseProgram(floor_program);
-      glUniformMatrix4fv(fu.model, 1, GL_FALSE, model.data());
-      glUniformMatrix4fv(fu.view_projection, 1, GL_FALSE, view_projection.data());
-      glUniformMatrix4fv(fu.light_matrix, 1, GL_FALSE, light_matrix.data());
-      glUniform1f(fu.tile, scene.floor.tile_m);
-      glUniform3fv(fu.color_a, 1, scene.floor.color_a.data());
-      glUniform3fv(fu.color_b, 1, scene.floor.color_b.data());
-      glUniform3fv(fu.ambient, 1, scene.light.ambient.data());
-      glUniform3fv(fu.direct, 1, direct.data());
-      glUniform1i(fu.use_shadows, use_shadows ? 1 : 0);
-      glUniform1i(fu.shadow_map, 1);
-      glUniform1f(fu.shadow_texel, 1.0F / static_cast<float>(map_size));
-      // Pushed back a little so that shapes resting on the floor never fight it for depth.
-      glEnable(GL_POLYGON_OFFSET_FILL);
-      glPolygonOffset(1.0F, 1.0F);
-      draw_all(floor_mesh);
-      glDisable(GL_POLYGON_OFFSET_FILL);
+  void draw_floor(const Scene& scene, const Eigen::Matrix4f& view_projection,
+                  const Eigen::Matrix4f& light_matrix, bool use_shadows, int map_size,
+                  const GpuMesh& mesh) {
+    Eigen::Matrix4f model = Eigen::Matrix4f::Identity();
+    model(2, 3) = scene.floor.height_m;
+    const Eigen::Vector3f to_light = -scene.light.direction.normalized();
+    const Eigen::Vector3f direct = scene.light.color * std::max(0.0F, to_light.z());
+    glUseProgram(floor_program);
+    glBindVertexArray(&mesh == &footprint_mesh ? footprint_vao : arena_vao);
+    glUniformMatrix4fv(fu.model, 1, GL_FALSE, model.data());
+    glUniformMatrix4fv(fu.view_projection, 1, GL_FALSE, view_projection.data());
+    glUniformMatrix4fv(fu.light_matrix, 1, GL_FALSE, light_matrix.data());
+    glUniform1f(fu.tile, scene.floor.tile_m);
+    glUniform3fv(fu.color_a, 1, scene.floor.color_a.data());
+    glUniform3fv(fu.color_b, 1, scene.floor.color_b.data());
+    glUniform3fv(fu.ambient, 1, scene.light.ambient.data());
+    glUniform3fv(fu.direct, 1, direct.data());
+    glUniform1i(fu.use_shadows, use_shadows ? 1 : 0);
+    glUniform1i(fu.shadow_map, 1);
+    glUniform1f(fu.shadow_texel, 1.0F / static_cast<float>(map_size));
+    // Pushed back a little so that shapes resting on the floor never fight it for depth.
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(1.0F, 1.0F);
+    draw_all(mesh);
+    glDisable(GL_POLYGON_OFFSET_FILL);
+    glBindVertexArray(arena_vao);
+  }
+
+  // Rectangles of floor (in floor coordinates, z = 0 before the floor's height is applied) that
+  // hold every shadow: each caster's bounding box projected along the light onto the floor.
+  // Returns null when no shadow reaches the floor. The rectangles live in a small dynamic
+  // buffer of their own.
+  const GpuMesh* shadow_footprints(const Scene& scene, const std::vector<const GpuMesh*>& gpu) {
+    const Eigen::Vector3f direction = scene.light.direction.normalized();
+    if (direction.z() > -1e-3F) return nullptr;  // light from below the horizon casts none on it
+    const float h = scene.floor.height_m;
+    footprint_vertices.clear();
+    for (std::size_t i = 0; i < scene.instances.size(); ++i) {
+      const Instance& instance = scene.instances[i];
+      if (!instance.casts_shadow) continue;
+      const Eigen::Matrix4f model = model_matrix(instance);
+      Eigen::AlignedBox2f rect;
+      bool above = false;
+      for (int corner = 0; corner < 8; ++corner) {
+        const Eigen::Vector3f p =
+            (model * gpu[i]
+                         ->bounds.corner(static_cast<Eigen::AlignedBox3f::CornerType>(corner))
+                         .homogeneous())
+                .head<3>();
+        above = above || p.z() > h;
+        const Eigen::Vector3f on_floor = p - direction * ((p.z() - h) / direction.z());
+        rect.extend(on_floor.head<2>());
+      }
+      if (!above) continue;  // entirely below the floor
+      const Eigen::Vector2f lo = rect.min();
+      const Eigen::Vector2f hi = rect.max();
+      const float quad[6][2] = {{lo.x(), lo.y()}, {hi.x(), lo.y()}, {hi.x(), hi.y()},
+                                {lo.x(), lo.y()}, {hi.x(), hi.y()}, {lo.x(), hi.y()}};
+      for (const auto& v : quad)
+        footprint_vertices.insert(footprint_vertices.end(), {v[0], v[1], 0, 0, 0, 1, 0, 0});
     }
+    if (footprint_vertices.empty()) return nullptr;
+    if (footprint_vao == 0) {
+      glGenVertexArrays(1, &footprint_vao);
+      glBindVertexArray(footprint_vao);
+      glGenBuffers(1, &footprint_vbo);
+      glGenBuffers(1, &footprint_ebo);
+      glBindBuffer(GL_ARRAY_BUFFER, footprint_vbo);
+      glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, footprint_ebo);
+      constexpr GLsizei kStride = 8 * sizeof(float);
+      glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, kStride, reinterpret_cast<void*>(0));
+      glEnableVertexAttribArray(0);
+    }
+    glBindVertexArray(footprint_vao);
+    glBindBuffer(GL_ARRAY_BUFFER, footprint_vbo);
+    glBufferData(GL_ARRAY_BUFFER,
+                 static_cast<GLsizeiptr>(footprint_vertices.size() * sizeof(float)),
+                 footprint_vertices.data(), GL_STREAM_DRAW);
+    const auto count = static_cast<std::uint32_t>(footprint_vertices.size() / 8);
+    if (footprint_indices.size() < count) {
+      footprint_indices.resize(count);
+      for (std::uint32_t k = 0; k < count; ++k) footprint_indices[k] = k;
+      glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, footprint_ebo);
+      glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(count * sizeof(std::uint32_t)),
+                   footprint_indices.data(), GL_STATIC_DRAW);
+    }
+    footprint_mesh.parts.assign(1, MeshData::Part{});
+    footprint_mesh.parts[0].index_count = count;
+    footprint_mesh.base_vertex = 0;
+    footprint_mesh.first_index = 0;
+    return &footprint_mesh;
+  }
 
-    // The sky last, at the far plane: depth-tested against what is already drawn (so only its
-    // visible pixels are shaded) and writing no depth.
+  // The sky at the far plane: depth-tested against what is already drawn (so only its visible
+  // pixels are shaded), writing no depth.
+  void draw_sky(const Scene& scene, const Eigen::Matrix4f& view_projection) {
     glDepthFunc(GL_LEQUAL);
     glDepthMask(GL_FALSE);
     glUseProgram(sky);
@@ -704,6 +770,108 @@ struct Renderer::Impl {
     glDrawArrays(GL_TRIANGLES, 0, 3);  // positions come from gl_VertexID; the arena is bound
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_LESS);
+  }
+
+  // Everything the background (sky and floor without shadows) depends on.
+  static std::vector<float> background_key(const Scene& scene, const Camera& camera,
+                                           const Eigen::Matrix4f& view_projection) {
+    std::vector<float> key(view_projection.data(), view_projection.data() + 16);
+    const auto add = [&key](const auto& v) {
+      key.insert(key.end(), v.data(), v.data() + v.size());
+    };
+    add(camera.X_world_camera.translation());
+    add(scene.light.direction);
+    add(scene.light.color);
+    add(scene.light.ambient);
+    add(scene.floor.color_a);
+    add(scene.floor.color_b);
+    add(scene.sky.horizon);
+    add(scene.sky.zenith);
+    key.insert(key.end(),
+               {scene.floor.enabled ? 1.0F : 0.0F, scene.floor.height_m, scene.floor.tile_m,
+                static_cast<float>(camera.width), static_cast<float>(camera.height),
+                static_cast<float>(camera.msaa_samples)});
+    return key;
+  }
+
+  void render(const Scene& scene, const Camera& camera, const RenderTargets& out) {
+    camera.validate();
+    context.make_current();
+    if (camera.msaa_samples > max_samples) {
+      throw std::invalid_argument("Renderer: msaa_samples " + std::to_string(camera.msaa_samples) +
+                                  " is more than this OpenGL offers: at most " +
+                                  std::to_string(max_samples) + " (" + context.description() + ")");
+    }
+    std::vector<const GpuMesh*> gpu(scene.instances.size());
+    for (std::size_t i = 0; i < scene.instances.size(); ++i) {
+      if (scene.instances[i].mesh == nullptr) {
+        throw std::invalid_argument("Renderer: instance " + std::to_string(i) + " has no mesh");
+      }
+      gpu[i] = &upload(detail_for(scene.instances[i], camera));
+    }
+    upload(floor);
+    sync_arena();
+    bound_albedo = 0;  // texture creation and the shadow map may have changed unit 0's binding
+    const Eigen::Matrix4f view_projection = camera.projection_matrix() * camera.view_matrix();
+
+    // Every pass depth-tests (without it GL writes no depth, and a shadow map would stay empty).
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    Eigen::Matrix4f light_matrix = Eigen::Matrix4f::Zero();
+    const int map_size = shadow_map_size(camera);
+    if (scene.shadows) light_matrix = shadow_pass(scene, gpu, map_size);
+    const bool use_shadows = scene.shadows && light_matrix(3, 3) != 0.0F;
+
+    glUseProgram(lit);
+    const Eigen::Vector3f to_light = -scene.light.direction.normalized();
+    const Eigen::Vector3f eye = camera.X_world_camera.translation();
+    glUniformMatrix4fv(u.view_projection, 1, GL_FALSE, view_projection.data());
+    glUniformMatrix4fv(u.light_matrix, 1, GL_FALSE, light_matrix.data());
+    glUniform3fv(u.to_light, 1, to_light.data());
+    glUniform3fv(u.light_color, 1, scene.light.color.data());
+    glUniform3fv(u.ambient, 1, scene.light.ambient.data());
+    glUniform3fv(u.camera_position, 1, eye.data());
+    glUniform1i(u.use_shadows, use_shadows ? 1 : 0);
+    glUniform1i(u.albedo, 0);
+    glUniform1i(u.shadow_map, 1);
+    glUniform1f(u.shadow_texel, 1.0F / static_cast<float>(map_size));
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, use_shadows ? shadow_texture : 0);
+    glActiveTexture(GL_TEXTURE0);
+
+    // The sky and the unshadowed floor depend only on the camera and the scene's settings: they
+    // are drawn once into a background image and copied in each frame. Shadows can only fall
+    // inside the casters' footprints on the floor, so with shadows on, only those rectangles of
+    // floor are drawn again (same shader, now with the shadow lookup). Every frame, the first
+    // included, takes this path, so a scene always gives the same bytes.
+    Target& t = target(camera);
+    Target& background = background_target(camera);
+    const std::vector<float> key = background_key(scene, camera, view_projection);
+    if (key != background_keys[background.framebuffer]) {
+      glBindFramebuffer(GL_FRAMEBUFFER, background.framebuffer);
+      glViewport(0, 0, camera.width, camera.height);
+      glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+      if (scene.floor.enabled)
+        draw_floor(scene, view_projection, light_matrix, false, map_size, meshes.at(floor.get()));
+      draw_sky(scene, view_projection);
+      background_keys[background.framebuffer] = key;
+    }
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, background.framebuffer);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, t.framebuffer);
+    glBlitFramebuffer(0, 0, camera.width, camera.height, 0, 0, camera.width, camera.height,
+                      GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+    glBindFramebuffer(GL_FRAMEBUFFER, t.framebuffer);
+    glViewport(0, 0, camera.width, camera.height);
+    if (use_shadows && scene.floor.enabled) {
+      const GpuMesh* footprints = shadow_footprints(scene, gpu);
+      if (footprints != nullptr) {
+        // Over the cached floor, at the same depth: always pass the depth test.
+        glDepthFunc(GL_ALWAYS);
+        draw_floor(scene, view_projection, light_matrix, true, map_size, *footprints);
+        glDepthFunc(GL_LESS);
+      }
+    }
+    draw_instances(scene, gpu);
 
     GLuint read_from = t.framebuffer;
     if (camera.msaa_samples > 0) {
@@ -716,8 +884,19 @@ struct Renderer::Impl {
       read_from = t.resolve_framebuffer;
     }
     glBindFramebuffer(GL_FRAMEBUFFER, read_from);
-    if (out.rgb != nullptr)
-      glReadPixels(0, 0, camera.width, camera.height, GL_RGB, GL_UNSIGNED_BYTE, out.rgb);
+    if (out.rgb != nullptr) {
+      // RGBA is the renderbuffer's own layout: reading it and packing RGB here is faster than
+      // Mesa's conversion.
+      const std::size_t count =
+          static_cast<std::size_t>(camera.width) * static_cast<std::size_t>(camera.height);
+      readback.resize(count * 4);
+      glReadPixels(0, 0, camera.width, camera.height, GL_RGBA, GL_UNSIGNED_BYTE, readback.data());
+      for (std::size_t p = 0; p < count; ++p) {
+        out.rgb[p * 3] = readback[p * 4];
+        out.rgb[p * 3 + 1] = readback[p * 4 + 1];
+        out.rgb[p * 3 + 2] = readback[p * 4 + 2];
+      }
+    }
     if (out.depth != nullptr) {
       glReadPixels(0, 0, camera.width, camera.height, GL_DEPTH_COMPONENT, GL_FLOAT, out.depth);
       const float n = camera.near_m;
@@ -729,8 +908,10 @@ struct Renderer::Impl {
         out.depth[p] = out.depth[p] >= 1.0F ? f : 2.0F * n * f / ((f + n) - ndc * (f - n));
       }
     }
-    if (out.segmentation != nullptr)
-      render_segmentation(scene, camera, view_projection, gpu, floor_mesh, out.segmentation);
+    if (out.segmentation != nullptr) {
+      render_segmentation(scene, camera, view_projection, gpu, meshes.at(floor.get()),
+                          out.segmentation);
+    }
   }
 
   void render_segmentation(const Scene& scene, const Camera& camera,
@@ -780,6 +961,12 @@ struct Renderer::Impl {
   GLuint arena_vbo = 0;
   GLuint arena_ebo = 0;
   GLuint bound_albedo = 0;  // on texture unit 0, to skip redundant binds
+  std::vector<float> footprint_vertices;
+  std::vector<std::uint32_t> footprint_indices;
+  GpuMesh footprint_mesh;
+  GLuint footprint_vao = 0;
+  GLuint footprint_vbo = 0;
+  GLuint footprint_ebo = 0;
   GLuint floor_program = 0;
   FloorUniforms fu{};
   GLuint empty_vao = 0;
@@ -788,6 +975,9 @@ struct Renderer::Impl {
   std::unordered_map<const MeshData*, GpuMesh> meshes;
   std::map<std::string, GLuint> textures;
   std::map<std::tuple<int, int, int>, Target> targets;
+  std::map<std::tuple<int, int, int>, Target> backgrounds;
+  std::map<GLuint, std::vector<float>> background_keys;  // by background framebuffer
+  std::vector<std::uint8_t> readback;
   std::map<std::pair<int, int>, SegmentationTarget> segmentation_targets;
   GLuint shadow_framebuffer = 0;
   GLuint shadow_texture = 0;
