@@ -36,10 +36,12 @@ struct Instance {
 
 /// A directional light with an ambient term.
 struct Light {
-  /// Direction the light travels (from the light towards the scene), in world coordinates.
-  Eigen::Vector3f direction{-0.4F, 0.3F, -1.0F};
-  Eigen::Vector3f color{0.75F, 0.75F, 0.72F};
-  Eigen::Vector3f ambient{0.35F, 0.35F, 0.38F};
+  /// Direction the light travels (from the light towards the scene), in world coordinates. The
+  /// default comes from above and from the -y side, where task cameras usually stand, so that
+  /// the faces they see are lit.
+  Eigen::Vector3f direction{-0.35F, 0.5F, -0.8F};
+  Eigen::Vector3f color{0.7F, 0.7F, 0.67F};
+  Eigen::Vector3f ambient{0.4F, 0.4F, 0.43F};
 };
 
 /// The ground: an infinite checkerboard in the plane z = height.
