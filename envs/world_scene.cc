@@ -10,6 +10,9 @@ namespace {
 
 constexpr float kPi = 3.14159265358979323846F;
 
+constexpr std::size_t kMeshLowDetailMinTriangles = 200;
+constexpr float kMeshLowDetailBelowPx = 10.0F;
+
 // Engine meshes converted for drawing, shared process-wide; the engine mesh is kept alive so its
 // address stays a valid key.
 struct ConvertedMesh {
@@ -39,6 +42,17 @@ std::shared_ptr<const MeshData> convert(const std::shared_ptr<const engine::Mesh
       out.rgba = part.rgba;
       out.has_color = keep_part_colors && part.has_color;
       data->parts.push_back(out);
+    }
+    // Drawn small (as in 84 x 84 observations), a mesh needs only a fraction of its triangles,
+    // and llvmpipe pays for every one: a clustered copy with cells of a tenth of its size is
+    // drawn while its half-diagonal covers fewer than kMeshLowDetailBelowPx pixels.
+    Eigen::AlignedBox3f bounds;
+    for (const Eigen::Vector3f& p : data->positions) bounds.extend(p);
+    const float half_diagonal = 0.5F * bounds.diagonal().norm();
+    if (data->triangle_count() > kMeshLowDetailMinTriangles && half_diagonal > 0.0F) {
+      data->low_detail = simplify_by_clustering(*data, half_diagonal / 5.0F);
+      data->low_detail_radius = half_diagonal;
+      data->low_detail_below_px = kMeshLowDetailBelowPx;
     }
     slot = std::move(data);
   }
@@ -150,19 +164,42 @@ Camera frame_box(const Eigen::AlignedBox3f& box, float azimuth_deg, float elevat
   const float elevation = elevation_deg * kPi / 180.0F;
   const Eigen::Vector3f direction(std::cos(elevation) * std::cos(azimuth),
                                   std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
-  // Far enough that the bounding sphere fits the narrower field of view.
+  // The closest distance at which all eight corners of the box project inside the image (with a
+  // 5% margin), found by bisection between touching the box and fitting its bounding sphere.
   const float aspect = static_cast<float>(width) / static_cast<float>(height);
   const float half_fov_y = fov_y_deg * kPi / 360.0F;
   const float half_fov = std::min(half_fov_y, std::atan(std::tan(half_fov_y) * aspect));
-  const float distance = radius / std::sin(half_fov) * 1.05F;
   const Eigen::Vector3f up =
       std::abs(direction.z()) > 0.99F ? Eigen::Vector3f::UnitY() : Eigen::Vector3f::UnitZ();
-  Camera camera = Camera::look_at(centre + distance * direction, centre, up);
-  camera.width = width;
-  camera.height = height;
-  camera.fov_y_deg = fov_y_deg;
-  camera.near_m = std::max(0.01F, distance - 2.0F * radius) * 0.5F;
-  camera.far_m = distance + 20.0F * radius + 10.0F;
+  const auto camera_at = [&](float distance) {
+    Camera camera = Camera::look_at(centre + distance * direction, centre, up);
+    camera.width = width;
+    camera.height = height;
+    camera.fov_y_deg = fov_y_deg;
+    camera.near_m = std::max(0.01F, distance - 2.0F * radius) * 0.5F;
+    camera.far_m = distance + 20.0F * radius + 10.0F;
+    return camera;
+  };
+  const auto fits = [&](const Camera& camera) {
+    const Eigen::Matrix4f view_projection = camera.projection_matrix() * camera.view_matrix();
+    for (int corner = 0; corner < 8; ++corner) {
+      const Eigen::Vector4f clip =
+          view_projection *
+          box.corner(static_cast<Eigen::AlignedBox3f::CornerType>(corner)).homogeneous();
+      if (clip.w() <= 0.0F || std::abs(clip.x()) > 0.95F * clip.w() ||
+          std::abs(clip.y()) > 0.95F * clip.w()) {
+        return false;
+      }
+    }
+    return true;
+  };
+  float near_distance = radius;
+  float far_distance = radius / std::sin(half_fov) * 1.05F;
+  for (int i = 0; i < 30; ++i) {
+    const float middle = 0.5F * (near_distance + far_distance);
+    (fits(camera_at(middle)) ? far_distance : near_distance) = middle;
+  }
+  Camera camera = camera_at(far_distance);
   return camera;
 }
 

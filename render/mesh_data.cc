@@ -2,6 +2,8 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <map>
+#include <tuple>
 
 namespace pixelgym {
 namespace {
@@ -129,6 +131,61 @@ std::shared_ptr<const MeshData> make_capsule_mesh(double length_over_radius, int
   }
   add_revolution(*mesh, profile, segments);
   return mesh;
+}
+
+std::shared_ptr<const MeshData> simplify_by_clustering(const MeshData& mesh, float cell) {
+  using Part = MeshData::Part;
+  auto result = std::make_shared<MeshData>();
+  std::vector<Part> parts = mesh.parts;
+  if (parts.empty()) {
+    Part all;
+    all.index_count = static_cast<std::uint32_t>(mesh.indices.size());
+    parts.push_back(all);
+  }
+  for (const Part& part : parts) {
+    // One output vertex per occupied grid cell of this part: the mean of its vertices.
+    std::map<std::tuple<long, long, long>, std::uint32_t> cell_vertex;
+    std::vector<std::uint32_t> counts;
+    const auto first_vertex = static_cast<std::uint32_t>(result->positions.size());
+    const auto cluster = [&](std::uint32_t source) {
+      const Eigen::Vector3f& p = mesh.positions[source];
+      const auto key = std::make_tuple(std::lround(std::floor(p.x() / cell)),
+                                       std::lround(std::floor(p.y() / cell)),
+                                       std::lround(std::floor(p.z() / cell)));
+      auto [it, added] =
+          cell_vertex.emplace(key, static_cast<std::uint32_t>(result->positions.size()));
+      const Eigen::Vector3f n =
+          source < mesh.normals.size() ? mesh.normals[source] : Eigen::Vector3f::UnitZ();
+      if (added) {
+        result->positions.push_back(p);
+        result->normals.push_back(n);
+        counts.push_back(1);
+      } else {
+        const std::uint32_t v = it->second;
+        result->positions[v] += p;
+        result->normals[v] += n;
+        ++counts[v - first_vertex];
+      }
+      return it->second;
+    };
+    Part out = part;
+    out.first_index = static_cast<std::uint32_t>(result->indices.size());
+    for (std::uint32_t i = part.first_index; i + 2 < part.first_index + part.index_count; i += 3) {
+      const std::uint32_t a = cluster(mesh.indices[i]);
+      const std::uint32_t b = cluster(mesh.indices[i + 1]);
+      const std::uint32_t c = cluster(mesh.indices[i + 2]);
+      if (a != b && b != c && a != c) result->indices.insert(result->indices.end(), {a, b, c});
+    }
+    for (std::uint32_t v = first_vertex; v < result->positions.size(); ++v) {
+      result->positions[v] /= static_cast<float>(counts[v - first_vertex]);
+      const float length = result->normals[v].norm();
+      result->normals[v] =
+          length > 1e-12F ? Eigen::Vector3f(result->normals[v] / length) : Eigen::Vector3f::UnitZ();
+    }
+    out.index_count = static_cast<std::uint32_t>(result->indices.size()) - out.first_index;
+    if (out.index_count > 0) result->parts.push_back(out);
+  }
+  return result;
 }
 
 std::shared_ptr<const MeshData> with_low_detail(const MeshData& fine,

@@ -48,6 +48,11 @@ std::shared_ptr<const MeshData> make_cylinder_mesh(int segments = 24);  // radiu
 /// uniformly, so each aspect ratio is its own mesh).
 std::shared_ptr<const MeshData> make_capsule_mesh(double length_over_radius, int segments = 24);
 
+/// A simplified copy of `mesh` for drawing small on screen: vertices are snapped to a grid of
+/// `cell` (mesh units) and merged within each part (so colours stay), triangles that collapse are
+/// dropped, and normals are averaged. Vertex clustering keeps the silhouette to about one cell.
+std::shared_ptr<const MeshData> simplify_by_clustering(const MeshData& mesh, float cell);
+
 /// A copy of `fine` that is drawn as `coarse` when its round cross-section (radius 1 in mesh
 /// units) covers fewer than `below_px` pixels of radius on screen.
 std::shared_ptr<const MeshData> with_low_detail(const MeshData& fine,

@@ -1,4 +1,6 @@
 // pixelgym view
+#include <algorithm>
+#include <iomanip>
 #include <iostream>
 #include <map>
 
@@ -52,11 +54,25 @@ int run_view(const ViewOptions& options) {
     view.scene().shadows = options.shadows;
     Renderer renderer;
     Array frame(DType::kUInt8, {options.height, options.width, 3});
-    renderer.render(view.scene(), camera, {frame.data<std::uint8_t>()});
+    std::vector<std::int32_t> ids(static_cast<std::size_t>(options.width) *
+                                  static_cast<std::size_t>(options.height));
+    renderer.render(view.scene(), camera, {frame.data<std::uint8_t>(), nullptr, ids.data()});
+    // How much of the frame the robot fills: a robot that cannot be seen is an error, not a PNG of
+    // an empty floor.
+    const auto covered =
+        std::count_if(ids.begin(), ids.end(), [](std::int32_t id) { return id > 0; });
+    const double coverage = static_cast<double>(covered) / static_cast<double>(ids.size());
+    if (covered == 0) {
+      throw std::runtime_error("view: robot \"" + model->name() + "\" covers no pixel of the " +
+                               std::to_string(options.width) + "x" +
+                               std::to_string(options.height) + " frame from camera " +
+                               options.camera);
+    }
     write_frame_png(options.out, frame);
     std::cout << "wrote " << options.out << " (" << options.width << "x" << options.height
               << ", robot \"" << model->name() << "\", " << view.scene().instances.size()
-              << " visual shapes, camera " << options.camera << ")\n";
+              << " visual shapes, camera " << options.camera << ", robot covers " << std::fixed
+              << std::setprecision(1) << 100.0 * coverage << "% of the frame)\n";
     return 0;
   }
   return 0;

@@ -151,5 +151,41 @@ TEST(PixelgymCliTest, InspectRefusesEveryBadFileNamingTheProblem) {
       0);
 }
 
+TEST(PixelgymCliTest, ViewRendersEveryAssetRobotVisibly) {
+  for (const char* urdf : {"cartpole/cartpole.urdf", "pendulum/pendulum.urdf",
+                           "acrobot/acrobot.urdf", "reacher/reacher.urdf", "arm/arm.urdf",
+                           "objects/table.urdf", "objects/cube.urdf", "objects/target.urdf"}) {
+    const std::string out = std::string(PIXELGYM_TEST_OUTPUT_DIR) + "/cli/view_" +
+                            std::filesystem::path(urdf).stem().string() + ".png";
+    std::filesystem::remove(out);
+    const CliRun result = run("view " + std::string(PIXELGYM_SOURCE_DIR) + "/assets/" + urdf +
+                              " --out " + out + " --width 160 --height 120");
+    ASSERT_EQ(result.exit_code, 0) << urdf << ": " << result.output;
+    const Image image = read_png(out);
+    EXPECT_EQ(image.width, 160);
+    EXPECT_EQ(image.height, 120);
+    // Framed automatically: the robot fills a good part of the picture.
+    const std::size_t at = result.output.find("robot covers ");
+    ASSERT_NE(at, std::string::npos) << result.output;
+    EXPECT_GT(std::stod(result.output.substr(at + 13)), 1.5) << urdf << ": " << result.output;
+  }
+}
+
+TEST(PixelgymCliTest, ViewRefusesBadInput) {
+  const std::string arm = std::string(PIXELGYM_SOURCE_DIR) + "/assets/arm/arm.urdf";
+  const std::string out = std::string(PIXELGYM_TEST_OUTPUT_DIR) + "/cli/bad.png";
+  EXPECT_EQ(run("view " + arm + " --out " + out + " --width 0").exit_code, 2);
+  EXPECT_EQ(run("view " + arm + " --out " + out + " --width 9000").exit_code, 2);
+  EXPECT_EQ(run("view " + arm + " --out " + out + " --msaa 3").exit_code, 2);
+  EXPECT_EQ(run("view " + arm + " --out " + out + " --camera nowhere").exit_code, 2);
+  EXPECT_EQ(run("view " + arm).exit_code, 2);  // --out is required
+  const CliRun missing = run("view /nonexistent/robot.urdf --out " + out);
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_THAT(missing.output, HasSubstr("/nonexistent/robot.urdf"));
+  const CliRun unwritable = run("view " + arm + " --out /proc/pixelgym/arm.png");
+  EXPECT_EQ(unwritable.exit_code, 1);
+  EXPECT_THAT(unwritable.output, HasSubstr("/proc/pixelgym"));
+}
+
 }  // namespace
 }  // namespace pixelgym
