@@ -1,0 +1,160 @@
+#include "envs/pixel_env.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "envs/spaces/box.h"
+#include "envs/spaces/dict.h"
+
+namespace pixelgym {
+namespace {
+
+constexpr int kMinImageSize = 16;
+constexpr int kMaxImageSize = 8192;
+constexpr int kRenderMsaaSamples = 4;
+
+int read_size(const Params& params, const std::string& key, const std::string& env) {
+  const std::int64_t value = params.at(key).as_int();
+  if (value < kMinImageSize || value > kMaxImageSize) {
+    throw std::invalid_argument(env + ": " + key + " must be in [" + std::to_string(kMinImageSize) +
+                                ", " + std::to_string(kMaxImageSize) + "], got " +
+                                std::to_string(value));
+  }
+  return static_cast<int>(value);
+}
+
+}  // namespace
+
+std::vector<ParamSpec> TaskConfig::params() {
+  const TaskConfig d;
+  return {{"width", d.width, "observation image width in pixels"},
+          {"height", d.height, "observation image height in pixels"},
+          {"camera", d.camera, "observation and render() camera (empty: the task's default)"},
+          {"obs_mode", d.obs_mode, "\"pixels+state\", \"pixels\" or \"state\""},
+          {"render_width", d.render_width, "render() frame width in pixels"},
+          {"render_height", d.render_height, "render() frame height in pixels"},
+          {"action_repeat", d.action_repeat, "control steps per env step (rewards are summed)"},
+          {"shadows", d.shadows, "draw shadows in observations and render()"}};
+}
+
+TaskConfig TaskConfig::from_params(const Params& params, const std::vector<std::string>& cameras,
+                                   const std::string& env) {
+  TaskConfig c;
+  c.width = read_size(params, "width", env);
+  c.height = read_size(params, "height", env);
+  c.render_width = read_size(params, "render_width", env);
+  c.render_height = read_size(params, "render_height", env);
+  c.camera = params.at("camera").as_string();
+  if (!c.camera.empty() && std::find(cameras.begin(), cameras.end(), c.camera) == cameras.end()) {
+    std::string names;
+    for (const std::string& name : cameras) names += (names.empty() ? "\"" : ", \"") + name + "\"";
+    throw std::invalid_argument(env + ": unknown camera \"" + c.camera + "\"; cameras: " + names);
+  }
+  c.obs_mode = params.at("obs_mode").as_string();
+  if (c.obs_mode != "pixels+state" && c.obs_mode != "pixels" && c.obs_mode != "state") {
+    throw std::invalid_argument(
+        env + ": obs_mode must be \"pixels+state\", \"pixels\" or \"state\", got \"" + c.obs_mode +
+        "\"");
+  }
+  const std::int64_t repeat = params.at("action_repeat").as_int();
+  if (repeat < 1 || repeat > 1000) {
+    throw std::invalid_argument(env + ": action_repeat must be in [1, 1000], got " +
+                                std::to_string(repeat));
+  }
+  c.action_repeat = static_cast<int>(repeat);
+  c.shadows = params.at("shadows").as_bool();
+  return c;
+}
+
+PixelEnv::PixelEnv(std::unique_ptr<Task> task, TaskConfig config, std::string name)
+    : task_(std::move(task)), config_(std::move(config)), name_(std::move(name)) {
+  if (task_ == nullptr) throw std::invalid_argument("PixelEnv: task is null");
+  const std::vector<std::string> cameras = task_->camera_names();
+  camera_ = config_.camera.empty() ? cameras.at(0) : config_.camera;
+  // Spaces from the config and the task alone.
+  spaces::Dict::Entries entries;
+  if (config_.has_pixels()) {
+    entries.emplace_back(
+        "pixels", std::make_shared<spaces::Box>(0.0, 255.0, Shape{config_.height, config_.width, 3},
+                                                DType::kUInt8));
+  }
+  if (config_.has_state()) {
+    const double inf = std::numeric_limits<double>::infinity();
+    for (const StateSpec& spec : task_->state_specs()) {
+      entries.emplace_back(spec.name,
+                           std::make_shared<spaces::Box>(-inf, inf, spec.shape, DType::kFloat32));
+    }
+  }
+  observation_space_ = std::make_shared<spaces::Dict>(std::move(entries));
+  action_space_ = task_->action_space();
+  const engine::WorldConfig world_config = task_->world_config();
+  substeps_ = std::max(
+      1, static_cast<int>(std::lround(task_->control_timestep_s() / world_config.timestep_s)));
+  metadata_.render_fps = 1.0 / (task_->control_timestep_s() * config_.action_repeat);
+  world_ = std::make_unique<engine::World>(world_config);
+  task_->build(*world_);
+  scene_ = std::make_unique<WorldScene>(*world_);
+  scene_->scene().shadows = config_.shadows;
+}
+
+PixelEnv::~PixelEnv() = default;
+
+Renderer& PixelEnv::renderer() {
+  if (renderer_ == nullptr) renderer_ = std::make_unique<Renderer>();
+  return *renderer_;
+}
+
+ResetResult PixelEnv::do_reset(std::optional<std::uint64_t> /*seed*/, const Options& options) {
+  if (!options.empty()) {
+    throw std::invalid_argument(name() + ": reset() takes no options, got \"" +
+                                options.begin()->first + "\"");
+  }
+  world_->reset();
+  task_->initialize_episode(*world_, rng());
+  control_steps_ = 0;
+  return {observe(), {}};
+}
+
+StepResult PixelEnv::do_step(const Value& action) {
+  StepResult result;
+  for (int r = 0; r < config_.action_repeat; ++r) {
+    task_->before_step(action, *world_);
+    world_->step(substeps_);
+    ++control_steps_;
+    result.reward += task_->reward(*world_);
+    result.terminated = task_->terminated(*world_);
+    if (result.terminated || control_steps_ >= task_->episode_length()) break;
+  }
+  result.truncated = !result.terminated && control_steps_ >= task_->episode_length();
+  result.obs = observe();
+  return result;
+}
+
+Value PixelEnv::observe() {
+  Dict obs;
+  if (config_.has_pixels())
+    obs.insert("pixels", render_camera(camera_, config_.width, config_.height, 0));
+  if (config_.has_state()) task_->observe(*world_, obs);
+  return obs;
+}
+
+Array PixelEnv::render_camera(const std::string& camera, int width, int height, int msaa_samples) {
+  scene_->update(*world_);
+  Camera view = task_->camera(camera, *world_);
+  view.width = width;
+  view.height = height;
+  view.msaa_samples = msaa_samples;
+  Array frame(DType::kUInt8, {height, width, 3});
+  renderer().render(scene_->scene(), view, {frame.data<std::uint8_t>()});
+  return frame;
+}
+
+Array PixelEnv::do_render() {
+  return render_camera(camera_, config_.render_width, config_.render_height, kRenderMsaaSamples);
+}
+
+void PixelEnv::do_close() { renderer_.reset(); }
+
+}  // namespace pixelgym

@@ -1,0 +1,66 @@
+// PixelEnv: the one environment class that runs every pixel task.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "engine/world.h"
+#include "envs/env.h"
+#include "envs/task.h"
+#include "envs/world_scene.h"
+#include "render/renderer.h"
+
+namespace pixelgym {
+
+/// Runs a Task: reset rebuilds the world and lets the task set the episode's start; each step
+/// repeats `action_repeat` times before_step -> physics steps -> reward, then observes.
+/// Observations are Dict{"pixels": (H, W, 3) uint8, <state arrays>: float32} per obs_mode;
+/// spaces come from the config and the task alone, before any world exists. The renderer (an
+/// OpenGL context) is created on first use, so obs_mode="state" never renders.
+/// Episodes are truncated after the task's episode length in control steps.
+class PixelEnv final : public Env {
+ public:
+  /// `name` is how messages name the env before the registry sets its id.
+  PixelEnv(std::unique_ptr<Task> task, TaskConfig config, std::string name);
+  ~PixelEnv() override;
+
+  const Space& observation_space() const override { return *observation_space_; }
+  const Space& action_space() const override { return *action_space_; }
+  const Metadata& metadata() const override { return metadata_; }
+
+  const Task& task() const { return *task_; }
+  const TaskConfig& config() const { return config_; }
+  /// The simulation, for inspection and scripted controllers (do not add bodies to it).
+  const engine::World& world() const { return *world_; }
+  /// Control steps taken in this episode.
+  int control_steps() const { return control_steps_; }
+
+  /// The observation camera's image at any size (for tests and tools).
+  Array render_camera(const std::string& camera, int width, int height, int msaa_samples);
+
+ protected:
+  std::string type_name() const override { return name_; }
+  ResetResult do_reset(std::optional<std::uint64_t> seed, const Options& options) override;
+  StepResult do_step(const Value& action) override;
+  Array do_render() override;
+  void do_close() override;
+
+ private:
+  Value observe();
+  Renderer& renderer();
+
+  std::unique_ptr<Task> task_;
+  TaskConfig config_;
+  std::string name_;
+  std::string camera_;
+  SpacePtr observation_space_;
+  SpacePtr action_space_;
+  Metadata metadata_;
+  int substeps_ = 1;
+  std::unique_ptr<engine::World> world_;
+  std::unique_ptr<WorldScene> scene_;
+  std::unique_ptr<Renderer> renderer_;
+  int control_steps_ = 0;
+};
+
+}  // namespace pixelgym

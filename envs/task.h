@@ -1,0 +1,88 @@
+// Task: what one pixel task is — its world, cameras, actions, observations, reward, termination.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "engine/world.h"
+#include "envs/params.h"
+#include "envs/rng.h"
+#include "envs/space.h"
+#include "envs/value.h"
+#include "render/camera.h"
+
+namespace pixelgym {
+
+/// The settings every pixel task shares (`make` kwargs and `--set` keys).
+struct TaskConfig {
+  /// Observation image size in pixels.
+  int width = 84;
+  int height = 84;
+  /// One of the task's camera names; empty for its default (the first).
+  std::string camera;
+  /// "pixels+state": Dict of "pixels" and the state arrays; "pixels": only "pixels";
+  /// "state": only the state arrays (no rendering at all).
+  std::string obs_mode = "pixels+state";
+  /// Size of `render()` frames (anti-aliased), separate from the observation.
+  int render_width = 256;
+  int render_height = 256;
+  /// Control steps per env step; rewards are summed over them.
+  int action_repeat = 1;
+  bool shadows = true;
+
+  bool has_pixels() const { return obs_mode != "state"; }
+  bool has_state() const { return obs_mode != "pixels"; }
+
+  /// The keys above with their defaults and docs.
+  static std::vector<ParamSpec> params();
+  /// Reads resolved kwargs. Throws std::invalid_argument, naming `env` and the key, for a size
+  /// outside [16, 8192], an unknown obs_mode or camera, or action_repeat < 1.
+  static TaskConfig from_params(const Params& params, const std::vector<std::string>& cameras,
+                                const std::string& env);
+};
+
+/// A named float32 state array of the observation.
+struct StateSpec {
+  std::string name;
+  Shape shape;
+};
+
+/// One task, written like dm_control's suite files: how its world is built, named quantities,
+/// then initialize_episode / before_step / observe / reward / terminated. PixelEnv runs it.
+/// Everything that fixes the spaces (action_space, state_specs, camera_names) is known without a
+/// world.
+class Task {
+ public:
+  virtual ~Task() = default;
+
+  /// Camera names; the first is the default for observations and render().
+  virtual std::vector<std::string> camera_names() const = 0;
+  virtual SpacePtr action_space() const = 0;
+  /// The state arrays, in observation order.
+  virtual std::vector<StateSpec> state_specs() const = 0;
+  /// Seconds of simulated time per control step, and the physics steps that make it.
+  virtual double control_timestep_s() const = 0;
+  virtual engine::WorldConfig world_config() const = 0;
+  /// Control steps per episode; PixelEnv truncates after them (whatever the action repeat).
+  virtual int episode_length() const { return 1000; }
+
+  /// Adds the robots and bodies.
+  virtual void build(engine::World& world) = 0;
+  /// Camera `name` for the world's current state (tracking cameras follow a body). The image
+  /// size is set by the caller.
+  virtual Camera camera(const std::string& name, const engine::World& world) const = 0;
+
+  /// Sets the start of an episode in a freshly reset world, drawing from `rng`.
+  virtual void initialize_episode(engine::World& world, Rng& rng) = 0;
+  /// Applies an action already known to be in action_space().
+  virtual void before_step(const Value& action, engine::World& world) = 0;
+  /// Writes every state array of state_specs() into `state` (each a new float32 array).
+  virtual void observe(const engine::World& world, Dict& state) const = 0;
+  /// This control step's reward, in [0, 1].
+  virtual double reward(const engine::World& world) const = 0;
+  virtual bool terminated(const engine::World& /*world*/) const { return false; }
+};
+
+}  // namespace pixelgym

@@ -1,0 +1,119 @@
+#include "envs/tasks/cartpole.h"
+
+#include <cmath>
+
+#include "engine/robot_model.h"
+#include "envs/pixel_env.h"
+#include "envs/spaces/box.h"
+#include "envs/spaces/discrete.h"
+#include "envs/tasks/reward.h"
+
+namespace pixelgym {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+double wrap_angle(double angle) {
+  return angle - 2.0 * kPi * std::floor((angle + kPi) / (2.0 * kPi));
+}
+
+}  // namespace
+
+CartPoleTask::CartPoleTask(bool swing_up, bool discrete)
+    : swing_up_(swing_up),
+      discrete_(discrete),
+      action_space_(discrete ? SpacePtr(std::make_shared<spaces::Discrete>(3))
+                             : SpacePtr(std::make_shared<spaces::Box>(-1.0, 1.0, Shape{1}))) {}
+
+engine::WorldConfig CartPoleTask::world_config() const {
+  engine::WorldConfig config;
+  config.timestep_s = 0.005;  // two physics steps per control step
+  return config;
+}
+
+void CartPoleTask::build(engine::World& world) {
+  robot_ = world.add_robot(
+      engine::default_model_cache().load_urdf(engine::asset_path("cartpole/cartpole.urdf")));
+}
+
+Camera CartPoleTask::camera(const std::string& name, const engine::World& world) const {
+  const float x = name == "tracking" ? static_cast<float>(cart_position(world)) : 0.0F;
+  Camera camera = Camera::look_at({x, -4.0F, 0.9F}, {x, 0.0F, 1.3F});
+  camera.fov_y_deg = 50.0F;
+  return camera;
+}
+
+void CartPoleTask::initialize_episode(engine::World& world, Rng& rng) {
+  Eigen::VectorXd q(2);
+  Eigen::VectorXd qd(2);
+  q[0] = rng.uniform(-0.25, 0.25);
+  q[1] = swing_up_ ? kPi + rng.uniform(-0.1, 0.1) : rng.uniform(-0.05, 0.05);
+  qd[0] = 0.01 * rng.normal();
+  qd[1] = 0.01 * rng.normal();
+  world.set_joint_state(robot_, q, qd);
+  control_ = 0.0;
+}
+
+void CartPoleTask::before_step(const Value& action, engine::World& world) {
+  const Array& a = action.array();
+  control_ = discrete_ ? static_cast<double>(a.element_as_double(0)) - 1.0 : a.element_as_double(0);
+  world.set_joint_commands(robot_, (Eigen::VectorXd(2) << kMaxForceN * control_, 0.0).finished());
+}
+
+double CartPoleTask::cart_position(const engine::World& world) const {
+  return world.joint_positions(robot_)[0];
+}
+
+double CartPoleTask::pole_angle(const engine::World& world) const {
+  return wrap_angle(world.joint_positions(robot_)[1]);
+}
+
+double CartPoleTask::pole_angular_velocity(const engine::World& world) const {
+  return world.joint_velocities(robot_)[1];
+}
+
+void CartPoleTask::observe(const engine::World& world, Dict& state) const {
+  const Eigen::VectorXd qd = world.joint_velocities(robot_);
+  state.insert("joint_pos",
+               Array::from_vector<float>({2}, {static_cast<float>(cart_position(world)),
+                                               static_cast<float>(pole_angle(world))}));
+  state.insert("joint_vel", Array::from_vector<float>(
+                                {2}, {static_cast<float>(qd[0]), static_cast<float>(qd[1])}));
+}
+
+double CartPoleTask::reward(const engine::World& world) const {
+  using reward::Sigmoid;
+  using reward::tolerance;
+  const double upright = (std::cos(pole_angle(world)) + 1.0) / 2.0;
+  const double centred = (1.0 + tolerance(cart_position(world), 0.0, 0.0, 2.0)) / 2.0;
+  const double small_control =
+      (4.0 + tolerance(control_, 0.0, 0.0, 1.0, Sigmoid::kQuadratic, 0.0)) / 5.0;
+  const double small_velocity =
+      (1.0 + tolerance(pole_angular_velocity(world), 0.0, 0.0, 5.0)) / 2.0;
+  return upright * centred * small_control * small_velocity;
+}
+
+std::vector<EnvSpec> CartPoleTask::specs() {
+  std::vector<EnvSpec> specs;
+  for (const bool swing_up : {false, true}) {
+    for (const bool discrete : {false, true}) {
+      EnvSpec spec;
+      spec.id = std::string("CartPole") + (swing_up ? "Swingup" : "Balance") +
+                (discrete ? "Discrete" : "") + "-v0";
+      spec.description = std::string(swing_up ? "swing the pole up from hanging and balance it"
+                                              : "keep the pole upright") +
+                         (discrete ? "; Discrete(3) pushes" : "; force in [-1, 1]");
+      spec.params = TaskConfig::params();
+      const std::string id = spec.id;
+      spec.factory = [swing_up, discrete, id](const Params& kwargs) {
+        auto task = std::make_unique<CartPoleTask>(swing_up, discrete);
+        TaskConfig config = TaskConfig::from_params(kwargs, task->camera_names(), id);
+        return std::make_unique<PixelEnv>(std::move(task), std::move(config), id);
+      };
+      specs.push_back(std::move(spec));
+    }
+  }
+  return specs;
+}
+
+}  // namespace pixelgym

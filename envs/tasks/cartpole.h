@@ -1,0 +1,58 @@
+// CartPoleBalance-v0, CartPoleSwingup-v0 and their Discrete variants.
+#pragma once
+
+#include "envs/registry.h"
+#include "envs/task.h"
+
+namespace pixelgym {
+
+/// A pole hinged on a cart that slides on a rail (assets/cartpole). The action pushes the cart:
+/// Box(-1, 1, (1,)) times 10 N, or Discrete(3) = {push left, nothing, push right}.
+/// - Balance: the pole starts near upright; Swingup: it starts hanging down.
+/// - Reward per step in [0, 1] (dm_control's cart-pole): upright * centred * small control *
+///   small angular velocity, where upright = (cos(pole angle) + 1) / 2.
+/// - State: joint_pos = (cart position m, pole angle rad in (-pi, pi], 0 upright),
+///   joint_vel = their rates. 1000 control steps of 0.01 s per episode; no termination.
+/// - Cameras: "fixed" (front, the default) and "tracking" (follows the cart).
+class CartPoleTask final : public Task {
+ public:
+  CartPoleTask(bool swing_up, bool discrete);
+
+  std::vector<std::string> camera_names() const override { return {"fixed", "tracking"}; }
+  SpacePtr action_space() const override { return action_space_; }
+  std::vector<StateSpec> state_specs() const override {
+    return {{"joint_pos", {2}}, {"joint_vel", {2}}};
+  }
+  double control_timestep_s() const override { return 0.01; }
+  engine::WorldConfig world_config() const override;
+
+  void build(engine::World& world) override;
+  Camera camera(const std::string& name, const engine::World& world) const override;
+  void initialize_episode(engine::World& world, Rng& rng) override;
+  void before_step(const Value& action, engine::World& world) override;
+  void observe(const engine::World& world, Dict& state) const override;
+  double reward(const engine::World& world) const override;
+
+  /// Named quantities.
+  double cart_position(const engine::World& world) const;
+  /// Wrapped to (-pi, pi]; 0 is upright.
+  double pole_angle(const engine::World& world) const;
+  double pole_angular_velocity(const engine::World& world) const;
+  /// The last force command in [-1, 1].
+  double control() const { return control_; }
+
+  static constexpr double kMaxForceN = 10.0;
+
+  /// The registry entries: CartPoleBalance-v0, CartPoleSwingup-v0, CartPoleBalanceDiscrete-v0,
+  /// CartPoleSwingupDiscrete-v0.
+  static std::vector<EnvSpec> specs();
+
+ private:
+  bool swing_up_;
+  bool discrete_;
+  SpacePtr action_space_;
+  int robot_ = 0;
+  double control_ = 0.0;
+};
+
+}  // namespace pixelgym
