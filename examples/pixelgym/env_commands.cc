@@ -1,4 +1,6 @@
-// pixelgym list | info | check | snapshot | rollout
+// pixelgym list | info | check | snapshot | rollout | bench
+#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
@@ -112,6 +114,34 @@ int run_rollout(const std::string& id, std::uint64_t seed, int episodes,
   return 0;
 }
 
+int run_bench(const std::string& id, std::uint64_t seed, int steps,
+              const std::vector<std::string>& sets) {
+  std::unique_ptr<Env> env = make_env(id, sets);
+  Rng action_rng(seed);
+  env->reset(seed);
+  // Warm up (shader compilation, caches) outside the timed loop.
+  for (int t = 0; t < 20; ++t) {
+    const StepResult step = env->step(env->action_space().sample(action_rng));
+    if (step.terminated || step.truncated) env->reset();
+  }
+  int episodes = 0;
+  const auto start = std::chrono::steady_clock::now();
+  for (int t = 0; t < steps; ++t) {
+    const StepResult step = env->step(env->action_space().sample(action_rng));
+    if (step.terminated || step.truncated) {
+      env->reset();
+      ++episodes;
+    }
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::cout << id << ": " << steps << " steps (" << episodes << " resets) in " << seconds
+            << " s, one thread\n";
+  std::cout << "steps_per_s=" << static_cast<long>(std::lround(steps / seconds)) << "\n";
+  env->close();
+  return 0;
+}
+
 }  // namespace
 
 std::vector<Command> add_env_commands(CLI::App& app) {
@@ -181,6 +211,21 @@ std::vector<Command> add_env_commands(CLI::App& app) {
   commands.push_back({rollout, [options] {
                         return run_rollout(options->id, options->seed, options->episodes,
                                            options->out, options->sets);
+                      }});
+  CLI::App* bench = app.add_subcommand(
+      "bench",
+      "Step an env with seeded random actions (resetting when done) and print steps_per_s= for "
+      "physics + "
+      "render + observation, one thread (--set obs_mode=state for physics alone)");
+  bench->add_option("id", options->id, "Env id, e.g. CartPoleSwingup-v0")->required();
+  bench->add_option("--steps", options->steps, "Steps to time")
+      ->default_val(2000)
+      ->check(CLI::PositiveNumber);
+  bench->add_option("--seed", options->seed, "Seed for the reset and the random actions")
+      ->capture_default_str();
+  add_set_option(*bench, options->sets);
+  commands.push_back({bench, [options] {
+                        return run_bench(options->id, options->seed, options->steps, options->sets);
                       }});
   return commands;
 }

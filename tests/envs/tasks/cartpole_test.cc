@@ -1,0 +1,165 @@
+#include "envs/tasks/cartpole.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <iostream>
+
+#include "envs/pixel_env.h"
+#include "envs/registry.h"
+
+namespace pixelgym {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// The cart-pole asset's parameters: cart 1 kg, pole 0.1 kg with its centre 0.5 m from the hinge
+// and 0.00833 kg m^2 about it.
+constexpr double kCartMass = 1.0;
+constexpr double kPoleMass = 0.1;
+constexpr double kPoleCentre = 0.5;
+constexpr double kPoleInertia =
+    0.008333 + kPoleMass * kPoleCentre * kPoleCentre;  // about the hinge
+constexpr double kG = 9.81;
+
+// LQR gains for the upright cart-pole, from its linearization about theta = 0, discretized at
+// the control step, by iterating the discrete Riccati equation.
+Eigen::RowVector4d lqr_gains(double dt) {
+  Eigen::Matrix2d mass;
+  mass << kCartMass + kPoleMass, kPoleMass * kPoleCentre, kPoleMass * kPoleCentre, kPoleInertia;
+  const Eigen::Matrix2d inverse = mass.inverse();
+  // state (x, theta, x_dot, theta_dot); input: force in N.
+  Eigen::Matrix4d a = Eigen::Matrix4d::Zero();
+  a(0, 2) = a(1, 3) = 1.0;
+  a.block<2, 1>(2, 1) = inverse * Eigen::Vector2d(0.0, kPoleMass * kG * kPoleCentre);
+  Eigen::Vector4d b = Eigen::Vector4d::Zero();
+  b.tail<2>() = inverse * Eigen::Vector2d(1.0, 0.0);
+  const Eigen::Matrix4d ad = Eigen::Matrix4d::Identity() + dt * a;
+  const Eigen::Vector4d bd = dt * b;
+  const Eigen::Matrix4d q = Eigen::Vector4d(1.0, 10.0, 0.5, 0.5).asDiagonal();
+  const double r = 0.05;
+  Eigen::Matrix4d p = q;
+  Eigen::RowVector4d k = Eigen::RowVector4d::Zero();
+  for (int i = 0; i < 5000; ++i) {
+    k = (bd.transpose() * p * ad) / (r + (bd.transpose() * p * bd)(0, 0));
+    p = q + ad.transpose() * p * (ad - bd * k);
+  }
+  return k;
+}
+
+// Energy pumping far from upright, LQR near it. Returns the command in [-1, 1].
+double swing_up_and_balance(const Eigen::Vector4d& s, const Eigen::RowVector4d& k) {
+  const double theta = s[1];
+  double force;
+  if (std::abs(theta) < 0.35) {
+    force = -(k * s)(0, 0);
+  } else {
+    // Pole energy relative to resting upright; drive it to 0 by moving the cart with the
+    // pole's swing, and keep the cart near the middle.
+    const double energy =
+        0.5 * kPoleInertia * s[3] * s[3] + kPoleMass * kG * kPoleCentre * (std::cos(theta) - 1.0);
+    const double pump = (s[3] * std::cos(theta) >= 0 ? 1.0 : -1.0) * energy;
+    force = 150.0 * pump - 2.0 * s[0] - 2.0 * s[2];
+  }
+  return std::clamp(force / CartPoleTask::kMaxForceN, -1.0, 1.0);
+}
+
+double run_episode(Env& env, std::uint64_t seed, bool scripted) {
+  const Eigen::RowVector4d k = lqr_gains(0.01);
+  Value obs = env.reset(seed).obs;
+  Rng rng(seed);
+  double total = 0.0;
+  for (;;) {
+    Value action;
+    if (scripted) {
+      const Array& pos = obs.dict().at("joint_pos").array();
+      const Array& vel = obs.dict().at("joint_vel").array();
+      const Eigen::Vector4d s(pos.data<float>()[0], pos.data<float>()[1], vel.data<float>()[0],
+                              vel.data<float>()[1]);
+      action = Array::from_vector<float>({1}, {static_cast<float>(swing_up_and_balance(s, k))});
+    } else {
+      action = env.action_space().sample(rng);
+    }
+    const StepResult step = env.step(action);
+    total += step.reward;
+    obs = step.obs;
+    if (step.terminated || step.truncated) return total;
+  }
+}
+
+TEST(CartPoleTest, EnergyPumpingAndLqrSwingUpAndHold) {
+  std::unique_ptr<Env> env = make("CartPoleSwingup-v0", {{"obs_mode", "state"}});
+  const double scripted = run_episode(*env, 0, true);
+  const double random = run_episode(*env, 0, false);
+  std::cout << "CartPoleSwingup-v0 return over 1000 steps: scripted " << scripted << ", random "
+            << random << "\n";
+  EXPECT_GE(scripted, 700.0);
+  EXPECT_LT(random, 200.0);
+}
+
+TEST(CartPoleTest, LqrHoldsTheBalanceTask) {
+  std::unique_ptr<Env> env = make("CartPoleBalance-v0", {{"obs_mode", "state"}});
+  const double scripted = run_episode(*env, 1, true);
+  const double random = run_episode(*env, 1, false);
+  std::cout << "CartPoleBalance-v0 return over 1000 steps: scripted " << scripted << ", random "
+            << random << "\n";
+  EXPECT_GE(scripted, 900.0);
+  EXPECT_LT(random, scripted - 200.0);
+}
+
+TEST(CartPoleTest, EpisodeIsOneThousandControlStepsWhateverTheActionRepeat) {
+  for (const int repeat : {1, 4}) {
+    std::unique_ptr<Env> env =
+        make("CartPoleBalance-v0", {{"obs_mode", "state"}, {"action_repeat", repeat}});
+    env->reset(0);
+    int steps = 0;
+    StepResult step;
+    do {
+      step = env->step(Array::from_vector<float>({1}, {0.0F}));
+      ++steps;
+    } while (!step.truncated && !step.terminated);
+    EXPECT_EQ(steps, 1000 / repeat);
+    EXPECT_TRUE(step.truncated);
+    EXPECT_LE(step.reward, static_cast<double>(repeat));
+  }
+}
+
+TEST(CartPoleTest, RewardIsHighUprightAndLowHanging) {
+  std::unique_ptr<Env> balance = make("CartPoleBalance-v0", {{"obs_mode", "state"}});
+  balance->reset(2);
+  EXPECT_GT(balance->step(Array::from_vector<float>({1}, {0.0F})).reward, 0.9);
+  std::unique_ptr<Env> swing = make("CartPoleSwingup-v0", {{"obs_mode", "state"}});
+  swing->reset(2);
+  EXPECT_LT(swing->step(Array::from_vector<float>({1}, {0.0F})).reward, 0.05);
+}
+
+TEST(CartPoleTest, DiscreteActionsPushLeftNothingRight) {
+  std::unique_ptr<Env> env = make("CartPoleBalanceDiscrete-v0", {{"obs_mode", "state"}});
+  for (std::int64_t a = 0; a < 3; ++a) {
+    Value obs = env->reset(3).obs;
+    const float x0 = obs.dict().at("joint_pos").array().data<float>()[0];
+    for (int t = 0; t < 20; ++t) obs = env->step(Array::scalar<std::int64_t>(a)).obs;
+    const float dx = obs.dict().at("joint_pos").array().data<float>()[0] - x0;
+    const float expected_sign = static_cast<float>(a - 1);
+    if (a == 1) {
+      EXPECT_NEAR(dx, 0.0F, 0.05F);
+    } else {
+      EXPECT_GT(dx * expected_sign, 0.05F) << "action " << a;
+    }
+  }
+}
+
+TEST(CartPoleTest, ConfigKeysAreValidated) {
+  EXPECT_THROW(make("CartPoleSwingup-v0", {{"camera", "top"}}), std::invalid_argument);
+  EXPECT_THROW(make("CartPoleSwingup-v0", {{"obs_mode", "rgb"}}), std::invalid_argument);
+  EXPECT_THROW(make("CartPoleSwingup-v0", {{"width", 8}}), std::invalid_argument);
+  EXPECT_THROW(make("CartPoleSwingup-v0", {{"action_repeat", 0}}), std::invalid_argument);
+  auto env = make("CartPoleSwingup-v0", {{"width", 64}, {"height", 48}, {"obs_mode", "pixels"}});
+  EXPECT_EQ(env->reset(0).obs.dict().keys(), std::vector<std::string>{"pixels"});
+  EXPECT_EQ(env->reset(0).obs.dict().at("pixels").array().shape(), (Shape{48, 64, 3}));
+  EXPECT_DOUBLE_EQ(env->metadata().render_fps, 100.0);
+}
+
+}  // namespace
+}  // namespace pixelgym
