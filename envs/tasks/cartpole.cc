@@ -6,18 +6,10 @@
 #include "envs/pixel_env.h"
 #include "envs/spaces/box.h"
 #include "envs/spaces/discrete.h"
+#include "envs/tasks/angles.h"
 #include "envs/tasks/reward.h"
 
 namespace pixelgym {
-namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-double wrap_angle(double angle) {
-  return angle - 2.0 * kPi * std::floor((angle + kPi) / (2.0 * kPi));
-}
-
-}  // namespace
 
 CartPoleTask::CartPoleTask(bool swing_up, bool discrete)
     : swing_up_(swing_up),

@@ -11,7 +11,7 @@ namespace pixelgym {
 /// - Balance: the pole starts near upright; Swingup: it starts hanging down.
 /// - Reward per step in [0, 1] (dm_control's cart-pole): upright * centred * small control *
 ///   small angular velocity, where upright = (cos(pole angle) + 1) / 2.
-/// - State: joint_pos = (cart position m, pole angle rad in (-pi, pi], 0 upright),
+/// - State: joint_pos = (cart position m, pole angle rad in [-pi, pi), 0 upright),
 ///   joint_vel = their rates. 1000 control steps of 0.01 s per episode; no termination.
 /// - Cameras: "fixed" (front, the default) and "tracking" (follows the cart).
 class CartPoleTask final : public Task {
@@ -35,7 +35,7 @@ class CartPoleTask final : public Task {
 
   /// Named quantities.
   double cart_position(const engine::World& world) const;
-  /// Wrapped to (-pi, pi]; 0 is upright.
+  /// Wrapped to [-pi, pi); 0 is upright.
   double pole_angle(const engine::World& world) const;
   double pole_angular_velocity(const engine::World& world) const;
   /// The last force command in [-1, 1].

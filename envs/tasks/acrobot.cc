@@ -1,0 +1,79 @@
+#include "envs/tasks/acrobot.h"
+
+#include "engine/robot_model.h"
+#include "envs/pixel_env.h"
+#include "envs/spaces/box.h"
+#include "envs/tasks/angles.h"
+#include "envs/tasks/reward.h"
+
+namespace pixelgym {
+
+const Eigen::Vector3d AcrobotTask::kTop{0.0, 0.0, 4.2};
+
+SpacePtr AcrobotTask::action_space() const {
+  return std::make_shared<spaces::Box>(-1.0, 1.0, Shape{1});
+}
+
+engine::WorldConfig AcrobotTask::world_config() const {
+  engine::WorldConfig config;
+  config.timestep_s = 0.005;
+  return config;
+}
+
+void AcrobotTask::build(engine::World& world) {
+  const auto model =
+      engine::default_model_cache().load_urdf(engine::asset_path("acrobot/acrobot.urdf"));
+  robot_ = world.add_robot(model);
+  lower_arm_ = model->link_index("lower_arm");
+}
+
+Camera AcrobotTask::camera(const std::string& name, const engine::World& /*world*/) const {
+  Camera camera = name == "wide" ? Camera::look_at({3.0F, -6.5F, 3.0F}, {0.0F, 0.0F, 2.1F})
+                                 : Camera::look_at({0.0F, -5.8F, 2.2F}, {0.0F, 0.0F, 2.2F});
+  camera.fov_y_deg = 45.0F;
+  return camera;
+}
+
+void AcrobotTask::initialize_episode(engine::World& world, Rng& rng) {
+  Eigen::VectorXd q(2);
+  q << rng.uniform(-kPi, kPi), rng.uniform(-kPi, kPi);
+  world.set_joint_state(robot_, q, Eigen::VectorXd::Zero(2));
+}
+
+void AcrobotTask::before_step(const Value& action, engine::World& world) {
+  world.set_joint_commands(
+      robot_,
+      (Eigen::VectorXd(2) << 0.0, kMaxTorqueNm * action.array().element_as_double(0)).finished());
+}
+
+Eigen::Vector3d AcrobotTask::tip(const engine::World& world) const {
+  return world.link_pose(robot_, lower_arm_) * Eigen::Vector3d(0.0, 0.0, -1.0);
+}
+
+void AcrobotTask::observe(const engine::World& world, Dict& state) const {
+  const Eigen::VectorXd q = world.joint_positions(robot_);
+  const Eigen::VectorXd qd = world.joint_velocities(robot_);
+  state.insert("joint_pos", Array::from_vector<float>({2}, {static_cast<float>(wrap_angle(q[0])),
+                                                            static_cast<float>(wrap_angle(q[1]))}));
+  state.insert("joint_vel", Array::from_vector<float>(
+                                {2}, {static_cast<float>(qd[0]), static_cast<float>(qd[1])}));
+}
+
+double AcrobotTask::reward(const engine::World& world) const {
+  return reward::tolerance((tip(world) - kTop).norm(), 0.0, 0.2, 1.0);
+}
+
+EnvSpec AcrobotTask::spec_v0() {
+  EnvSpec spec;
+  spec.id = "AcrobotSwingup-v0";
+  spec.description = "swing a two-link arm up with its elbow alone; torque in [-1, 1]";
+  spec.params = TaskConfig::params();
+  spec.factory = [](const Params& kwargs) {
+    auto task = std::make_unique<AcrobotTask>();
+    TaskConfig config = TaskConfig::from_params(kwargs, task->camera_names(), "AcrobotSwingup-v0");
+    return std::make_unique<PixelEnv>(std::move(task), std::move(config), "AcrobotSwingup-v0");
+  };
+  return spec;
+}
+
+}  // namespace pixelgym

@@ -1,0 +1,113 @@
+#include "envs/tasks/reacher.h"
+
+#include <cmath>
+
+#include "engine/robot_model.h"
+#include "envs/pixel_env.h"
+#include "envs/spaces/box.h"
+#include "envs/tasks/angles.h"
+#include "envs/tasks/reward.h"
+
+namespace pixelgym {
+
+ReacherTask::ReacherTask(double target_radius_m) : target_radius_m_(target_radius_m) {}
+
+SpacePtr ReacherTask::action_space() const {
+  return std::make_shared<spaces::Box>(-1.0, 1.0, Shape{2});
+}
+
+engine::WorldConfig ReacherTask::world_config() const {
+  engine::WorldConfig config;
+  config.timestep_s = 0.005;
+  return config;
+}
+
+void ReacherTask::build(engine::World& world) {
+  const auto model =
+      engine::default_model_cache().load_urdf(engine::asset_path("reacher/reacher.urdf"));
+  robot_ = world.add_robot(model);
+  fingertip_link_ = model->link_index("fingertip");
+  engine::BodyOptions marker;
+  marker.name = "target";
+  marker.geometry.type = engine::GeometryType::kSphere;
+  marker.geometry.radius_m = target_radius_m_;
+  marker.material.rgba = {0.2, 0.8, 0.3, 1.0};
+  marker.material.has_rgba = true;
+  marker.mass_kg = 0.0;
+  marker.collides = false;
+  target_body_ = world.add_body(marker);
+}
+
+Camera ReacherTask::camera(const std::string& name, const engine::World& /*world*/) const {
+  Camera camera = name == "angled" ? Camera::look_at({0.0F, -0.55F, 0.45F}, {0.0F, 0.0F, 0.0F})
+                                   : Camera::look_at({0.0F, 0.0F, 0.75F}, {0.0F, 0.0F, 0.0F},
+                                                     Eigen::Vector3f::UnitY());
+  camera.fov_y_deg = 45.0F;
+  return camera;
+}
+
+void ReacherTask::initialize_episode(engine::World& world, Rng& rng) {
+  Eigen::VectorXd q(2);
+  q << rng.uniform(-kPi, kPi), rng.uniform(-2.5, 2.5);
+  world.set_joint_state(robot_, q, Eigen::VectorXd::Zero(2));
+  const double angle = rng.uniform(-kPi, kPi);
+  const double radius = rng.uniform(0.05, 0.22);
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() = Eigen::Vector3d(radius * std::cos(angle), radius * std::sin(angle), 0.02);
+  world.set_body_pose(target_body_, pose);
+}
+
+void ReacherTask::before_step(const Value& action, engine::World& world) {
+  const Array& a = action.array();
+  world.set_joint_commands(robot_, (Eigen::VectorXd(2) << kMaxTorqueNm * a.element_as_double(0),
+                                    kMaxTorqueNm * a.element_as_double(1))
+                                       .finished());
+}
+
+Eigen::Vector3d ReacherTask::fingertip(const engine::World& world) const {
+  return world.link_pose(robot_, fingertip_link_).translation();
+}
+
+Eigen::Vector3d ReacherTask::target(const engine::World& world) const {
+  return world.body_pose(target_body_).translation();
+}
+
+void ReacherTask::observe(const engine::World& world, Dict& state) const {
+  const Eigen::VectorXd q = world.joint_positions(robot_);
+  const Eigen::VectorXd qd = world.joint_velocities(robot_);
+  const Eigen::Vector3d to_target = target(world) - fingertip(world);
+  state.insert("joint_pos", Array::from_vector<float>({2}, {static_cast<float>(wrap_angle(q[0])),
+                                                            static_cast<float>(wrap_angle(q[1]))}));
+  state.insert("joint_vel", Array::from_vector<float>(
+                                {2}, {static_cast<float>(qd[0]), static_cast<float>(qd[1])}));
+  state.insert("to_target", Array::from_vector<float>({2}, {static_cast<float>(to_target.x()),
+                                                            static_cast<float>(to_target.y())}));
+}
+
+double ReacherTask::reward(const engine::World& world) const {
+  const Eigen::Vector3d d = target(world) - fingertip(world);
+  return reward::tolerance(d.head<2>().norm(), 0.0, target_radius_m_);
+}
+
+std::vector<EnvSpec> ReacherTask::specs() {
+  std::vector<EnvSpec> specs;
+  for (const auto& [name, radius] : {std::pair<const char*, double>{"ReacherEasy-v0", 0.05},
+                                     std::pair<const char*, double>{"ReacherHard-v0", 0.015}}) {
+    EnvSpec spec;
+    spec.id = name;
+    spec.description = std::string("two-link arm reaches a random ") +
+                       (radius > 0.02 ? "large" : "small") + " target; torques in [-1, 1]";
+    spec.params = TaskConfig::params();
+    const std::string id = name;
+    const double target_radius = radius;
+    spec.factory = [id, target_radius](const Params& kwargs) {
+      auto task = std::make_unique<ReacherTask>(target_radius);
+      TaskConfig config = TaskConfig::from_params(kwargs, task->camera_names(), id);
+      return std::make_unique<PixelEnv>(std::move(task), std::move(config), id);
+    };
+    specs.push_back(std::move(spec));
+  }
+  return specs;
+}
+
+}  // namespace pixelgym

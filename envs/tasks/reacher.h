@@ -1,0 +1,48 @@
+// ReacherEasy-v0 and ReacherHard-v0: a two-link planar arm reaches a random target.
+#pragma once
+
+#include "envs/registry.h"
+#include "envs/task.h"
+
+namespace pixelgym {
+
+/// Two 0.12 m links turning about z on the ground (assets/reacher); actions are the two joint
+/// torques, Box(-1, 1, (2,)) times 0.05 N m. Each episode puts a target (a green marker that
+/// nothing touches) at a random place within reach, 0.05 to 0.22 m from the shoulder, and starts
+/// the arm at random angles.
+/// - Reward 1 while the fingertip is within the target radius (Easy 0.05 m, Hard 0.015 m), else 0.
+/// - State: joint_pos (2, rad, wrapped), joint_vel (2), to_target (2, m, target minus fingertip
+///   in the ground plane). 1000 control steps of 0.02 s. Cameras: "top" (default), "angled".
+class ReacherTask final : public Task {
+ public:
+  explicit ReacherTask(double target_radius_m);
+
+  std::vector<std::string> camera_names() const override { return {"top", "angled"}; }
+  SpacePtr action_space() const override;
+  std::vector<StateSpec> state_specs() const override {
+    return {{"joint_pos", {2}}, {"joint_vel", {2}}, {"to_target", {2}}};
+  }
+  double control_timestep_s() const override { return 0.02; }
+  engine::WorldConfig world_config() const override;
+
+  void build(engine::World& world) override;
+  Camera camera(const std::string& name, const engine::World& world) const override;
+  void initialize_episode(engine::World& world, Rng& rng) override;
+  void before_step(const Value& action, engine::World& world) override;
+  void observe(const engine::World& world, Dict& state) const override;
+  double reward(const engine::World& world) const override;
+
+  Eigen::Vector3d fingertip(const engine::World& world) const;
+  Eigen::Vector3d target(const engine::World& world) const;
+
+  static constexpr double kMaxTorqueNm = 0.05;
+  static std::vector<EnvSpec> specs();
+
+ private:
+  double target_radius_m_;
+  int robot_ = 0;
+  int fingertip_link_ = 0;
+  int target_body_ = 0;
+};
+
+}  // namespace pixelgym
