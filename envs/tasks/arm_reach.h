@@ -1,0 +1,51 @@
+// ArmReach-v0: the 7-DOF mesh arm brings its end effector to a random target.
+#pragma once
+
+#include "envs/registry.h"
+#include "envs/task.h"
+
+namespace pixelgym {
+
+/// The arm of assets/arm on the floor; a green marker (never touched) shows a random target in
+/// its workspace, 0.35 to 0.7 m from the shoulder, in front and above the floor.
+/// - Actions: Box(-1, 1, (7,)): joint velocities times 1.5 rad/s (kwarg control="velocity", the
+///   default) or joint torques times each joint's effort limit (control="torque").
+/// - Reward: the end effector's distance d to the target: 1 within 0.05 m, falling smoothly to
+///   0.1 at 0.3 m further.
+/// - State: joint_pos (7), joint_vel (7), end_effector_pos (3), target_pos (3), in metres and
+///   radians. 500 control steps of 0.02 s. Cameras: "fixed" (front-left, default), "top".
+class ArmReachTask final : public Task {
+ public:
+  explicit ArmReachTask(bool torque_control);
+
+  std::vector<std::string> camera_names() const override { return {"fixed", "top"}; }
+  SpacePtr action_space() const override;
+  std::vector<StateSpec> state_specs() const override {
+    return {{"joint_pos", {7}}, {"joint_vel", {7}}, {"end_effector_pos", {3}}, {"target_pos", {3}}};
+  }
+  double control_timestep_s() const override { return 0.02; }
+  engine::WorldConfig world_config() const override;
+  int episode_length() const override { return 500; }
+
+  void build(engine::World& world) override;
+  Camera camera(const std::string& name, const engine::World& world) const override;
+  void initialize_episode(engine::World& world, Rng& rng) override;
+  void before_step(const Value& action, engine::World& world) override;
+  void observe(const engine::World& world, Dict& state) const override;
+  double reward(const engine::World& world) const override;
+
+  Eigen::Vector3d end_effector(const engine::World& world) const;
+  Eigen::Vector3d target(const engine::World& world) const;
+
+  static constexpr double kMaxJointSpeed = 1.5;  // rad/s at action 1
+  static EnvSpec spec_v0();
+
+ private:
+  bool torque_control_;
+  int robot_ = 0;
+  int end_effector_link_ = 0;
+  int target_body_ = 0;
+  Eigen::VectorXd effort_limits_;
+};
+
+}  // namespace pixelgym
