@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "envs/spaces/box.h"
+#include "envs/spaces/dict.h"
 #include "envs/spaces/discrete.h"
 
 namespace pixelgym {
@@ -42,19 +44,35 @@ void fill_rect(Array& image, int y0, int y1, int x0, int x1, Rgb color) {
 std::vector<ParamSpec> GridWorldConfig::params() {
   const GridWorldConfig defaults;
   return {{"render_width", defaults.render_width, "width of render() frames in pixels"},
-          {"render_height", defaults.render_height, "height of render() frames in pixels"}};
+          {"render_height", defaults.render_height, "height of render() frames in pixels"},
+          {"obs_mode", defaults.obs_mode,
+           "\"index\" (Discrete(16)) or \"pixels\" (Dict with an image)"},
+          {"width", defaults.width, "observation image width for obs_mode \"pixels\""},
+          {"height", defaults.height, "observation image height for obs_mode \"pixels\""}};
 }
 
 GridWorldConfig GridWorldConfig::from_params(const Params& params) {
   GridWorldConfig config;
   config.render_width = read_size(params, "render_width");
   config.render_height = read_size(params, "render_height");
+  config.width = read_size(params, "width");
+  config.height = read_size(params, "height");
+  config.obs_mode = params.at("obs_mode").as_string();
+  if (config.obs_mode != "index" && config.obs_mode != "pixels") {
+    throw std::invalid_argument("GridWorld: obs_mode must be \"index\" or \"pixels\", got \"" +
+                                config.obs_mode + "\"");
+  }
   return config;
 }
 
 GridWorld::GridWorld(GridWorldConfig config)
     : config_(config),
-      observation_space_(std::make_shared<spaces::Discrete>(kSize * kSize)),
+      observation_space_(config.obs_mode == "pixels"
+                             ? SpacePtr(std::make_shared<spaces::Dict>(spaces::Dict::Entries{
+                                   {"pixels", std::make_shared<spaces::Box>(
+                                                  0.0, 255.0, Shape{config.height, config.width, 3},
+                                                  DType::kUInt8)}}))
+                             : SpacePtr(std::make_shared<spaces::Discrete>(kSize * kSize))),
       action_space_(std::make_shared<spaces::Discrete>(4)) {
   metadata_.render_fps = 4.0;
 }
@@ -97,12 +115,13 @@ StepResult GridWorld::do_step(const Value& action) {
 }
 
 Value GridWorld::observe() const {
+  if (config_.obs_mode == "pixels") return Dict{{"pixels", draw(config_.width, config_.height)}};
   return Array::scalar<std::int64_t>(agent_.row * kSize + agent_.col);
 }
 
-Array GridWorld::do_render() {
-  const int height = config_.render_height;
-  const int width = config_.render_width;
+Array GridWorld::do_render() { return draw(config_.render_width, config_.render_height); }
+
+Array GridWorld::draw(int width, int height) const {
   Array image(DType::kUInt8, {height, width, 3});
   fill_rect(image, 0, height, 0, width, kLineColor);
   const int line = std::max(1, std::min(width, height) / 96);

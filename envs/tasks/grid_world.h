@@ -15,10 +15,16 @@ struct GridWorldConfig {
   /// Size of `render()` frames in pixels.
   int render_width = 256;
   int render_height = 256;
+  /// "index": Discrete(16), the agent's cell; "pixels": Dict{"pixels": (height, width, 3) uint8}.
+  std::string obs_mode = "index";
+  /// Observation image size for obs_mode "pixels".
+  int width = 84;
+  int height = 84;
 
   /// The kwargs above with their defaults and docs.
   static std::vector<ParamSpec> params();
-  /// Reads resolved kwargs. Throws std::invalid_argument for a size outside [16, 8192].
+  /// Reads resolved kwargs. Throws std::invalid_argument for a size outside [16, 8192] or an
+  /// unknown obs_mode.
   static GridWorldConfig from_params(const Params& params);
 };
 
@@ -27,7 +33,8 @@ struct GridWorldConfig {
 ///
 /// - Actions: Discrete(4), in Gymnasium FrozenLake's order: 0 left, 1 down, 2 right, 3 up. A
 ///   move into the wall or off the grid leaves the agent where it is.
-/// - Observation: Discrete(16), the agent's cell as row * 4 + column.
+/// - Observation: Discrete(16), the agent's cell as row * 4 + column; with obs_mode="pixels",
+///   Dict{"pixels": (height, width, 3) uint8}, the grid as render() draws it.
 /// - Reward: +1.0 on the step that reaches the goal, which terminates the episode; -0.04 on
 ///   every other step.
 /// - The registered spec truncates after 50 steps (TimeLimit).
@@ -68,6 +75,7 @@ class GridWorld final : public Env {
 
  private:
   Value observe() const;
+  Array draw(int width, int height) const;
 
   GridWorldConfig config_;
   SpacePtr observation_space_;

@@ -2,7 +2,9 @@
 // registry adds it here.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 
 #include "envs/checker.h"
 #include "envs/registry.h"
@@ -47,6 +49,73 @@ TEST_P(RegisteredEnvTest, RejectsActionsOfTheWrongKind) {
   env->reset(0);
   EXPECT_THROW(env->step(Value(Tuple{})), std::invalid_argument);
   EXPECT_THROW(env->step(Array::scalar<double>(std::nan(""))), std::invalid_argument);
+}
+
+// GridWorld's start cell is fixed by its definition (issue 2); every other env randomizes its
+// start.
+bool has_fixed_start(const std::string& id) { return id == "GridWorld-v0"; }
+
+TEST_P(RegisteredEnvTest, InitialStatesDifferAcrossSeeds) {
+  if (has_fixed_start(GetParam()))
+    GTEST_SKIP() << GetParam() << " starts in a fixed state by design";
+  std::unique_ptr<Env> env = make(GetParam());
+  const Value first = env->reset(0).obs.clone();
+  int differing = 0;
+  for (std::uint64_t seed = 1; seed < 4; ++seed)
+    differing += env->reset(seed).obs.equals(first) ? 0 : 1;
+  EXPECT_EQ(differing, 3);
+}
+
+// Over a few seeded episodes of random actions, every element of every state array takes more
+// than one value, and the pixels change (dm_control's suite test does the same).
+TEST_P(RegisteredEnvTest, NoObservationElementIsConstant) {
+  std::unique_ptr<Env> env = make(GetParam());
+  std::map<std::string, std::vector<Array>> seen;
+  const auto record = [&seen](const Value& obs) {
+    if (obs.is_array()) {
+      seen["obs"].push_back(obs.array());
+      return;
+    }
+    for (std::size_t i = 0; i < obs.dict().size(); ++i)
+      seen[obs.dict().keys()[i]].push_back(obs.dict().values()[i].array());
+  };
+  for (std::uint64_t seed = 0; seed < 3; ++seed) {
+    Rng rng(seed);
+    record(env->reset(seed).obs);
+    for (int t = 0; t < 40; ++t) {
+      const StepResult step = env->step(env->action_space().sample(rng));
+      record(step.obs);
+      if (step.terminated || step.truncated) break;
+    }
+  }
+  for (const auto& [key, arrays] : seen) {
+    if (key == "pixels") {
+      bool changed = false;
+      for (const Array& frame : arrays) changed = changed || !frame.equals(arrays.front());
+      EXPECT_TRUE(changed) << GetParam() << ": the pixels never change";
+      continue;
+    }
+    for (std::int64_t i = 0; i < arrays.front().size(); ++i) {
+      bool varies = false;
+      for (const Array& a : arrays)
+        varies = varies || a.element_as_double(i) != arrays.front().element_as_double(i);
+      EXPECT_TRUE(varies) << GetParam() << ": element " << i << " of \"" << key << "\" is constant";
+    }
+  }
+}
+
+TEST_P(RegisteredEnvTest, StateModeNeedsNoRendering) {
+  const auto spec = default_registry().spec(GetParam());
+  // The pixel tasks (obs_mode "pixels+state" by default) offer a state-only mode.
+  const bool pixel_task =
+      std::any_of(spec->params.begin(), spec->params.end(), [](const ParamSpec& p) {
+        return p.name == "obs_mode" && p.default_value == Param("pixels+state");
+      });
+  if (!pixel_task) GTEST_SKIP() << GetParam() << " is not a pixel task";
+  std::unique_ptr<Env> env = make(GetParam(), {{"obs_mode", "state"}});
+  const Value obs = env->reset(0).obs;
+  EXPECT_FALSE(obs.dict().contains("pixels"));
+  EXPECT_TRUE(env->observation_space().contains(obs));
 }
 
 INSTANTIATE_TEST_SUITE_P(AllEnvs, RegisteredEnvTest, ::testing::ValuesIn(registered_ids()),

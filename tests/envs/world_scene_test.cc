@@ -23,7 +23,8 @@ TEST(WorldSceneTest, OneInstancePerVisualShapeWithSegmentationIds) {
   ASSERT_EQ(f.view->scene().instances.size(), f.world->visual_shapes().size());
   EXPECT_EQ(f.view->scene().instances.size(), 9U + 5U + 1U + 1U);  // arm, table, cube, target
   for (std::size_t i = 0; i < f.view->scene().instances.size(); ++i) {
-    EXPECT_EQ(f.view->scene().instances[i].segmentation_id, f.world->visual_shapes()[i].segmentation_id);
+    EXPECT_EQ(f.view->scene().instances[i].segmentation_id,
+              f.world->visual_shapes()[i].segmentation_id);
     EXPECT_GT(f.view->scene().instances[i].segmentation_id, 0);
   }
 }
@@ -31,10 +32,12 @@ TEST(WorldSceneTest, OneInstancePerVisualShapeWithSegmentationIds) {
 TEST(WorldSceneTest, UpdateFollowsTheWorld) {
   FixtureScene f = testing::cartpole_scene(84, 84);
   const Eigen::Isometry3f before = f.view->scene().instances.back().X_world_instance;  // the pole
-  f.world->set_joint_state(0, (Eigen::VectorXd(2) << -0.5, 0.0).finished(), Eigen::VectorXd::Zero(2));
+  f.world->set_joint_state(0, (Eigen::VectorXd(2) << -0.5, 0.0).finished(),
+                           Eigen::VectorXd::Zero(2));
   f.view->update(*f.world);
   const Eigen::Isometry3f after = f.view->scene().instances.back().X_world_instance;
-  EXPECT_NEAR(after.translation().x() - before.translation().x(), -0.8F - 0.5F * std::sin(0.4F), 1e-4F);
+  EXPECT_NEAR(after.translation().x() - before.translation().x(), -0.8F - 0.5F * std::sin(0.4F),
+              1e-4F);
 }
 
 TEST(WorldSceneTest, UrdfColoursOverrideMeshColoursOnlyWhenGiven) {
@@ -70,16 +73,21 @@ class GoldenTest : public ::testing::TestWithParam<GoldenCase> {};
 
 TEST_P(GoldenTest, MatchesTheReferenceFrame) {
   const GoldenCase& c = GetParam();
-  FixtureScene f = c.arm ? testing::arm_scene(c.size, c.size) : testing::cartpole_scene(c.size, c.size);
+  FixtureScene f =
+      c.arm ? testing::arm_scene(c.size, c.size) : testing::cartpole_scene(c.size, c.size);
   Renderer renderer;
   const Array frame = draw(f, renderer);
   EXPECT_TRUE(testing::matches_golden(c.name, frame.data<std::uint8_t>(), c.size, c.size));
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, GoldenTest,
-                         ::testing::Values(GoldenCase{"cartpole_84", false, 84}, GoldenCase{"cartpole_256", false, 256},
-                                           GoldenCase{"arm_84", true, 84}, GoldenCase{"arm_256", true, 256}),
-                         [](const ::testing::TestParamInfo<GoldenCase>& param_info) { return std::string(param_info.param.name); });
+                         ::testing::Values(GoldenCase{"cartpole_84", false, 84},
+                                           GoldenCase{"cartpole_256", false, 256},
+                                           GoldenCase{"arm_84", true, 84},
+                                           GoldenCase{"arm_256", true, 256}),
+                         [](const ::testing::TestParamInfo<GoldenCase>& param_info) {
+                           return std::string(param_info.param.name);
+                         });
 
 }  // namespace
 }  // namespace pixelgym

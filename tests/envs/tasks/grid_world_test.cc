@@ -120,6 +120,19 @@ TEST(GridWorldTest, RenderDrawsAgentGoalWallAndFloor) {
   EXPECT_FALSE(moved.shares_memory(frame));
 }
 
+TEST(GridWorldTest, PixelObservationsShowTheAgentMoving) {
+  std::unique_ptr<Env> env = make("GridWorld-v0", {{"obs_mode", "pixels"}});
+  const Value first = env->reset(0).obs;
+  ASSERT_TRUE(env->observation_space().contains(first));
+  const Array& frame = first.dict().at("pixels").array();
+  EXPECT_EQ(frame.shape(), (Shape{84, 84, 3}));
+  EXPECT_EQ(cell_colour(frame, 0, 0), (std::array<int, 3>{31, 100, 200}));
+  const Value moved = env->step(move(GridWorld::kRight)).obs;
+  EXPECT_EQ(cell_colour(moved.dict().at("pixels").array(), 0, 1),
+            (std::array<int, 3>{31, 100, 200}));
+  EXPECT_THROW(make("GridWorld-v0", {{"obs_mode", "rgb"}}), std::invalid_argument);
+}
+
 TEST(GridWorldTest, ConfigIsValidated) {
   EXPECT_THROW(make("GridWorld-v0", {{"render_width", 0}}), std::invalid_argument);
   EXPECT_THROW(make("GridWorld-v0", {{"render_height", 9000}}), std::invalid_argument);
