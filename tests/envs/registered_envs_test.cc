@@ -8,6 +8,7 @@
 
 #include "envs/checker.h"
 #include "envs/registry.h"
+#include "tests/golden.h"
 
 namespace pixelgym {
 namespace {
@@ -116,6 +117,16 @@ TEST_P(RegisteredEnvTest, StateModeNeedsNoRendering) {
   const Value obs = env->reset(0).obs;
   EXPECT_FALSE(obs.dict().contains("pixels"));
   EXPECT_TRUE(env->observation_space().contains(obs));
+}
+
+// The 84 x 84 observation after reset(seed=0), against tests/golden/env_<id>.png under the
+// tolerance documented in tests/golden.h.
+TEST_P(RegisteredEnvTest, FirstObservationMatchesItsGolden) {
+  std::unique_ptr<Env> env = make(GetParam(), {{"obs_mode", "pixels"}});
+  const Array frame = env->reset(0).obs.dict().at("pixels").array();
+  ASSERT_EQ(frame.shape(), (Shape{84, 84, 3}));
+  std::string name = "env_" + GetParam();
+  EXPECT_TRUE(testing::matches_golden(name, frame.data<std::uint8_t>(), 84, 84));
 }
 
 INSTANTIATE_TEST_SUITE_P(AllEnvs, RegisteredEnvTest, ::testing::ValuesIn(registered_ids()),
