@@ -21,6 +21,7 @@ constexpr const char* kLitVertex = R"(#version 330 core
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
 layout(location = 2) in vec2 uv;
+layout(location = 3) in vec4 part_color;
 uniform mat4 model;
 uniform mat3 normal_matrix;
 uniform mat4 view_projection;
@@ -29,8 +30,10 @@ out vec3 world_position;
 out vec3 world_normal;
 out vec2 texcoord;
 out vec4 light_position;
+out vec4 vertex_color;
 void main() {
   vec4 world = model * vec4(position, 1.0);
+  vertex_color = part_color;
   world_position = world.xyz;
   world_normal = normal_matrix * normal;
   texcoord = uv;
@@ -44,6 +47,7 @@ in vec3 world_position;
 in vec3 world_normal;
 in vec2 texcoord;
 in vec4 light_position;
+in vec4 vertex_color;
 uniform vec4 base_color;
 uniform float specular;
 uniform float shininess;
@@ -71,7 +75,8 @@ float lit_fraction() {
 void main() {
   vec3 n = normalize(world_normal);
   if (!gl_FrontFacing) n = -n;
-  vec3 color = base_color.rgb;
+  // A mesh part's own colour, or the instance's when the part has none (alpha < 0).
+  vec3 color = vertex_color.a >= 0.0 ? vertex_color.rgb : base_color.rgb;
   if (use_texture) color *= texture(albedo, texcoord).rgb;
   float diffuse = max(dot(n, to_light), 0.0);
   vec3 view = normalize(camera_position - world_position);
@@ -218,11 +223,14 @@ struct FloorUniforms {
       shadow_map, shadow_texel;
 };
 
+// Floats per arena vertex: position 3, normal 3, texture coordinate 2, part colour 4.
+constexpr int kArenaStride = 12;
+
 struct GpuMesh {
   std::shared_ptr<const MeshData> keep_alive;
   GLint base_vertex = 0;          // of its first vertex in the arena
   std::uint32_t first_index = 0;  // of its first index in the arena
-  std::vector<MeshData::Part> parts;
+  std::uint32_t index_count = 0;
   float radius = 0.0F;         // of a sphere about the origin that holds every vertex
   Eigen::AlignedBox3f bounds;  // in mesh coordinates
 };
@@ -336,7 +344,7 @@ struct Renderer::Impl {
     glGenBuffers(1, &arena_ebo);
     glBindBuffer(GL_ARRAY_BUFFER, arena_vbo);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, arena_ebo);
-    constexpr GLsizei kStride = 8 * sizeof(float);
+    constexpr GLsizei kStride = kArenaStride * sizeof(float);
     glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, kStride, reinterpret_cast<void*>(0));
     glEnableVertexAttribArray(0);
     glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, kStride,
@@ -345,6 +353,9 @@ struct Renderer::Impl {
     glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, kStride,
                           reinterpret_cast<void*>(6 * sizeof(float)));
     glEnableVertexAttribArray(2);
+    glVertexAttribPointer(3, 4, GL_FLOAT, GL_FALSE, kStride,
+                          reinterpret_cast<void*>(8 * sizeof(float)));
+    glEnableVertexAttribArray(3);
     // The floor: a large square (its checker pattern comes from world coordinates).
     auto floor_mesh = std::make_shared<MeshData>();
     const float half = 500.0F;
@@ -410,27 +421,32 @@ struct Renderer::Impl {
     if (found != meshes.end()) return found->second;
     GpuMesh gpu;
     gpu.keep_alive = mesh;
-    gpu.base_vertex = static_cast<GLint>(arena_vertices.size() / 8);
+    gpu.base_vertex = static_cast<GLint>(arena_vertices.size() / kArenaStride);
     gpu.first_index = static_cast<std::uint32_t>(arena_indices.size());
+    // Each part's colour goes into its vertices, so that a mesh is one draw whatever its number
+    // of materials; alpha -1 marks "the instance's colour".
+    std::vector<Eigen::Vector4f> colors(mesh->positions.size(), Eigen::Vector4f(0, 0, 0, -1));
+    for (const MeshData::Part& part : mesh->parts) {
+      if (!part.has_color) continue;
+      for (std::uint32_t k = part.first_index; k < part.first_index + part.index_count; ++k) {
+        colors[mesh->indices[k]] = part.rgba;
+      }
+    }
     for (std::size_t i = 0; i < mesh->positions.size(); ++i) {
       const Eigen::Vector3f& p = mesh->positions[i];
       const Eigen::Vector3f n =
           i < mesh->normals.size() ? mesh->normals[i] : Eigen::Vector3f::UnitZ();
       const Eigen::Vector2f t =
           i < mesh->texcoords.size() ? mesh->texcoords[i] : Eigen::Vector2f::Zero();
-      arena_vertices.insert(arena_vertices.end(),
-                            {p.x(), p.y(), p.z(), n.x(), n.y(), n.z(), t.x(), t.y()});
+      const Eigen::Vector4f& c = colors[i];
+      arena_vertices.insert(arena_vertices.end(), {p.x(), p.y(), p.z(), n.x(), n.y(), n.z(), t.x(),
+                                                   t.y(), c.x(), c.y(), c.z(), c.w()});
       gpu.radius = std::max(gpu.radius, p.norm());
       gpu.bounds.extend(p);
     }
     arena_indices.insert(arena_indices.end(), mesh->indices.begin(), mesh->indices.end());
     arena_dirty = true;
-    gpu.parts = mesh->parts;
-    if (gpu.parts.empty()) {
-      MeshData::Part all;
-      all.index_count = static_cast<std::uint32_t>(mesh->indices.size());
-      gpu.parts.push_back(all);
-    }
+    gpu.index_count = static_cast<std::uint32_t>(mesh->indices.size());
     return meshes.emplace(mesh.get(), std::move(gpu)).first->second;
   }
 
@@ -616,16 +632,11 @@ struct Renderer::Impl {
     return light;
   }
 
-  static void draw_part(const GpuMesh& mesh, const MeshData::Part& part) {
-    glDrawElementsBaseVertex(
-        GL_TRIANGLES, static_cast<GLsizei>(part.index_count), GL_UNSIGNED_INT,
-        reinterpret_cast<void*>(static_cast<std::uintptr_t>(mesh.first_index + part.first_index) *
-                                sizeof(std::uint32_t)),
-        mesh.base_vertex);
-  }
-
   static void draw_all(const GpuMesh& mesh) {
-    for (const MeshData::Part& part : mesh.parts) draw_part(mesh, part);
+    glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(mesh.index_count), GL_UNSIGNED_INT,
+                             reinterpret_cast<void*>(static_cast<std::uintptr_t>(mesh.first_index) *
+                                                     sizeof(std::uint32_t)),
+                             mesh.base_vertex);
   }
 
   // Picks the coarse version of a mesh for instances small on screen.
@@ -656,11 +667,8 @@ struct Renderer::Impl {
       const bool textured = !instance.material.texture_path.empty();
       glUniform1i(u.use_texture, textured ? 1 : 0);
       bind_albedo(textured ? texture(instance.material.texture_path) : white_texture);
-      for (const MeshData::Part& part : gpu[i]->parts) {
-        const Eigen::Vector4f& color = part.has_color ? part.rgba : instance.material.base_color;
-        glUniform4fv(u.base_color, 1, color.data());
-        draw_part(*gpu[i], part);
-      }
+      glUniform4fv(u.base_color, 1, instance.material.base_color.data());
+      draw_all(*gpu[i]);
     }
   }
 
@@ -750,8 +758,7 @@ struct Renderer::Impl {
       glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(count * sizeof(std::uint32_t)),
                    footprint_indices.data(), GL_STATIC_DRAW);
     }
-    footprint_mesh.parts.assign(1, MeshData::Part{});
-    footprint_mesh.parts[0].index_count = count;
+    footprint_mesh.index_count = count;
     footprint_mesh.base_vertex = 0;
     footprint_mesh.first_index = 0;
     return &footprint_mesh;
