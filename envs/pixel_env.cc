@@ -157,4 +157,33 @@ Array PixelEnv::do_render() {
 
 void PixelEnv::do_close() { renderer_.reset(); }
 
+EnvSpec pixel_task_spec(const std::string& id, const std::string& description,
+                        std::function<std::unique_ptr<Task>(const Params& kwargs)> make_task,
+                        std::vector<ParamSpec> extra_params) {
+  EnvSpec spec;
+  spec.id = id;
+  spec.description = description;
+  spec.params = TaskConfig::params();
+  spec.params.insert(spec.params.end(), extra_params.begin(), extra_params.end());
+  spec.factory = [id, make_task = std::move(make_task)](const Params& kwargs) {
+    std::unique_ptr<Task> task = make_task(kwargs);
+    TaskConfig config = TaskConfig::from_params(kwargs, task->camera_names(), id);
+    return std::make_unique<PixelEnv>(std::move(task), std::move(config), id);
+  };
+  return spec;
+}
+
+engine::BodyOptions marker_body(const std::string& name, double radius_m,
+                                const Eigen::Vector4d& rgba) {
+  engine::BodyOptions marker;
+  marker.name = name;
+  marker.geometry.type = engine::GeometryType::kSphere;
+  marker.geometry.radius_m = radius_m;
+  marker.material.rgba = rgba;
+  marker.material.has_rgba = true;
+  marker.mass_kg = 0.0;
+  marker.collides = false;
+  return marker;
+}
+
 }  // namespace pixelgym

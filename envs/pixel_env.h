@@ -1,11 +1,13 @@
 // PixelEnv: the one environment class that runs every pixel task.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 
 #include "engine/world.h"
 #include "envs/env.h"
+#include "envs/registry.h"
 #include "envs/task.h"
 #include "envs/world_scene.h"
 #include "render/renderer.h"
@@ -62,5 +64,15 @@ class PixelEnv final : public Env {
   std::unique_ptr<Renderer> renderer_;
   int control_steps_ = 0;
 };
+
+/// The registry entry of a pixel task: the shared TaskConfig keys plus `extra_params`; the
+/// factory builds the task with `make_task(kwargs)` and runs it in a PixelEnv.
+EnvSpec pixel_task_spec(const std::string& id, const std::string& description,
+                        std::function<std::unique_ptr<Task>(const Params& kwargs)> make_task,
+                        std::vector<ParamSpec> extra_params = {});
+
+/// A sphere that is drawn but never touched (a target or goal marker), static.
+engine::BodyOptions marker_body(const std::string& name, double radius_m,
+                                const Eigen::Vector4d& rgba);
 
 }  // namespace pixelgym

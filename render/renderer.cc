@@ -17,6 +17,20 @@ namespace {
 
 // --- shaders ---------------------------------------------------------------------------------
 
+// The fraction of light a point receives, from the shadow map; spliced into the fragment
+// shaders that receive shadows (at "@SHADOW@").
+constexpr const char* kShadowLookup = R"(
+float lit_fraction() {
+  vec3 p = light_position.xyz / light_position.w * 0.5 + 0.5;
+  // Outside the casters' footprint nothing can shade it; beyond their far side (the floor under
+  // them) it compares as the farthest depth.
+  if (p.x <= 0.0 || p.x >= 1.0 || p.y <= 0.0 || p.y >= 1.0) return 1.0;
+  p.z = min(p.z, 1.0);
+  // One linear-filtered lookup: the hardware compares the 2 x 2 nearest texels and blends.
+  return texture(shadow_map, p);
+}
+)";
+
 constexpr const char* kLitVertex = R"(#version 330 core
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
@@ -59,18 +73,9 @@ uniform bool use_texture;
 uniform sampler2D albedo;
 uniform bool use_shadows;
 uniform sampler2DShadow shadow_map;
-uniform float shadow_texel;
 out vec4 fragment;
 
-float lit_fraction() {
-  vec3 p = light_position.xyz / light_position.w * 0.5 + 0.5;
-  // Outside the casters' footprint nothing can shade it; beyond their far side (the floor under
-  // them) it compares as the farthest depth.
-  if (p.x <= 0.0 || p.x >= 1.0 || p.y <= 0.0 || p.y >= 1.0) return 1.0;
-  p.z = min(p.z, 1.0);
-  // One linear-filtered lookup: the hardware compares the 2 x 2 nearest texels and blends.
-  return texture(shadow_map, p);
-}
+@SHADOW@
 
 void main() {
   vec3 n = normalize(world_normal);
@@ -138,17 +143,9 @@ uniform vec3 ambient;
 uniform vec3 direct;
 uniform bool use_shadows;
 uniform sampler2DShadow shadow_map;
-uniform float shadow_texel;
 out vec4 fragment;
 
-float lit_fraction() {
-  vec3 p = light_position.xyz / light_position.w * 0.5 + 0.5;
-  // Outside the casters' footprint nothing can shade it; beyond their far side (the floor under
-  // them) it compares as the farthest depth.
-  if (p.x <= 0.0 || p.x >= 1.0 || p.y <= 0.0 || p.y >= 1.0) return 1.0;
-  p.z = min(p.z, 1.0);
-  return texture(shadow_map, p);
-}
+@SHADOW@
 
 void main() {
   // The checker averaged over the pixel's footprint (a box filter integrated in closed form),
@@ -192,6 +189,15 @@ GLuint compile(GLenum type, const char* source) {
   return shader;
 }
 
+// `source` with the shared shadow lookup spliced in.
+std::string with_shadow_lookup(const char* source) {
+  std::string text = source;
+  const std::string marker = "@SHADOW@";
+  const std::size_t at = text.find(marker);
+  if (at != std::string::npos) text.replace(at, marker.size(), kShadowLookup);
+  return text;
+}
+
 GLuint link(const char* vertex, const char* fragment) {
   const GLuint program = glCreateProgram();
   const GLuint v = compile(GL_VERTEX_SHADER, vertex);
@@ -214,13 +220,12 @@ GLuint link(const char* vertex, const char* fragment) {
 // Uniform locations of the lit program, looked up once.
 struct LitUniforms {
   GLint model, normal_matrix, view_projection, light_matrix, base_color, specular, shininess,
-      to_light, light_color, ambient, camera_position, use_texture, albedo, use_shadows, shadow_map,
-      shadow_texel;
+      to_light, light_color, ambient, camera_position, use_texture, albedo, use_shadows, shadow_map;
 };
 
 struct FloorUniforms {
   GLint model, view_projection, light_matrix, tile, color_a, color_b, ambient, direct, use_shadows,
-      shadow_map, shadow_texel;
+      shadow_map;
 };
 
 // Floats per arena vertex: position 3, normal 3, texture coordinate 2, part colour 4.
@@ -317,7 +322,7 @@ Eigen::Matrix4f model_matrix(const Instance& instance) {
 
 struct Renderer::Impl {
   explicit Impl(GlBackend backend) : context(backend) {
-    lit = link(kLitVertex, kLitFragment);
+    lit = link(kLitVertex, with_shadow_lookup(kLitFragment).c_str());
     sky = link(kSkyVertex, kSkyFragment);
     depth_only = link(kDepthVertex, kDepthFragment);
     segmentation = link(kDepthVertex, kSegmentationFragment);
@@ -325,15 +330,15 @@ struct Renderer::Impl {
     u = {at("model"),       at("normal_matrix"), at("view_projection"), at("light_matrix"),
          at("base_color"),  at("specular"),      at("shininess"),       at("to_light"),
          at("light_color"), at("ambient"),       at("camera_position"), at("use_texture"),
-         at("albedo"),      at("use_shadows"),   at("shadow_map"),      at("shadow_texel")};
-    floor_program = link(kFloorVertex, kFloorFragment);
+         at("albedo"),      at("use_shadows"),   at("shadow_map")};
+    floor_program = link(kFloorVertex, with_shadow_lookup(kFloorFragment).c_str());
     const auto floor_at = [this](const char* name) {
       return glGetUniformLocation(floor_program, name);
     };
-    fu = {floor_at("model"),      floor_at("view_projection"), floor_at("light_matrix"),
-          floor_at("tile"),       floor_at("color_a"),         floor_at("color_b"),
-          floor_at("ambient"),    floor_at("direct"),          floor_at("use_shadows"),
-          floor_at("shadow_map"), floor_at("shadow_texel")};
+    fu = {floor_at("model"),     floor_at("view_projection"), floor_at("light_matrix"),
+          floor_at("tile"),      floor_at("color_a"),         floor_at("color_b"),
+          floor_at("ambient"),   floor_at("direct"),          floor_at("use_shadows"),
+          floor_at("shadow_map")};
     sky_inverse_view_projection = glGetUniformLocation(sky, "inverse_view_projection");
     sky_horizon = glGetUniformLocation(sky, "horizon");
     sky_zenith = glGetUniformLocation(sky, "zenith");
@@ -673,8 +678,7 @@ struct Renderer::Impl {
   }
 
   void draw_floor(const Scene& scene, const Eigen::Matrix4f& view_projection,
-                  const Eigen::Matrix4f& light_matrix, bool use_shadows, int map_size,
-                  const GpuMesh& mesh) {
+                  const Eigen::Matrix4f& light_matrix, bool use_shadows, const GpuMesh& mesh) {
     Eigen::Matrix4f model = Eigen::Matrix4f::Identity();
     model(2, 3) = scene.floor.height_m;
     const Eigen::Vector3f to_light = -scene.light.direction.normalized();
@@ -691,7 +695,6 @@ struct Renderer::Impl {
     glUniform3fv(fu.direct, 1, direct.data());
     glUniform1i(fu.use_shadows, use_shadows ? 1 : 0);
     glUniform1i(fu.shadow_map, 1);
-    glUniform1f(fu.shadow_texel, 1.0F / static_cast<float>(map_size));
     // Pushed back a little so that shapes resting on the floor never fight it for depth.
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(1.0F, 1.0F);
@@ -841,7 +844,6 @@ struct Renderer::Impl {
     glUniform1i(u.use_shadows, use_shadows ? 1 : 0);
     glUniform1i(u.albedo, 0);
     glUniform1i(u.shadow_map, 1);
-    glUniform1f(u.shadow_texel, 1.0F / static_cast<float>(map_size));
     glActiveTexture(GL_TEXTURE1);
     glBindTexture(GL_TEXTURE_2D, use_shadows ? shadow_texture : 0);
     glActiveTexture(GL_TEXTURE0);
@@ -859,7 +861,7 @@ struct Renderer::Impl {
       glViewport(0, 0, camera.width, camera.height);
       glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
       if (scene.floor.enabled)
-        draw_floor(scene, view_projection, light_matrix, false, map_size, meshes.at(floor.get()));
+        draw_floor(scene, view_projection, light_matrix, false, meshes.at(floor.get()));
       draw_sky(scene, view_projection);
       background_keys[background.framebuffer] = key;
     }
@@ -874,7 +876,7 @@ struct Renderer::Impl {
       if (footprints != nullptr) {
         // Over the cached floor, at the same depth: always pass the depth test.
         glDepthFunc(GL_ALWAYS);
-        draw_floor(scene, view_projection, light_matrix, true, map_size, *footprints);
+        draw_floor(scene, view_projection, light_matrix, true, *footprints);
         glDepthFunc(GL_LESS);
       }
     }

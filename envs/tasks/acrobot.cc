@@ -64,16 +64,9 @@ double AcrobotTask::reward(const engine::World& world) const {
 }
 
 EnvSpec AcrobotTask::spec_v0() {
-  EnvSpec spec;
-  spec.id = "AcrobotSwingup-v0";
-  spec.description = "swing a two-link arm up with its elbow alone; torque in [-1, 1]";
-  spec.params = TaskConfig::params();
-  spec.factory = [](const Params& kwargs) {
-    auto task = std::make_unique<AcrobotTask>();
-    TaskConfig config = TaskConfig::from_params(kwargs, task->camera_names(), "AcrobotSwingup-v0");
-    return std::make_unique<PixelEnv>(std::move(task), std::move(config), "AcrobotSwingup-v0");
-  };
-  return spec;
+  return pixel_task_spec("AcrobotSwingup-v0",
+                         "swing a two-link arm up with its elbow alone; torque in [-1, 1]",
+                         [](const Params&) { return std::make_unique<AcrobotTask>(); });
 }
 
 }  // namespace pixelgym

@@ -42,15 +42,7 @@ void ArmReachTask::build(engine::World& world) {
                                 model->movable_joints()[static_cast<std::size_t>(d)])]
                             .effort_limit;
   }
-  engine::BodyOptions marker;
-  marker.name = "target";
-  marker.geometry.type = engine::GeometryType::kSphere;
-  marker.geometry.radius_m = 0.04;
-  marker.material.rgba = {0.2, 0.85, 0.3, 1.0};
-  marker.material.has_rgba = true;
-  marker.mass_kg = 0.0;
-  marker.collides = false;
-  target_body_ = world.add_body(marker);
+  target_body_ = world.add_body(marker_body("target", 0.04, {0.2, 0.85, 0.3, 1.0}));
 }
 
 Camera ArmReachTask::camera(const std::string& name, const engine::World& /*world*/) const {
@@ -118,24 +110,18 @@ double ArmReachTask::reward(const engine::World& world) const {
 }
 
 EnvSpec ArmReachTask::spec_v0() {
-  EnvSpec spec;
-  spec.id = "ArmReach-v0";
-  spec.description =
-      "7-DOF mesh arm brings its end effector to a random target; 7 joint velocities in [-1, 1]";
-  spec.params = TaskConfig::params();
-  spec.params.push_back(
-      {"control", "velocity", "\"velocity\" (joint velocities) or \"torque\" (joint torques)"});
-  spec.factory = [](const Params& kwargs) {
-    const std::string control = kwargs.at("control").as_string();
-    if (control != "velocity" && control != "torque") {
-      throw std::invalid_argument(
-          "ArmReach-v0: control must be \"velocity\" or \"torque\", got \"" + control + "\"");
-    }
-    auto task = std::make_unique<ArmReachTask>(control == "torque");
-    TaskConfig config = TaskConfig::from_params(kwargs, task->camera_names(), "ArmReach-v0");
-    return std::make_unique<PixelEnv>(std::move(task), std::move(config), "ArmReach-v0");
-  };
-  return spec;
+  return pixel_task_spec(
+      "ArmReach-v0",
+      "7-DOF mesh arm brings its end effector to a random target; 7 joint velocities in [-1, 1]",
+      [](const Params& kwargs) {
+        const std::string control = kwargs.at("control").as_string();
+        if (control != "velocity" && control != "torque") {
+          throw std::invalid_argument(
+              "ArmReach-v0: control must be \"velocity\" or \"torque\", got \"" + control + "\"");
+        }
+        return std::make_unique<ArmReachTask>(control == "torque");
+      },
+      {{"control", "velocity", "\"velocity\" (joint velocities) or \"torque\" (joint torques)"}});
 }
 
 }  // namespace pixelgym

@@ -89,20 +89,15 @@ std::vector<EnvSpec> CartPoleTask::specs() {
   std::vector<EnvSpec> specs;
   for (const bool swing_up : {false, true}) {
     for (const bool discrete : {false, true}) {
-      EnvSpec spec;
-      spec.id = std::string("CartPole") + (swing_up ? "Swingup" : "Balance") +
-                (discrete ? "Discrete" : "") + "-v0";
-      spec.description = std::string(swing_up ? "swing the pole up from hanging and balance it"
-                                              : "keep the pole upright") +
-                         (discrete ? "; Discrete(3) pushes" : "; force in [-1, 1]");
-      spec.params = TaskConfig::params();
-      const std::string id = spec.id;
-      spec.factory = [swing_up, discrete, id](const Params& kwargs) {
-        auto task = std::make_unique<CartPoleTask>(swing_up, discrete);
-        TaskConfig config = TaskConfig::from_params(kwargs, task->camera_names(), id);
-        return std::make_unique<PixelEnv>(std::move(task), std::move(config), id);
-      };
-      specs.push_back(std::move(spec));
+      const std::string id = std::string("CartPole") + (swing_up ? "Swingup" : "Balance") +
+                             (discrete ? "Discrete" : "") + "-v0";
+      const std::string description =
+          std::string(swing_up ? "swing the pole up from hanging and balance it"
+                               : "keep the pole upright") +
+          (discrete ? "; Discrete(3) pushes" : "; force in [-1, 1]");
+      specs.push_back(pixel_task_spec(id, description, [swing_up, discrete](const Params&) {
+        return std::make_unique<CartPoleTask>(swing_up, discrete);
+      }));
     }
   }
   return specs;

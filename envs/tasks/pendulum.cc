@@ -62,16 +62,9 @@ double PendulumTask::reward(const engine::World& world) const {
 }
 
 EnvSpec PendulumTask::spec_v0() {
-  EnvSpec spec;
-  spec.id = "PendulumSwingup-v0";
-  spec.description = "swing a torque-limited pendulum up and hold it; torque in [-1, 1]";
-  spec.params = TaskConfig::params();
-  spec.factory = [](const Params& kwargs) {
-    auto task = std::make_unique<PendulumTask>();
-    TaskConfig config = TaskConfig::from_params(kwargs, task->camera_names(), "PendulumSwingup-v0");
-    return std::make_unique<PixelEnv>(std::move(task), std::move(config), "PendulumSwingup-v0");
-  };
-  return spec;
+  return pixel_task_spec("PendulumSwingup-v0",
+                         "swing a torque-limited pendulum up and hold it; torque in [-1, 1]",
+                         [](const Params&) { return std::make_unique<PendulumTask>(); });
 }
 
 }  // namespace pixelgym

@@ -27,15 +27,7 @@ void ReacherTask::build(engine::World& world) {
       engine::default_model_cache().load_urdf(engine::asset_path("reacher/reacher.urdf"));
   robot_ = world.add_robot(model);
   fingertip_link_ = model->link_index("fingertip");
-  engine::BodyOptions marker;
-  marker.name = "target";
-  marker.geometry.type = engine::GeometryType::kSphere;
-  marker.geometry.radius_m = target_radius_m_;
-  marker.material.rgba = {0.2, 0.8, 0.3, 1.0};
-  marker.material.has_rgba = true;
-  marker.mass_kg = 0.0;
-  marker.collides = false;
-  target_body_ = world.add_body(marker);
+  target_body_ = world.add_body(marker_body("target", target_radius_m_, {0.2, 0.8, 0.3, 1.0}));
 }
 
 Camera ReacherTask::camera(const std::string& name, const engine::World& /*world*/) const {
@@ -91,21 +83,14 @@ double ReacherTask::reward(const engine::World& world) const {
 
 std::vector<EnvSpec> ReacherTask::specs() {
   std::vector<EnvSpec> specs;
-  for (const auto& [name, radius] : {std::pair<const char*, double>{"ReacherEasy-v0", 0.05},
-                                     std::pair<const char*, double>{"ReacherHard-v0", 0.015}}) {
-    EnvSpec spec;
-    spec.id = name;
-    spec.description = std::string("two-link arm reaches a random ") +
-                       (radius > 0.02 ? "large" : "small") + " target; torques in [-1, 1]";
-    spec.params = TaskConfig::params();
-    const std::string id = name;
+  for (const auto& [id, radius] : {std::pair<const char*, double>{"ReacherEasy-v0", 0.05},
+                                   std::pair<const char*, double>{"ReacherHard-v0", 0.015}}) {
     const double target_radius = radius;
-    spec.factory = [id, target_radius](const Params& kwargs) {
-      auto task = std::make_unique<ReacherTask>(target_radius);
-      TaskConfig config = TaskConfig::from_params(kwargs, task->camera_names(), id);
-      return std::make_unique<PixelEnv>(std::move(task), std::move(config), id);
-    };
-    specs.push_back(std::move(spec));
+    specs.push_back(pixel_task_spec(
+        id,
+        std::string("two-link arm reaches a random ") + (radius > 0.02 ? "large" : "small") +
+            " target; torques in [-1, 1]",
+        [target_radius](const Params&) { return std::make_unique<ReacherTask>(target_radius); }));
   }
   return specs;
 }
