@@ -509,10 +509,9 @@ struct Renderer::Impl {
     return handle;
   }
 
-  Target& target(const Camera& camera) {
-    const auto key = std::make_tuple(camera.width, camera.height, camera.msaa_samples);
-    auto found = targets.find(key);
-    if (found != targets.end()) return found->second;
+  // Colour and depth renderbuffers of the camera's size and samples, plus a single-sampled
+  // copy to read from when `resolvable` and multisampled.
+  static Target make_target(const Camera& camera, bool resolvable, const char* what) {
     Target t;
     glGenFramebuffers(1, &t.framebuffer);
     glBindFramebuffer(GL_FRAMEBUFFER, t.framebuffer);
@@ -521,8 +520,8 @@ struct Renderer::Impl {
         make_renderbuffer(GL_DEPTH_COMPONENT24, camera.width, camera.height, camera.msaa_samples);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, t.color);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t.depth);
-    check_framebuffer("colour");
-    if (camera.msaa_samples > 0) {
+    check_framebuffer(what);
+    if (resolvable && camera.msaa_samples > 0) {
       glGenFramebuffers(1, &t.resolve_framebuffer);
       glBindFramebuffer(GL_FRAMEBUFFER, t.resolve_framebuffer);
       t.resolve_color = make_renderbuffer(GL_RGBA8, camera.width, camera.height, 0);
@@ -533,24 +532,23 @@ struct Renderer::Impl {
                                 t.resolve_depth);
       check_framebuffer("resolve");
     }
-    return targets.emplace(key, t).first->second;
+    return t;
   }
 
-  // A second target of the same size and samples, holding the cached background.
+  // The frame being drawn, by size and samples.
+  Target& target(const Camera& camera) {
+    const auto key = std::make_tuple(camera.width, camera.height, camera.msaa_samples);
+    auto found = targets.find(key);
+    if (found != targets.end()) return found->second;
+    return targets.emplace(key, make_target(camera, true, "colour")).first->second;
+  }
+
+  // The cached background (sky and unshadowed floor), by size and samples.
   Target& background_target(const Camera& camera) {
     const auto key = std::make_tuple(camera.width, camera.height, camera.msaa_samples);
     auto found = backgrounds.find(key);
     if (found != backgrounds.end()) return found->second;
-    Target t;
-    glGenFramebuffers(1, &t.framebuffer);
-    glBindFramebuffer(GL_FRAMEBUFFER, t.framebuffer);
-    t.color = make_renderbuffer(GL_RGBA8, camera.width, camera.height, camera.msaa_samples);
-    t.depth =
-        make_renderbuffer(GL_DEPTH_COMPONENT24, camera.width, camera.height, camera.msaa_samples);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, t.color);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t.depth);
-    check_framebuffer("background");
-    return backgrounds.emplace(key, t).first->second;
+    return backgrounds.emplace(key, make_target(camera, false, "background")).first->second;
   }
 
   SegmentationTarget& segmentation_target(const Camera& camera) {
