@@ -698,6 +698,23 @@ Eigen::Vector3d World::link_linear_velocity(int robot, int link) const {
 
 Eigen::Isometry3d World::base_pose(int robot) const { return link_pose(robot, 0); }
 
+void World::set_base_pose(int robot, const Eigen::Isometry3d& X_world_base) {
+  check_robot(robot);
+  Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot)];
+  if (r.options.fixed_base) {
+    throw std::invalid_argument("World::set_base_pose: robot \"" + r.model->name() +
+                                "\" has a fixed base");
+  }
+  if (!X_world_base.matrix().allFinite()) {
+    throw std::invalid_argument("World::set_base_pose: non-finite pose for robot \"" +
+                                r.model->name() + "\"");
+  }
+  r.body->setBaseWorldTransform(to_bt(X_world_base * r.frames[0].X_link_com));
+  r.body->setBaseVel(btVector3(0, 0, 0));
+  r.body->setBaseOmega(btVector3(0, 0, 0));
+  impl_->update_kinematics(r);
+}
+
 int World::num_bodies() const { return static_cast<int>(impl_->bodies.size()); }
 
 const BodyOptions& World::body_options(int body) const {

@@ -147,6 +147,9 @@ class World {
   /// World linear velocity of the origin of link `link`'s URDF frame, in m/s.
   Eigen::Vector3d link_linear_velocity(int robot, int link) const;
   Eigen::Isometry3d base_pose(int robot) const;
+  /// Moves a floating-base robot's root link frame to `X_world_base` and stops its base. Throws
+  /// std::invalid_argument for a fixed-base robot or a non-finite pose.
+  void set_base_pose(int robot, const Eigen::Isometry3d& X_world_base);
 
   // --- free bodies --------------------------------------------------------------------------
   int num_bodies() const;

@@ -173,6 +173,13 @@ EnvSpec pixel_task_spec(const std::string& id, const std::string& description,
   return spec;
 }
 
+Array float32_array(const Eigen::VectorXd& values) {
+  Array array(DType::kFloat32, {static_cast<std::int64_t>(values.size())});
+  for (Eigen::Index i = 0; i < values.size(); ++i)
+    array.data<float>()[i] = static_cast<float>(values[i]);
+  return array;
+}
+
 engine::BodyOptions marker_body(const std::string& name, double radius_m,
                                 const Eigen::Vector4d& rgba) {
   engine::BodyOptions marker;

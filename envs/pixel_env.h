@@ -71,6 +71,9 @@ EnvSpec pixel_task_spec(const std::string& id, const std::string& description,
                         std::function<std::unique_ptr<Task>(const Params& kwargs)> make_task,
                         std::vector<ParamSpec> extra_params = {});
 
+/// A float32 array of shape (n,) holding `values` (for state observations).
+Array float32_array(const Eigen::VectorXd& values);
+
 /// A sphere that is drawn but never touched (a target or goal marker), static.
 engine::BodyOptions marker_body(const std::string& name, double radius_m,
                                 const Eigen::Vector4d& rgba);

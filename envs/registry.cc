@@ -71,14 +71,21 @@ std::shared_ptr<const EnvSpec> Registry::spec(const std::string& id) const {
   }
   std::string message = "unknown env id \"" + id + "\"";
   const std::vector<std::string> closest = closest_ids(id);
-  if (closest.empty()) {
-    message += "; no envs are registered";
-  } else {
-    message += "; did you mean ";
-    for (std::size_t i = 0; i < closest.size(); ++i) {
-      message += (i == 0 ? "" : i + 1 == closest.size() ? " or " : ", ") + closest[i];
+  const std::vector<std::string> all = registered_ids();
+  const auto list = [](const std::vector<std::string>& ids, const char* last_separator) {
+    std::string text;
+    for (std::size_t i = 0; i < ids.size(); ++i) {
+      text += (i == 0 ? "" : i + 1 == ids.size() ? last_separator : ", ") + ids[i];
     }
-    message += "? (`pixelgym list` shows all " + std::to_string(registered_ids().size()) + ")";
+    return text;
+  };
+  if (all.empty()) {
+    message += "; no envs are registered";
+  } else if (!closest.empty()) {
+    message += "; did you mean " + list(closest, " or ") + "? (`pixelgym list` shows all " +
+               std::to_string(all.size()) + ")";
+  } else {
+    message += "; registered ids: " + list(all, ", ");
   }
   throw std::invalid_argument(message);
 }
@@ -114,9 +121,12 @@ std::vector<std::string> Registry::registered_ids() const {
 }
 
 std::vector<std::string> Registry::closest_ids(const std::string& id, std::size_t count) const {
+  // Close enough to be a typo: an edit distance of at most a third of the id (and at least 2).
+  const std::size_t limit = std::max<std::size_t>(2, id.size() / 3);
   std::vector<std::pair<std::size_t, std::string>> ranked;
   for (const std::string& candidate : registered_ids()) {
-    ranked.emplace_back(edit_distance(lowercase(id), lowercase(candidate)), candidate);
+    const std::size_t distance = edit_distance(lowercase(id), lowercase(candidate));
+    if (distance <= limit) ranked.emplace_back(distance, candidate);
   }
   std::sort(ranked.begin(), ranked.end());
   std::vector<std::string> closest;

@@ -38,7 +38,7 @@ class Registry {
 
   /// Builds env `id` with `kwargs`, wrapped in TimeLimit when the spec (or the reserved kwarg
   /// "max_episode_steps") sets a limit. Throws std::invalid_argument for an unknown id (naming
-  /// the closest registered ids), an unknown kwarg (listing the valid ones with types and
+  /// the closest registered ids, or all of them when none is close), an unknown kwarg (listing the valid ones with types and
   /// defaults) or a kwarg of the wrong type.
   std::unique_ptr<Env> make(const std::string& id, const Params& kwargs = {}) const;
 
@@ -48,7 +48,9 @@ class Registry {
   /// Every registered id, sorted.
   std::vector<std::string> registered_ids() const;
 
-  /// Up to `count` registered ids ordered by edit distance to `id` (case-insensitive).
+  /// Up to `count` registered ids within a typo's edit distance of `id` (at most a third of its
+  /// length, at least 2; case-insensitive), closest first. An unknown id with none of these gets
+  /// the list of every registered id in its error instead.
   std::vector<std::string> closest_ids(const std::string& id, std::size_t count = 3) const;
 
  private:

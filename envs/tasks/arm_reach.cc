@@ -92,17 +92,11 @@ Eigen::Vector3d ArmReachTask::target(const engine::World& world) const {
 }
 
 void ArmReachTask::observe(const engine::World& world, Dict& state) const {
-  const auto to_array = [](const Eigen::VectorXd& v) {
-    std::vector<float> values(static_cast<std::size_t>(v.size()));
-    for (Eigen::Index i = 0; i < v.size(); ++i)
-      values[static_cast<std::size_t>(i)] = static_cast<float>(v[i]);
-    return Array::from_vector<float>({static_cast<std::int64_t>(v.size())}, values);
-  };
   Eigen::VectorXd q = world.joint_positions(robot_);
-  state.insert("joint_pos", to_array(q));
-  state.insert("joint_vel", to_array(world.joint_velocities(robot_)));
-  state.insert("end_effector_pos", to_array(end_effector(world)));
-  state.insert("target_pos", to_array(target(world)));
+  state.insert("joint_pos", float32_array(q));
+  state.insert("joint_vel", float32_array(world.joint_velocities(robot_)));
+  state.insert("end_effector_pos", float32_array(end_effector(world)));
+  state.insert("target_pos", float32_array(target(world)));
 }
 
 double ArmReachTask::reward(const engine::World& world) const {

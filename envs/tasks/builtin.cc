@@ -1,6 +1,7 @@
 #include "envs/tasks/builtin.h"
 
 #include "envs/tasks/acrobot.h"
+#include "envs/tasks/arm_push.h"
 #include "envs/tasks/arm_reach.h"
 #include "envs/tasks/cartpole.h"
 #include "envs/tasks/grid_world.h"
@@ -17,6 +18,7 @@ void register_builtin_envs(Registry& registry) {
   registry.register_env(AcrobotTask::spec_v0());
   for (EnvSpec& spec : ReacherTask::specs()) registry.register_env(std::move(spec));
   registry.register_env(ArmReachTask::spec_v0());
+  registry.register_env(ArmPushTask::spec_v0());
 }
 
 }  // namespace pixelgym

@@ -213,6 +213,23 @@ TEST(WorldTest, LimitsAndMotorsWorkOnRobotsWithoutCollisionShapes) {
   EXPECT_NEAR(world.joint_velocities(reacher)[0], 1.0, 1e-3);
 }
 
+TEST(WorldTest, FloatingBaseCanBeMovedAndSettles) {
+  ModelCache cache;
+  World world;
+  RobotOptions options;
+  options.fixed_base = false;
+  const int cube = world.add_robot(cache.load_urdf(asset_path("objects/cube.urdf")), options);
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() = Eigen::Vector3d(0.3, -0.2, 0.5);
+  world.set_base_pose(cube, pose);
+  EXPECT_TRUE(world.base_pose(cube).translation().isApprox(pose.translation(), 1e-12));
+  world.step(480);
+  EXPECT_TRUE(
+      world.base_pose(cube).translation().isApprox(Eigen::Vector3d(0.3, -0.2, 0.025), 2e-3));
+  const int fixed = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
+  EXPECT_THROW(world.set_base_pose(fixed, pose), std::invalid_argument);
+}
+
 TEST(WorldTest, VisualShapesListEveryVisualWithItsPose) {
   ModelCache cache;
   World world;
@@ -289,7 +306,8 @@ TEST(WorldTest, StaticMeshBodiesCollideAsTriangles) {
   scaled.X_world_body.translation() = Eigen::Vector3d(2, 0, 0.3);
   const int s = world.add_body(scaled);
   world.step(480);
-  EXPECT_NEAR(world.body_pose(s).translation().z(), 0.0, 3e-3) << "the 0.08 m hull rests on the ground";
+  EXPECT_NEAR(world.body_pose(s).translation().z(), 0.0, 3e-3)
+      << "the 0.08 m hull rests on the ground";
 }
 
 TEST(WorldTest, NonFiniteStateRaisesNamingTheRobot) {
