@@ -50,7 +50,13 @@ std::shared_ptr<const MeshData> convert(const std::shared_ptr<const engine::Mesh
     for (const Eigen::Vector3f& p : data->positions) bounds.extend(p);
     const float half_diagonal = 0.5F * bounds.diagonal().norm();
     if (data->triangle_count() > kMeshLowDetailMinTriangles && half_diagonal > 0.0F) {
-      data->low_detail = simplify_by_clustering(*data, half_diagonal / 5.0F);
+      // Two levels: the coarse copy has its own coarser copy, which shadows use (see Renderer).
+      auto coarse =
+          std::make_shared<MeshData>(*simplify_by_clustering(*data, half_diagonal / 3.0F));
+      coarse->low_detail = simplify_by_clustering(*data, half_diagonal / 1.5F);
+      coarse->low_detail_radius = half_diagonal;
+      coarse->low_detail_below_px = 0.0F;  // never chosen for the camera, only for shadows
+      data->low_detail = std::move(coarse);
       data->low_detail_radius = half_diagonal;
       data->low_detail_below_px = kMeshLowDetailBelowPx;
     }

@@ -31,7 +31,8 @@ struct MeshData {
   /// A coarser version drawn instead when the instance is small on screen: when
   /// `low_detail_radius` (in mesh units) times the smaller of the instance's x and y scales
   /// covers fewer than `low_detail_below_px` pixels. (The x-y cross-section is what a round
-  /// primitive's segment count must resolve.) Null for none.
+  /// primitive's segment count must resolve.) Null for none. Shadows are cast by one level
+  /// coarser than the camera draws, when there is one.
   std::shared_ptr<const MeshData> low_detail;
   float low_detail_radius = 1.0F;
   float low_detail_below_px = 0.0F;

@@ -231,6 +231,10 @@ struct FloorUniforms {
 // Floats per arena vertex: position 3, normal 3, texture coordinate 2, part colour 4.
 constexpr int kArenaStride = 12;
 
+// Polygon offsets of the floor and of the shadowed floor footprints drawn over it.
+constexpr float kFloorDepthOffset = 1.0F;
+constexpr float kFootprintDepthOffset = 0.5F;
+
 struct GpuMesh {
   std::shared_ptr<const MeshData> keep_alive;
   GLint base_vertex = 0;          // of its first vertex in the arena
@@ -339,6 +343,7 @@ struct Renderer::Impl {
           floor_at("tile"),      floor_at("color_a"),         floor_at("color_b"),
           floor_at("ambient"),   floor_at("direct"),          floor_at("use_shadows"),
           floor_at("shadow_map")};
+    depth_mvp = glGetUniformLocation(depth_only, "model_view_projection");
     sky_inverse_view_projection = glGetUniformLocation(sky, "inverse_view_projection");
     sky_horizon = glGetUniformLocation(sky, "horizon");
     sky_zenith = glGetUniformLocation(sky, "zenith");
@@ -385,6 +390,11 @@ struct Renderer::Impl {
   ~Impl() {
     context.make_current();
     glDeleteVertexArrays(1, &arena_vao);
+    if (caster_vao != 0) {
+      glDeleteVertexArrays(1, &caster_vao);
+      const GLuint caster_buffers[] = {caster_vbo, caster_ebo};
+      glDeleteBuffers(2, caster_buffers);
+    }
     if (footprint_vao != 0) {
       glDeleteVertexArrays(1, &footprint_vao);
       const GLuint footprint_buffers[] = {footprint_vbo, footprint_ebo};
@@ -623,13 +633,48 @@ struct Renderer::Impl {
     glUseProgram(depth_only);
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(2.0F, 4.0F);  // slope-scaled bias against shadow acne
-    const GLint mvp = glGetUniformLocation(depth_only, "model_view_projection");
+    // Every caster in one draw: llvmpipe's cost per draw call outweighs transforming the
+    // casters' vertices here (the depth pass needs positions only).
+    caster_positions.clear();
+    caster_indices.clear();
     for (std::size_t i = 0; i < scene.instances.size(); ++i) {
       if (!scene.instances[i].casts_shadow) continue;
-      const Eigen::Matrix4f m = light * model_matrix(scene.instances[i]);
-      glUniformMatrix4fv(mvp, 1, GL_FALSE, m.data());
-      draw_all(*gpu[i]);
+      const Eigen::Matrix4f model = model_matrix(scene.instances[i]);
+      // Soft, low-resolution shadows need less geometry than the camera: one level coarser.
+      const GpuMesh& drawn = *gpu[i];
+      const GpuMesh& mesh =
+          drawn.keep_alive->low_detail != nullptr ? upload(drawn.keep_alive->low_detail) : drawn;
+      const auto first = static_cast<std::uint32_t>(caster_positions.size() / 3);
+      const std::size_t vertex_count = mesh.keep_alive->positions.size();
+      for (std::size_t v = 0; v < vertex_count; ++v) {
+        const Eigen::Vector4f p = model * mesh.keep_alive->positions[v].homogeneous();
+        caster_positions.insert(caster_positions.end(), {p.x(), p.y(), p.z()});
+      }
+      for (std::uint32_t index : mesh.keep_alive->indices) caster_indices.push_back(first + index);
     }
+    if (caster_vao == 0) {
+      glGenVertexArrays(1, &caster_vao);
+      glBindVertexArray(caster_vao);
+      glGenBuffers(1, &caster_vbo);
+      glGenBuffers(1, &caster_ebo);
+      glBindBuffer(GL_ARRAY_BUFFER, caster_vbo);
+      glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, caster_ebo);
+      glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float),
+                            reinterpret_cast<void*>(0));
+      glEnableVertexAttribArray(0);
+    }
+    glBindVertexArray(caster_vao);
+    glBindBuffer(GL_ARRAY_BUFFER, caster_vbo);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(caster_positions.size() * sizeof(float)),
+                 caster_positions.data(), GL_STREAM_DRAW);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, caster_ebo);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER,
+                 static_cast<GLsizeiptr>(caster_indices.size() * sizeof(std::uint32_t)),
+                 caster_indices.data(), GL_STREAM_DRAW);
+    glUniformMatrix4fv(depth_mvp, 1, GL_FALSE, light.data());
+    glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(caster_indices.size()), GL_UNSIGNED_INT,
+                   nullptr);
+    glBindVertexArray(arena_vao);
     glDisable(GL_POLYGON_OFFSET_FILL);
     // Clip [-1, 1] to texture [0, 1] happens in the shader.
     return light;
@@ -675,8 +720,11 @@ struct Renderer::Impl {
     }
   }
 
+  // `depth_offset` pushes the floor back (polygon offset factor and units) so that shapes resting
+  // on it never fight it for depth.
   void draw_floor(const Scene& scene, const Eigen::Matrix4f& view_projection,
-                  const Eigen::Matrix4f& light_matrix, bool use_shadows, const GpuMesh& mesh) {
+                  const Eigen::Matrix4f& light_matrix, bool use_shadows, const GpuMesh& mesh,
+                  float depth_offset) {
     Eigen::Matrix4f model = Eigen::Matrix4f::Identity();
     model(2, 3) = scene.floor.height_m;
     const Eigen::Vector3f to_light = -scene.light.direction.normalized();
@@ -693,9 +741,8 @@ struct Renderer::Impl {
     glUniform3fv(fu.direct, 1, direct.data());
     glUniform1i(fu.use_shadows, use_shadows ? 1 : 0);
     glUniform1i(fu.shadow_map, 1);
-    // Pushed back a little so that shapes resting on the floor never fight it for depth.
     glEnable(GL_POLYGON_OFFSET_FILL);
-    glPolygonOffset(1.0F, 1.0F);
+    glPolygonOffset(depth_offset, depth_offset);
     draw_all(mesh);
     glDisable(GL_POLYGON_OFFSET_FILL);
     glBindVertexArray(arena_vao);
@@ -859,7 +906,8 @@ struct Renderer::Impl {
       glViewport(0, 0, camera.width, camera.height);
       glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
       if (scene.floor.enabled)
-        draw_floor(scene, view_projection, light_matrix, false, meshes.at(floor.get()));
+        draw_floor(scene, view_projection, light_matrix, false, meshes.at(floor.get()),
+                   kFloorDepthOffset);
       draw_sky(scene, view_projection);
       background_keys[background.framebuffer] = key;
     }
@@ -872,10 +920,10 @@ struct Renderer::Impl {
     if (use_shadows && scene.floor.enabled) {
       const GpuMesh* footprints = shadow_footprints(scene, gpu);
       if (footprints != nullptr) {
-        // Over the cached floor, at the same depth: always pass the depth test.
-        glDepthFunc(GL_ALWAYS);
-        draw_floor(scene, view_projection, light_matrix, true, *footprints);
-        glDepthFunc(GL_LESS);
+        // Footprints overlap (a tall arm casts long ones). Drawn a little nearer than the cached
+        // floor (and still behind the instances), the first footprint over a pixel passes the
+        // depth test and the ones after it tie and fail: each floor pixel is shaded once.
+        draw_floor(scene, view_projection, light_matrix, true, *footprints, kFootprintDepthOffset);
       }
     }
     draw_instances(scene, gpu);
@@ -972,6 +1020,12 @@ struct Renderer::Impl {
   std::vector<std::uint32_t> footprint_indices;
   GpuMesh footprint_mesh;
   GLuint footprint_vao = 0;
+  std::vector<float> caster_positions;  // world positions of every caster's vertices, per frame
+  std::vector<std::uint32_t> caster_indices;
+  GLuint caster_vao = 0;
+  GLuint caster_vbo = 0;
+  GLuint caster_ebo = 0;
+  GLint depth_mvp = -1;
   GLuint footprint_vbo = 0;
   GLuint footprint_ebo = 0;
   GLuint floor_program = 0;
