@@ -71,18 +71,29 @@ int run_check(const std::string& id, std::uint64_t seed, int steps,
 }
 
 int run_snapshot(const std::string& id, std::uint64_t seed, int steps, const std::string& out,
-                 const std::vector<std::string>& sets) {
+                 bool observation, const std::vector<std::string>& sets) {
   std::unique_ptr<Env> env = make_env(id, sets);
-  env->reset(seed);
+  Value obs = env->reset(seed).obs;
   Rng action_rng(seed);
   for (int t = 0; t < steps; ++t) {
     const StepResult step = env->step(env->action_space().sample(action_rng));
-    if (step.terminated || step.truncated) env->reset();
+    obs = step.obs;
+    if (step.terminated || step.truncated) obs = env->reset().obs;
   }
-  const Array frame = env->render();
+  Array frame;
+  if (observation) {
+    if (!obs.is_dict() || !obs.dict().contains("pixels")) {
+      throw std::invalid_argument(
+          id + ": --observation needs an observation with \"pixels\" (try --set obs_mode=pixels)");
+    }
+    frame = obs.dict().at("pixels").array();
+  } else {
+    frame = env->render();
+  }
   write_frame_png(out, frame);
-  std::cout << "wrote " << out << " (" << frame.shape()[1] << "x" << frame.shape()[0] << ", " << id
-            << ", seed " << seed << ", " << steps << " steps)\n";
+  std::cout << "wrote " << out << " (" << frame.shape()[1] << "x" << frame.shape()[0] << " "
+            << (observation ? "observation" : "render()") << ", " << id << ", seed " << seed << ", "
+            << steps << " steps)\n";
   env->close();
   return 0;
 }
@@ -152,6 +163,7 @@ std::vector<Command> add_env_commands(CLI::App& app) {
     int steps = 0;
     int episodes = 5;
     std::string out;
+    bool observation = false;
     std::vector<std::string> sets;
   };
   auto options = std::make_shared<Options>();
@@ -181,8 +193,9 @@ std::vector<Command> add_env_commands(CLI::App& app) {
                         return run_check(options->id, options->seed, options->steps, options->sets);
                       }});
 
-  CLI::App* snapshot = app.add_subcommand(
-      "snapshot", "Reset with a seed, take K seeded random actions, write render() as a PNG");
+  CLI::App* snapshot = app.add_subcommand("snapshot",
+                                          "Reset with a seed, take K seeded random actions, write "
+                                          "render() (or the observation) as a PNG");
   snapshot->add_option("id", options->id, "Env id, e.g. GridWorld-v0")->required();
   snapshot->add_option("--seed", options->seed, "Seed for the reset and the random actions")
       ->required();
@@ -191,10 +204,13 @@ std::vector<Command> add_env_commands(CLI::App& app) {
   snapshot->add_option("--steps", options->steps, "Random actions before the frame is taken")
       ->default_val(0)
       ->check(CLI::NonNegativeNumber);
+  snapshot->add_flag(
+      "--observation", options->observation,
+      "Write the observation's \"pixels\" (what the agent sees) instead of render()");
   add_set_option(*snapshot, options->sets);
   commands.push_back({snapshot, [options] {
                         return run_snapshot(options->id, options->seed, options->steps,
-                                            options->out, options->sets);
+                                            options->out, options->observation, options->sets);
                       }});
 
   CLI::App* rollout = app.add_subcommand(

@@ -103,6 +103,18 @@ TEST(PixelgymCliTest, SnapshotIsReproducibleFromTheSeed) {
   EXPECT_EQ(read_png(dir + "a.png").pixels, read_png(dir + "b.png").pixels);
 }
 
+TEST(PixelgymCliTest, SnapshotOfTheObservationIsWhatTheAgentSees) {
+  const std::string out = std::string(PIXELGYM_TEST_OUTPUT_DIR) + "/cli/observation.png";
+  const CliRun result = run("snapshot CartPoleSwingup-v0 --seed 0 --observation --out " + out);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const Image image = read_png(out);
+  EXPECT_EQ(image.width, 84);
+  EXPECT_EQ(image.height, 84);
+  const CliRun index = run("snapshot GridWorld-v0 --seed 0 --observation --out " + out);
+  EXPECT_EQ(index.exit_code, 1);
+  EXPECT_THAT(index.output, HasSubstr("obs_mode=pixels"));
+}
+
 TEST(PixelgymCliTest, SnapshotToUnwritablePathFailsClearly) {
   const CliRun result = run("snapshot GridWorld-v0 --seed 0 --out /proc/pixelgym/x.png");
   EXPECT_EQ(result.exit_code, 1);
