@@ -43,6 +43,7 @@ std::shared_ptr<const MeshData> convert(const std::shared_ptr<const engine::Mesh
       out.has_color = keep_part_colors && part.has_color;
       data->parts.push_back(out);
     }
+    data->closed = is_closed_surface(*data);
     // Drawn small (as in 84 x 84 observations), a mesh needs only a fraction of its triangles,
     // and llvmpipe pays for every one: a clustered copy with cells of a tenth of its size is
     // drawn while its half-diagonal covers fewer than kMeshLowDetailBelowPx pixels.

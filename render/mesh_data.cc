@@ -1,9 +1,11 @@
 #include "render/mesh_data.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <tuple>
+#include <utility>
 
 namespace pixelgym {
 namespace {
@@ -87,6 +89,7 @@ std::shared_ptr<const MeshData> make_box_mesh() {
                            {base, base + 2, base + 1, base, base + 3, base + 2});
     }
   }
+  mesh->closed = is_closed_surface(*mesh);
   return mesh;
 }
 
@@ -101,6 +104,7 @@ std::shared_ptr<const MeshData> make_sphere_mesh(int segments) {
     profile.emplace_back(c, s, c, s);
   }
   add_revolution(*mesh, profile, segments);
+  mesh->closed = is_closed_surface(*mesh);
   return mesh;
 }
 
@@ -109,6 +113,7 @@ std::shared_ptr<const MeshData> make_cylinder_mesh(int segments) {
   add_revolution(*mesh, {{1, -0.5F, 1, 0}, {1, 0.5F, 1, 0}}, segments);
   add_disc(*mesh, 0.5F, 1.0F, segments);
   add_disc(*mesh, -0.5F, -1.0F, segments);
+  mesh->closed = is_closed_surface(*mesh);
   return mesh;
 }
 
@@ -130,12 +135,14 @@ std::shared_ptr<const MeshData> make_capsule_mesh(double length_over_radius, int
     profile.emplace_back(c, half + s, c, s);
   }
   add_revolution(*mesh, profile, segments);
+  mesh->closed = is_closed_surface(*mesh);
   return mesh;
 }
 
 std::shared_ptr<const MeshData> simplify_by_clustering(const MeshData& mesh, float cell) {
   using Part = MeshData::Part;
   auto result = std::make_shared<MeshData>();
+  result->closed = mesh.closed;
   std::vector<Part> parts = mesh.parts;
   if (parts.empty()) {
     Part all;
@@ -186,6 +193,43 @@ std::shared_ptr<const MeshData> simplify_by_clustering(const MeshData& mesh, flo
     if (out.index_count > 0) result->parts.push_back(out);
   }
   return result;
+}
+
+bool is_closed_surface(const MeshData& mesh) {
+  if (mesh.indices.empty() || mesh.indices.size() % 3 != 0) return false;
+  Eigen::AlignedBox3f bounds;
+  for (const Eigen::Vector3f& p : mesh.positions) bounds.extend(p);
+  const float tolerance = std::max(1e-6F * bounds.diagonal().norm(), 1e-12F);
+  // Vertices by rounded position.
+  std::map<std::tuple<long, long, long>, std::uint32_t> welded;
+  std::vector<std::uint32_t> id(mesh.positions.size());
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+    const Eigen::Vector3f& p = mesh.positions[v];
+    const auto key = std::make_tuple(std::lround(p.x() / tolerance), std::lround(p.y() / tolerance),
+                                     std::lround(p.z() / tolerance));
+    id[v] = welded.emplace(key, static_cast<std::uint32_t>(welded.size())).first->second;
+  }
+  // Directed edges and how often each is used.
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> edges;
+  double six_volume = 0.0;
+  for (std::size_t i = 0; i + 2 < mesh.indices.size(); i += 3) {
+    const std::uint32_t v[3] = {mesh.indices[i], mesh.indices[i + 1], mesh.indices[i + 2]};
+    if (v[0] >= id.size() || v[1] >= id.size() || v[2] >= id.size()) return false;
+    const std::uint32_t a = id[v[0]], b = id[v[1]], c = id[v[2]];
+    if (a == b || b == c || a == c) continue;
+    ++edges[{a, b}];
+    ++edges[{b, c}];
+    ++edges[{c, a}];
+    six_volume += mesh.positions[v[0]].cast<double>().dot(
+        mesh.positions[v[1]].cast<double>().cross(mesh.positions[v[2]].cast<double>()));
+  }
+  if (edges.empty()) return false;
+  for (const auto& [edge, count] : edges) {
+    if (count != 1) return false;
+    const auto reverse = edges.find({edge.second, edge.first});
+    if (reverse == edges.end() || reverse->second != 1) return false;
+  }
+  return six_volume > 0.0;
 }
 
 std::shared_ptr<const MeshData> with_low_detail(const MeshData& fine,

@@ -37,8 +37,19 @@ struct MeshData {
   float low_detail_radius = 1.0F;
   float low_detail_below_px = 0.0F;
 
+  /// A closed, outward-wound surface (see `is_closed_surface`): faces turned away from a viewer
+  /// always lie behind faces turned toward it, so the renderer culls them. False draws every
+  /// face. Primitives are closed; `simplify_by_clustering` keeps its source's flag.
+  bool closed = false;
+
   std::size_t triangle_count() const { return indices.size() / 3; }
 };
+
+/// Whether `mesh` bounds a volume with every triangle counter-clockwise seen from outside: with
+/// vertices matched by position (to a millionth of the mesh's size, so that seams with split
+/// normals or texture coordinates join), every edge is used exactly once in each direction, and
+/// the enclosed volume is positive. Degenerate triangles are ignored.
+bool is_closed_surface(const MeshData& mesh);
 
 /// Unit primitives, centred at the origin; instances scale them. Cylinders and capsules lie along
 /// z. `segments` sets the smoothness of round shapes.
@@ -52,6 +63,9 @@ std::shared_ptr<const MeshData> make_capsule_mesh(double length_over_radius, int
 /// A simplified copy of `mesh` for drawing small on screen: vertices are snapped to a grid of
 /// `cell` (mesh units) and merged within each part (so colours stay), triangles that collapse are
 /// dropped, and normals are averaged. Vertex clustering keeps the silhouette to about one cell.
+/// The copy keeps `mesh.closed`: every triangle keeps its orientation, so a closed surface's
+/// faces turned away from a viewer stay hidden, to about one cell, even where parts no longer
+/// share vertices.
 std::shared_ptr<const MeshData> simplify_by_clustering(const MeshData& mesh, float cell);
 
 /// A copy of `fine` that is drawn as `coarse` when its round cross-section (radius 1 in mesh

@@ -73,13 +73,14 @@ uniform bool use_texture;
 uniform sampler2D albedo;
 uniform bool use_shadows;
 uniform sampler2DShadow shadow_map;
+uniform bool mirrored;  // a negative scale turns the winding, and so gl_FrontFacing, around
 out vec4 fragment;
 
 @SHADOW@
 
 void main() {
   vec3 n = normalize(world_normal);
-  if (!gl_FrontFacing) n = -n;
+  if (gl_FrontFacing == mirrored) n = -n;  // seen from behind: light the side in view
   // A mesh part's own colour, or the instance's when the part has none (alpha < 0).
   vec3 color = vertex_color.a >= 0.0 ? vertex_color.rgb : base_color.rgb;
   if (use_texture) color *= texture(albedo, texcoord).rgb;
@@ -220,7 +221,8 @@ GLuint link(const char* vertex, const char* fragment) {
 // Uniform locations of the lit program, looked up once.
 struct LitUniforms {
   GLint model, normal_matrix, view_projection, light_matrix, base_color, specular, shininess,
-      to_light, light_color, ambient, camera_position, use_texture, albedo, use_shadows, shadow_map;
+      to_light, light_color, ambient, camera_position, use_texture, albedo, use_shadows, shadow_map,
+      mirrored;
 };
 
 struct FloorUniforms {
@@ -334,7 +336,7 @@ struct Renderer::Impl {
     u = {at("model"),       at("normal_matrix"), at("view_projection"), at("light_matrix"),
          at("base_color"),  at("specular"),      at("shininess"),       at("to_light"),
          at("light_color"), at("ambient"),       at("camera_position"), at("use_texture"),
-         at("albedo"),      at("use_shadows"),   at("shadow_map")};
+         at("albedo"),      at("use_shadows"),   at("shadow_map"),      at("mirrored")};
     floor_program = link(kFloorVertex, with_shadow_lookup(kFloorFragment).c_str());
     const auto floor_at = [this](const char* name) {
       return glGetUniformLocation(floor_program, name);
@@ -622,6 +624,14 @@ struct Renderer::Impl {
       }
     }
     if (low.x() > high.x()) return Eigen::Matrix4f::Zero();  // nothing casts
+    // A flat caster (a sheet facing the light, or seen edge-on) has no extent along some axis;
+    // give it half a millimetre each way so that the projection stays finite.
+    for (int axis = 0; axis < 3; ++axis) {
+      if (high[axis] - low[axis] < 1e-4F) {
+        low[axis] -= 5e-4F;
+        high[axis] += 5e-4F;
+      }
+    }
     // Light space looks down -z: the casters lie between depths -high.z() and -low.z().
     const Eigen::Matrix4f light =
         orthographic(low.x(), high.x(), low.y(), high.y(), -high.z(), -low.z()) * light_view;
@@ -633,24 +643,34 @@ struct Renderer::Impl {
     glUseProgram(depth_only);
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(2.0F, 4.0F);  // slope-scaled bias against shadow acne
-    // Every caster in one draw: llvmpipe's cost per draw call outweighs transforming the
-    // casters' vertices here (the depth pass needs positions only).
+    // Every caster in at most two draws: llvmpipe's cost per draw call outweighs transforming
+    // the casters' vertices here (the depth pass needs positions only). Closed casters come
+    // first and are drawn with their faces turned away from the light culled: the map keeps the
+    // nearest depth, which is always a face turned toward the light, and llvmpipe's cost here is
+    // in filling triangles (culling halves the arm's shadow pass).
     caster_positions.clear();
     caster_indices.clear();
-    for (std::size_t i = 0; i < scene.instances.size(); ++i) {
-      if (!scene.instances[i].casts_shadow) continue;
-      const Eigen::Matrix4f model = model_matrix(scene.instances[i]);
-      // Soft, low-resolution shadows need less geometry than the camera: one level coarser.
-      const GpuMesh& drawn = *gpu[i];
-      const GpuMesh& mesh =
-          drawn.keep_alive->low_detail != nullptr ? upload(drawn.keep_alive->low_detail) : drawn;
-      const auto first = static_cast<std::uint32_t>(caster_positions.size() / 3);
-      const std::size_t vertex_count = mesh.keep_alive->positions.size();
-      for (std::size_t v = 0; v < vertex_count; ++v) {
-        const Eigen::Vector4f p = model * mesh.keep_alive->positions[v].homogeneous();
-        caster_positions.insert(caster_positions.end(), {p.x(), p.y(), p.z()});
+    std::size_t culled_index_count = 0;
+    for (const bool closed_pass : {true, false}) {
+      for (std::size_t i = 0; i < scene.instances.size(); ++i) {
+        if (!scene.instances[i].casts_shadow) continue;
+        // Soft, low-resolution shadows need less geometry than the camera: one level coarser.
+        const GpuMesh& drawn = *gpu[i];
+        const GpuMesh& mesh =
+            drawn.keep_alive->low_detail != nullptr ? upload(drawn.keep_alive->low_detail) : drawn;
+        if (cullable(scene.instances[i], *mesh.keep_alive) != closed_pass) continue;
+        const Eigen::Matrix4f model = model_matrix(scene.instances[i]);
+        const auto first = static_cast<std::uint32_t>(caster_positions.size() / 3);
+        const std::size_t vertex_count = mesh.keep_alive->positions.size();
+        for (std::size_t v = 0; v < vertex_count; ++v) {
+          const Eigen::Vector4f p = model * mesh.keep_alive->positions[v].homogeneous();
+          caster_positions.insert(caster_positions.end(), {p.x(), p.y(), p.z()});
+        }
+        for (std::uint32_t index : mesh.keep_alive->indices) {
+          caster_indices.push_back(first + index);
+        }
       }
-      for (std::uint32_t index : mesh.keep_alive->indices) caster_indices.push_back(first + index);
+      if (closed_pass) culled_index_count = caster_indices.size();
     }
     if (caster_vao == 0) {
       glGenVertexArrays(1, &caster_vao);
@@ -672,8 +692,19 @@ struct Renderer::Impl {
                  static_cast<GLsizeiptr>(caster_indices.size() * sizeof(std::uint32_t)),
                  caster_indices.data(), GL_STREAM_DRAW);
     glUniformMatrix4fv(depth_mvp, 1, GL_FALSE, light.data());
-    glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(caster_indices.size()), GL_UNSIGNED_INT,
-                   nullptr);
+    glFrontFace(GL_CCW);  // the light's projection is not flipped
+    if (culled_index_count > 0) {
+      glEnable(GL_CULL_FACE);
+      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(culled_index_count), GL_UNSIGNED_INT,
+                     nullptr);
+      glDisable(GL_CULL_FACE);
+    }
+    if (caster_indices.size() > culled_index_count) {
+      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(caster_indices.size() - culled_index_count),
+                     GL_UNSIGNED_INT,
+                     reinterpret_cast<void*>(culled_index_count * sizeof(std::uint32_t)));
+    }
+    glFrontFace(GL_CW);  // back to the camera's flipped projection
     glBindVertexArray(arena_vao);
     glDisable(GL_POLYGON_OFFSET_FILL);
     // Clip [-1, 1] to texture [0, 1] happens in the shader.
@@ -702,10 +733,25 @@ struct Renderer::Impl {
     return size * pixels_per_metre < mesh.low_detail_below_px ? mesh.low_detail : instance.mesh;
   }
 
+  // Whether an instance's faces turned away from the viewer may be culled: a closed mesh, not
+  // mirrored by its scale (a mirror turns its winding inside out).
+  static bool cullable(const Instance& instance, const MeshData& mesh) {
+    return mesh.closed && instance.scale.prod() > 0.0F;
+  }
+
   void draw_instances(const Scene& scene, const std::vector<const GpuMesh*>& gpu) {
     glUseProgram(lit);
+    bool culling = false;
     for (std::size_t i = 0; i < scene.instances.size(); ++i) {
       const Instance& instance = scene.instances[i];
+      if (cullable(instance, *gpu[i]->keep_alive) != culling) {
+        culling = !culling;
+        if (culling) {
+          glEnable(GL_CULL_FACE);
+        } else {
+          glDisable(GL_CULL_FACE);
+        }
+      }
       const Eigen::Matrix4f model = model_matrix(instance);
       const Eigen::Matrix3f normal_matrix = model.block<3, 3>(0, 0).inverse().transpose();
       glUniformMatrix4fv(u.model, 1, GL_FALSE, model.data());
@@ -714,10 +760,12 @@ struct Renderer::Impl {
       glUniform1f(u.shininess, instance.material.shininess);
       const bool textured = !instance.material.texture_path.empty();
       glUniform1i(u.use_texture, textured ? 1 : 0);
+      glUniform1i(u.mirrored, instance.scale.prod() < 0.0F ? 1 : 0);
       bind_albedo(textured ? texture(instance.material.texture_path) : white_texture);
       glUniform4fv(u.base_color, 1, instance.material.base_color.data());
       draw_all(*gpu[i]);
     }
+    glDisable(GL_CULL_FACE);
   }
 
   // `depth_offset` pushes the floor back (polygon offset factor and units) so that shapes resting

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <utility>
 
 namespace pixelgym {
 namespace {
@@ -24,10 +25,40 @@ void expect_closed_outward(const MeshData& mesh) {
 }
 
 TEST(MeshDataTest, PrimitivesAreClosedAndFaceOutward) {
-  expect_closed_outward(*make_box_mesh());
-  expect_closed_outward(*make_sphere_mesh());
-  expect_closed_outward(*make_cylinder_mesh());
-  expect_closed_outward(*make_capsule_mesh(3.0));
+  for (const auto& mesh :
+       {make_box_mesh(), make_sphere_mesh(), make_sphere_mesh(10), make_cylinder_mesh(),
+        make_cylinder_mesh(10), make_capsule_mesh(3.0), make_capsule_mesh(0.0, 10)}) {
+    expect_closed_outward(*mesh);
+    EXPECT_TRUE(mesh->closed);
+    EXPECT_TRUE(is_closed_surface(*mesh));
+  }
+}
+
+TEST(MeshDataTest, OpenOrInsideOutSurfacesAreNotClosed) {
+  const MeshData box = *make_box_mesh();
+  MeshData open = box;  // one triangle missing
+  open.indices.resize(open.indices.size() - 3);
+  EXPECT_FALSE(is_closed_surface(open));
+  MeshData inside_out = box;  // every triangle wound the other way
+  for (std::size_t i = 0; i < inside_out.indices.size(); i += 3) {
+    std::swap(inside_out.indices[i + 1], inside_out.indices[i + 2]);
+  }
+  EXPECT_FALSE(is_closed_surface(inside_out));
+  MeshData one_flipped = box;  // inconsistent winding
+  std::swap(one_flipped.indices[1], one_flipped.indices[2]);
+  EXPECT_FALSE(is_closed_surface(one_flipped));
+  MeshData doubled = box;  // a face drawn twice
+  doubled.indices.insert(doubled.indices.end(), box.indices.begin(), box.indices.begin() + 3);
+  EXPECT_FALSE(is_closed_surface(doubled));
+  EXPECT_FALSE(is_closed_surface(MeshData{}));
+  EXPECT_FALSE(MeshData{}.closed);
+}
+
+TEST(MeshDataTest, ClusteringKeepsTheClosedFlag) {
+  EXPECT_TRUE(simplify_by_clustering(*make_sphere_mesh(), 0.5F)->closed);
+  MeshData open = *make_sphere_mesh();
+  open.closed = false;
+  EXPECT_FALSE(simplify_by_clustering(open, 0.5F)->closed);
 }
 
 TEST(MeshDataTest, PrimitiveExtents) {

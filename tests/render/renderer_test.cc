@@ -151,6 +151,59 @@ TEST(RendererTest, ShadowsDarkenTheFloorUnderAnObject) {
   EXPECT_GT(unchanged, kSize * kSize / 2) << "shadows darkened more than the shadow";
 }
 
+// Faces turned away are culled only for closed meshes: an open one (a single sheet, here facing
+// away from both the camera and the light) is still drawn and still casts its shadow.
+TEST(RendererTest, OpenMeshesAreDrawnAndShadowedFromBehind) {
+  auto sheet = std::make_shared<MeshData>();
+  sheet->positions = {{-0.3F, -0.3F, 0}, {0.3F, -0.3F, 0}, {0.3F, 0.3F, 0}, {-0.3F, 0.3F, 0}};
+  sheet->normals.assign(4, Eigen::Vector3f(0, 0, -1));
+  sheet->indices = {0, 2, 1, 0, 3, 2};  // clockwise seen from above: it faces down
+  ASSERT_FALSE(is_closed_surface(*sheet));
+  Renderer renderer;
+  Scene scene;
+  scene.light.direction = {0, 0, -1};  // straight down, onto the sheet's back
+  Instance instance;
+  instance.mesh = sheet;
+  instance.X_world_instance.translation() = Eigen::Vector3f(0, 0, 0.6F);
+  instance.material.base_color = {0.9F, 0.1F, 0.1F, 1};
+  scene.instances.push_back(instance);
+  Camera camera = Camera::look_at({0.01F, -0.5F, 3.0F}, {0, 0, 0});
+  camera.width = camera.height = kSize;
+  std::vector<std::uint8_t> with(kSize * kSize * 3);
+  std::vector<std::uint8_t> without(kSize * kSize * 3);
+  renderer.render(scene, camera, {with.data()});
+  const Pixel centre = at(with, kSize, kSize / 2, kSize / 2);
+  EXPECT_GT(centre.r, 2 * centre.g) << "the sheet is not drawn from behind";
+  scene.shadows = false;
+  renderer.render(scene, camera, {without.data()});
+  int darker = 0;
+  for (std::size_t i = 0; i < with.size(); i += 3) {
+    if (int{without[i]} - int{with[i]} > 20) ++darker;
+  }
+  EXPECT_GT(darker, 20) << "the sheet casts no shadow from behind";
+}
+
+// A closed mesh mirrored by a negative scale is wound inside out; it must not be culled as if it
+// were not. A mirrored box is the same box.
+TEST(RendererTest, MirroredClosedMeshesLookTheSame) {
+  Renderer renderer;
+  Scene scene;
+  scene.instances.push_back(box({0, 0, 0.5F}, {0.6F, 0.4F, 0.5F}, {0.2F, 0.7F, 0.3F, 1}));
+  std::vector<std::uint8_t> plain(kSize * kSize * 3);
+  std::vector<std::uint8_t> mirrored(kSize * kSize * 3);
+  const Camera camera = Camera::look_at({1.5F, -2.5F, 1.8F}, {0, 0, 0.4F});
+  Camera sized = camera;
+  sized.width = sized.height = kSize;
+  renderer.render(scene, sized, {plain.data()});
+  scene.instances[0].scale.x() = -scene.instances[0].scale.x();
+  renderer.render(scene, sized, {mirrored.data()});
+  int differing = 0;
+  for (std::size_t i = 0; i < plain.size(); ++i) {
+    if (std::abs(int{plain[i]} - int{mirrored[i]}) > 8) ++differing;
+  }
+  EXPECT_LT(differing, 10);
+}
+
 TEST(RendererTest, TexturesModulateTheBaseColour) {
   Renderer renderer;
   Scene scene = flat_scene();
