@@ -103,9 +103,9 @@ struct AcrobotModel {
   }
 };
 
-/// An energy-pumping swing-up, used only as the planner's initial guess: the elbow pushes energy
-/// in (its power is tau * w2) while the arm is below the upright energy, and otherwise keeps
-/// the arm straight.
+/// An energy-pumping swing-up, used only as the planner's initial guess: the elbow drives the
+/// energy toward the upright energy (its power is tau * w2) while a soft spring keeps the arm
+/// straight. Alone it reaches the upright energy but not the top: the lower link ends up spinning.
 inline double energy_pump(const Eigen::Vector4d& s) {
   const double tau = 20.0 * (AcrobotModel::kTopEnergy - AcrobotModel::energy(s)) * s[3] -
                      4.0 * wrap_angle_pi(s[1]) - 1.0 * s[3];
