@@ -8,6 +8,10 @@
 #   CartPoleSwingup-v0, shadows off  /  MuJoCo -lite (no shadows)          target >= 4
 #   CartPoleSwingup-v0, shadows on   /  MuJoCo with dm_control's visuals    target >= 40
 #   ArmReach-v0 (7-DOF mesh arm)     /  CartPoleSwingup-v0 (shadows on)      target >= 0.25
+# and then, with LP_NUM_THREADS=0, every registered env: pixel steps per second with its default
+# kwargs (84x84, shadows on; GridWorld with obs_mode=pixels), beside its physics-only rate
+# (obs_mode=state; GridWorld's index observation), and its pixel rate over the MuJoCo cart-pole's
+# with dm_control's visuals (which has shadows too) in the same run: a scale, not a like-for-like.
 # Installs libmujoco-dev with apt-get when it is missing (the peer needs it; pixelgym does not).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -46,3 +50,15 @@ for threads in 0 unset; do
   echo "  cart-pole shadows on / MuJoCo full  = $(ratio "$cart_on" "$mj_full")  (target >= 40)"
   echo "  arm / cart-pole (shadows on)        = $(ratio "$arm_on" "$cart_on")  (target >= 0.25)"
 done
+
+echo "every env, LP_NUM_THREADS=0 (medians of $repeats, steps/s, one env, one thread)"
+printf '  %-28s %10s %10s %14s\n' "id" "pixels" "no pixels" "pixels / MJ"
+mj_full=$(for r in $(seq "$repeats"); do LP_NUM_THREADS=0 "$build/peers/mujoco_bench" "$peer/cartpole.xml" -n 400 -w 84 -h 84 2>/dev/null | rate; done | median)
+for id in $("$pixelgym" list | awk '{print $1}'); do
+  if [ "$id" = GridWorld-v0 ]; then pixels=(--set obs_mode=pixels); plain=();
+  else pixels=(); plain=(--set obs_mode=state); fi
+  with=$(for r in $(seq "$repeats"); do LP_NUM_THREADS=0 "$pixelgym" bench "$id" --steps 1500 "${pixels[@]}" | rate; done | median)
+  without=$(for r in $(seq "$repeats"); do LP_NUM_THREADS=0 "$pixelgym" bench "$id" --steps 5000 "${plain[@]}" | rate; done | median)
+  printf '  %-28s %10s %10s %14s\n' "$id" "$with" "$without" "$(ratio "$with" "$mj_full")"
+done
+echo "  (MJ: MuJoCo + OSMesa cart-pole with dm_control's visuals, measured again here: $mj_full)"
