@@ -156,11 +156,15 @@ int run_bench(const std::string& id, std::uint64_t seed, int steps,
 }  // namespace
 
 std::vector<Command> add_env_commands(CLI::App& app) {
-  // Options live in shared state owned by the returned callbacks.
+  // Options live in shared state owned by the returned callbacks. Each subcommand's `--steps` has
+  // its own variable: CLI11 writes a default into the variable when the option is declared, so
+  // a shared one would take the last subcommand's default.
   struct Options {
     std::string id;
     std::uint64_t seed = 0;
-    int steps = 0;
+    int check_steps = 0;
+    int snapshot_steps = 0;
+    int bench_steps = 0;
     int episodes = 5;
     std::string out;
     bool observation = false;
@@ -185,12 +189,13 @@ std::vector<Command> add_env_commands(CLI::App& app) {
   check->add_option("id", options->id, "Env id, e.g. GridWorld-v0")->required();
   check->add_option("--seed", options->seed, "Seed for resets and random actions")
       ->capture_default_str();
-  check->add_option("--steps", options->steps, "Random steps per checked trajectory")
+  check->add_option("--steps", options->check_steps, "Random steps per checked trajectory")
       ->default_val(100)
       ->check(CLI::PositiveNumber);
   add_set_option(*check, options->sets);
   commands.push_back({check, [options] {
-                        return run_check(options->id, options->seed, options->steps, options->sets);
+                        return run_check(options->id, options->seed, options->check_steps,
+                                         options->sets);
                       }});
 
   CLI::App* snapshot = app.add_subcommand("snapshot",
@@ -201,7 +206,8 @@ std::vector<Command> add_env_commands(CLI::App& app) {
       ->required();
   snapshot->add_option("--out", options->out, "PNG file to write (folders are created)")
       ->required();
-  snapshot->add_option("--steps", options->steps, "Random actions before the frame is taken")
+  snapshot
+      ->add_option("--steps", options->snapshot_steps, "Random actions before the frame is taken")
       ->default_val(0)
       ->check(CLI::NonNegativeNumber);
   snapshot->add_flag(
@@ -209,7 +215,7 @@ std::vector<Command> add_env_commands(CLI::App& app) {
       "Write the observation's \"pixels\" (what the agent sees) instead of render()");
   add_set_option(*snapshot, options->sets);
   commands.push_back({snapshot, [options] {
-                        return run_snapshot(options->id, options->seed, options->steps,
+                        return run_snapshot(options->id, options->seed, options->snapshot_steps,
                                             options->out, options->observation, options->sets);
                       }});
 
@@ -234,14 +240,15 @@ std::vector<Command> add_env_commands(CLI::App& app) {
       "physics + "
       "render + observation, one thread (--set obs_mode=state for physics alone)");
   bench->add_option("id", options->id, "Env id, e.g. CartPoleSwingup-v0")->required();
-  bench->add_option("--steps", options->steps, "Steps to time")
+  bench->add_option("--steps", options->bench_steps, "Steps to time")
       ->default_val(2000)
       ->check(CLI::PositiveNumber);
   bench->add_option("--seed", options->seed, "Seed for the reset and the random actions")
       ->capture_default_str();
   add_set_option(*bench, options->sets);
   commands.push_back({bench, [options] {
-                        return run_bench(options->id, options->seed, options->steps, options->sets);
+                        return run_bench(options->id, options->seed, options->bench_steps,
+                                         options->sets);
                       }});
   return commands;
 }

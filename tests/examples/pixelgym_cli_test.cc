@@ -103,6 +103,18 @@ TEST(PixelgymCliTest, SnapshotIsReproducibleFromTheSeed) {
   EXPECT_EQ(read_png(dir + "a.png").pixels, read_png(dir + "b.png").pixels);
 }
 
+// Each subcommand keeps its own defaults: snapshot's --steps is 0 (the frame after reset), not
+// bench's 2000.
+TEST(PixelgymCliTest, SnapshotDefaultsToTheFrameAfterReset) {
+  const std::string dir = std::string(PIXELGYM_TEST_OUTPUT_DIR) + "/cli/";
+  const CliRun plain = run("snapshot GridWorld-v0 --seed 2 --out " + dir + "reset_default.png");
+  ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  EXPECT_THAT(plain.output, HasSubstr("seed 2, 0 steps)"));
+  ASSERT_EQ(
+      run("snapshot GridWorld-v0 --seed 2 --steps 0 --out " + dir + "reset_zero.png").exit_code, 0);
+  EXPECT_EQ(read_png(dir + "reset_default.png").pixels, read_png(dir + "reset_zero.png").pixels);
+}
+
 TEST(PixelgymCliTest, SnapshotOfTheObservationIsWhatTheAgentSees) {
   const std::string out = std::string(PIXELGYM_TEST_OUTPUT_DIR) + "/cli/observation.png";
   const CliRun result = run("snapshot CartPoleSwingup-v0 --seed 0 --observation --out " + out);
