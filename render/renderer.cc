@@ -650,28 +650,26 @@ struct Renderer::Impl {
     // in filling triangles (culling halves the arm's shadow pass).
     caster_positions.clear();
     caster_indices.clear();
-    std::size_t culled_index_count = 0;
-    for (const bool closed_pass : {true, false}) {
-      for (std::size_t i = 0; i < scene.instances.size(); ++i) {
-        if (!scene.instances[i].casts_shadow) continue;
-        // Soft, low-resolution shadows need less geometry than the camera: one level coarser.
-        const GpuMesh& drawn = *gpu[i];
-        const GpuMesh& mesh =
-            drawn.keep_alive->low_detail != nullptr ? upload(drawn.keep_alive->low_detail) : drawn;
-        if (cullable(scene.instances[i], *mesh.keep_alive) != closed_pass) continue;
-        const Eigen::Matrix4f model = model_matrix(scene.instances[i]);
-        const auto first = static_cast<std::uint32_t>(caster_positions.size() / 3);
-        const std::size_t vertex_count = mesh.keep_alive->positions.size();
-        for (std::size_t v = 0; v < vertex_count; ++v) {
-          const Eigen::Vector4f p = model * mesh.keep_alive->positions[v].homogeneous();
-          caster_positions.insert(caster_positions.end(), {p.x(), p.y(), p.z()});
-        }
-        for (std::uint32_t index : mesh.keep_alive->indices) {
-          caster_indices.push_back(first + index);
-        }
+    open_caster_indices.clear();
+    for (std::size_t i = 0; i < scene.instances.size(); ++i) {
+      if (!scene.instances[i].casts_shadow) continue;
+      // Soft, low-resolution shadows need less geometry than the camera: one level coarser.
+      const GpuMesh& drawn = *gpu[i];
+      const GpuMesh& mesh =
+          drawn.keep_alive->low_detail != nullptr ? upload(drawn.keep_alive->low_detail) : drawn;
+      const Eigen::Matrix4f model = model_matrix(scene.instances[i]);
+      const auto first = static_cast<std::uint32_t>(caster_positions.size() / 3);
+      for (const Eigen::Vector3f& position : mesh.keep_alive->positions) {
+        const Eigen::Vector4f p = model * position.homogeneous();
+        caster_positions.insert(caster_positions.end(), {p.x(), p.y(), p.z()});
       }
-      if (closed_pass) culled_index_count = caster_indices.size();
+      std::vector<std::uint32_t>& indices =
+          cullable(scene.instances[i], *mesh.keep_alive) ? caster_indices : open_caster_indices;
+      for (std::uint32_t index : mesh.keep_alive->indices) indices.push_back(first + index);
     }
+    const std::size_t culled_index_count = caster_indices.size();
+    caster_indices.insert(caster_indices.end(), open_caster_indices.begin(),
+                          open_caster_indices.end());
     if (caster_vao == 0) {
       glGenVertexArrays(1, &caster_vao);
       glBindVertexArray(caster_vao);
@@ -1069,7 +1067,8 @@ struct Renderer::Impl {
   GpuMesh footprint_mesh;
   GLuint footprint_vao = 0;
   std::vector<float> caster_positions;  // world positions of every caster's vertices, per frame
-  std::vector<std::uint32_t> caster_indices;
+  std::vector<std::uint32_t> caster_indices;       // closed casters', then the open ones'
+  std::vector<std::uint32_t> open_caster_indices;  // scratch
   GLuint caster_vao = 0;
   GLuint caster_vbo = 0;
   GLuint caster_ebo = 0;

@@ -21,12 +21,9 @@
 #include <vector>
 
 #include "envs/tasks/acrobot.h"
+#include "envs/tasks/angles.h"
 
 namespace pixelgym::testing {
-
-inline constexpr double kAcrobotPi = 3.14159265358979323846;
-
-inline double wrap_angle_pi(double a) { return std::remainder(a, 2.0 * kAcrobotPi); }
 
 /// The acrobot asset as an analytic model: two 1 kg, 1 m links with centres at 0.5 m and
 /// 1/12 kg m^2 about them. State s = (q1, q2, w1, w2): angles from hanging straight down, the
@@ -62,15 +59,8 @@ struct AcrobotModel {
 
   /// Gradient of `energy` by central differences.
   static Eigen::RowVector4d energy_gradient(const Eigen::Vector4d& s) {
-    constexpr double kEps = 1e-6;
-    Eigen::RowVector4d gradient;
-    for (int j = 0; j < 4; ++j) {
-      Eigen::Vector4d plus = s, minus = s;
-      plus[j] += kEps;
-      minus[j] -= kEps;
-      gradient[j] = (energy(plus) - energy(minus)) / (2 * kEps);
-    }
-    return gradient;
+    return central_difference<1>(
+        [](const Eigen::Vector4d& x) { return Eigen::Matrix<double, 1, 1>(energy(x)); }, s);
   }
 
   /// One 0.01 s control step under `action` in [-1, 1], integrated as the simulation does it:
@@ -87,19 +77,28 @@ struct AcrobotModel {
   /// Jacobians of `step` by central differences.
   static void linearize(const Eigen::Vector4d& s, double action, Eigen::Matrix4d& a,
                         Eigen::Vector4d& b) {
+    a = central_difference<4>([action](const Eigen::Vector4d& x) { return step(x, action); }, s);
     constexpr double kEps = 1e-6;
+    b = (step(s, action + kEps) - step(s, action - kEps)) / (2 * kEps);
+  }
+
+  /// d f / d s (rows: f's outputs) by central differences of 1e-6.
+  template <int Rows, typename F>
+  static Eigen::Matrix<double, Rows, 4> central_difference(F f, const Eigen::Vector4d& s) {
+    constexpr double kEps = 1e-6;
+    Eigen::Matrix<double, Rows, 4> jacobian;
     for (int j = 0; j < 4; ++j) {
       Eigen::Vector4d plus = s, minus = s;
       plus[j] += kEps;
       minus[j] -= kEps;
-      a.col(j) = (step(plus, action) - step(minus, action)) / (2 * kEps);
+      jacobian.col(j) = (f(plus) - f(minus)) / (2 * kEps);
     }
-    b = (step(s, action + kEps) - step(s, action - kEps)) / (2 * kEps);
+    return jacobian;
   }
 
   /// Deviation from upright, angles wrapped to [-pi, pi].
   static Eigen::Vector4d from_top(const Eigen::Vector4d& s) {
-    return {wrap_angle_pi(s[0] - kAcrobotPi), wrap_angle_pi(s[1]), s[2], s[3]};
+    return {wrap_angle(s[0] - kPi), wrap_angle(s[1]), s[2], s[3]};
   }
 };
 
@@ -108,7 +107,7 @@ struct AcrobotModel {
 /// straight. Alone it reaches the upright energy but not the top: the lower link ends up spinning.
 inline double energy_pump(const Eigen::Vector4d& s) {
   const double tau = 20.0 * (AcrobotModel::kTopEnergy - AcrobotModel::energy(s)) * s[3] -
-                     4.0 * wrap_angle_pi(s[1]) - 1.0 * s[3];
+                     4.0 * wrap_angle(s[1]) - 1.0 * s[3];
   return std::clamp(tau / AcrobotTask::kMaxTorqueNm, -1.0, 1.0);
 }
 
@@ -249,7 +248,7 @@ class Planner {
 inline Eigen::RowVector4d upright_lqr_gain() {
   Eigen::Matrix4d a;
   Eigen::Vector4d b;
-  AcrobotModel::linearize(Eigen::Vector4d(kAcrobotPi, 0, 0, 0), 0.0, a, b);
+  AcrobotModel::linearize(Eigen::Vector4d(kPi, 0, 0, 0), 0.0, a, b);
   const Eigen::Matrix4d q = Eigen::Vector4d(1, 1, 0.1, 0.1).asDiagonal();
   constexpr double kR = 1.0;
   Eigen::Matrix4d p = q;

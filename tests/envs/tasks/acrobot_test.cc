@@ -8,6 +8,7 @@
 
 #include "envs/pixel_env.h"
 #include "envs/registry.h"
+#include "envs/tasks/angles.h"
 #include "tests/envs/tasks/acrobot_mpc.h"
 #include "tests/envs/tasks/scripted.h"
 
@@ -15,7 +16,6 @@ namespace pixelgym {
 namespace {
 
 using testing::AcrobotModel;
-using testing::kAcrobotPi;
 using testing::state;
 
 Eigen::Vector4d observed_state(const Value& obs) {
@@ -51,8 +51,7 @@ TEST(AcrobotTest, StepModelMatchesTheSimulation) {
     const Eigen::Vector4d simulated = observed_state(env->step(action(u)).obs);
     const Eigen::Vector4d predicted = AcrobotModel::step(s, u);
     for (int j = 0; j < 2; ++j) {
-      worst_angle =
-          std::max(worst_angle, std::abs(testing::wrap_angle_pi(simulated[j] - predicted[j])));
+      worst_angle = std::max(worst_angle, std::abs(wrap_angle(simulated[j] - predicted[j])));
       worst_rate = std::max(worst_rate, std::abs(simulated[2 + j] - predicted[2 + j]));
     }
   }
@@ -67,8 +66,8 @@ TEST(AcrobotTest, UprightLqrHoldsTheArm) {
   std::unique_ptr<Env> env = make("AcrobotSwingup-v0", {{"obs_mode", "state"}});
   const Eigen::RowVector4d gain = testing::upright_lqr_gain();
   for (const Eigen::Vector4d& start :
-       {Eigen::Vector4d(kAcrobotPi + 0.01, 0, 0, 0), Eigen::Vector4d(kAcrobotPi, -0.01, 0, 0),
-        Eigen::Vector4d(kAcrobotPi - 0.01, 0.01, 0.05, -0.05)}) {
+       {Eigen::Vector4d(kPi + 0.01, 0, 0, 0), Eigen::Vector4d(kPi, -0.01, 0, 0),
+        Eigen::Vector4d(kPi - 0.01, 0.01, 0.05, -0.05)}) {
     env->reset(0);
     set_state(*env, start);
     Eigen::Vector4d s = start;
@@ -120,7 +119,7 @@ TEST(AcrobotTest, RewardIsOneWithTheTipAtTheTop) {
   env->reset(0);
   auto& pixel_env = static_cast<PixelEnv&>(env->unwrapped());
   const auto& task = static_cast<const AcrobotTask&>(pixel_env.task());
-  set_state(*env, Eigen::Vector4d(kAcrobotPi, 0, 0, 0));
+  set_state(*env, Eigen::Vector4d(kPi, 0, 0, 0));
   EXPECT_NEAR((task.tip(pixel_env.world()) - AcrobotTask::kTop).norm(), 0.0, 1e-6);
   EXPECT_DOUBLE_EQ(task.reward(pixel_env.world()), 1.0);
 }
