@@ -33,7 +33,7 @@ int main(int argc, char** argv) {
   pixelgym::testing::FixtureScene f = arm ? pixelgym::testing::arm_scene(width, height)
                                           : pixelgym::testing::cartpole_scene(width, height);
   f.view->scene().shadows = shadows;
-  pixelgym::Renderer renderer;
+  pixelgym::render::Renderer renderer;
   std::vector<std::uint8_t> rgb(static_cast<std::size_t>(width) * static_cast<std::size_t>(height) *
                                 3);
   const int dofs = f.world->num_dofs(0);

@@ -19,7 +19,7 @@ namespace pixelgym {
 struct EnvSpec;
 
 /// Extra information returned beside observations (Gymnasium's `info` dict).
-using Info = Dict;
+using Info = ValueDict;
 
 /// Settings passed to `reset` (Gymnasium's `options`).
 using Options = Params;

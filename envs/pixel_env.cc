@@ -101,8 +101,8 @@ PixelEnv::PixelEnv(std::unique_ptr<Task> task, TaskConfig config, std::string na
 
 PixelEnv::~PixelEnv() = default;
 
-Renderer& PixelEnv::renderer() {
-  if (renderer_ == nullptr) renderer_ = std::make_unique<Renderer>();
+render::Renderer& PixelEnv::renderer() {
+  if (renderer_ == nullptr) renderer_ = std::make_unique<render::Renderer>();
   return *renderer_;
 }
 
@@ -133,7 +133,7 @@ StepResult PixelEnv::do_step(const Value& action) {
 }
 
 Value PixelEnv::observe() {
-  Dict obs;
+  ValueDict obs;
   if (config_.has_pixels())
     obs.insert("pixels", render_camera(camera_, config_.width, config_.height, 0));
   if (config_.has_state()) task_->observe(*world_, obs);
@@ -142,7 +142,7 @@ Value PixelEnv::observe() {
 
 Array PixelEnv::render_camera(const std::string& camera, int width, int height, int msaa_samples) {
   scene_->update(*world_);
-  Camera view = task_->camera(camera, *world_);
+  render::Camera view = task_->camera(camera, *world_);
   view.width = width;
   view.height = height;
   view.msaa_samples = msaa_samples;

@@ -49,7 +49,7 @@ class PixelEnv final : public Env {
 
  private:
   Value observe();
-  Renderer& renderer();
+  render::Renderer& renderer();
 
   std::unique_ptr<Task> task_;
   TaskConfig config_;
@@ -61,7 +61,7 @@ class PixelEnv final : public Env {
   int substeps_ = 1;
   std::unique_ptr<engine::World> world_;
   std::unique_ptr<WorldScene> scene_;
-  std::unique_ptr<Renderer> renderer_;
+  std::unique_ptr<render::Renderer> renderer_;
   int control_steps_ = 0;
 };
 

@@ -72,14 +72,14 @@ class Task {
   virtual void build(engine::World& world) = 0;
   /// Camera `name` for the world's current state (tracking cameras follow a body). The image
   /// size is set by the caller.
-  virtual Camera camera(const std::string& name, const engine::World& world) const = 0;
+  virtual render::Camera camera(const std::string& name, const engine::World& world) const = 0;
 
   /// Sets the start of an episode in a freshly reset world, drawing from `rng`.
   virtual void initialize_episode(engine::World& world, Rng& rng) = 0;
   /// Applies an action already known to be in action_space().
   virtual void before_step(const Value& action, engine::World& world) = 0;
   /// Writes every state array of state_specs() into `state` (each a new float32 array).
-  virtual void observe(const engine::World& world, Dict& state) const = 0;
+  virtual void observe(const engine::World& world, ValueDict& state) const = 0;
   /// This control step's reward, in [0, 1].
   virtual double reward(const engine::World& world) const = 0;
   virtual bool terminated(const engine::World& /*world*/) const { return false; }

@@ -5,18 +5,18 @@
 
 namespace pixelgym {
 
-Dict::Dict(std::initializer_list<std::pair<std::string, Value>> entries) {
+ValueDict::ValueDict(std::initializer_list<std::pair<std::string, Value>> entries) {
   for (const auto& [key, value] : entries) insert(key, value);
 }
 
-std::ptrdiff_t Dict::find(const std::string& key) const {
+std::ptrdiff_t ValueDict::find(const std::string& key) const {
   for (std::size_t i = 0; i < keys_.size(); ++i) {
     if (keys_[i] == key) return static_cast<std::ptrdiff_t>(i);
   }
   return -1;
 }
 
-void Dict::insert(const std::string& key, Value value) {
+void ValueDict::insert(const std::string& key, Value value) {
   const std::ptrdiff_t i = find(key);
   if (i >= 0) {
     values_[static_cast<std::size_t>(i)] = std::move(value);
@@ -26,9 +26,9 @@ void Dict::insert(const std::string& key, Value value) {
   values_.push_back(std::move(value));
 }
 
-bool Dict::contains(const std::string& key) const { return find(key) >= 0; }
+bool ValueDict::contains(const std::string& key) const { return find(key) >= 0; }
 
-const Value& Dict::at(const std::string& key) const {
+const Value& ValueDict::at(const std::string& key) const {
   const std::ptrdiff_t i = find(key);
   if (i < 0) {
     std::string present;
@@ -39,14 +39,14 @@ const Value& Dict::at(const std::string& key) const {
   return values_[static_cast<std::size_t>(i)];
 }
 
-Value& Dict::at(const std::string& key) {
-  return const_cast<Value&>(static_cast<const Dict&>(*this).at(key));
+Value& ValueDict::at(const std::string& key) {
+  return const_cast<Value&>(static_cast<const ValueDict&>(*this).at(key));
 }
 
-Tuple::Tuple(std::initializer_list<Value> items) : items_(items) {}
-Tuple::Tuple(std::vector<Value> items) : items_(std::move(items)) {}
+ValueTuple::ValueTuple(std::initializer_list<Value> items) : items_(items) {}
+ValueTuple::ValueTuple(std::vector<Value> items) : items_(std::move(items)) {}
 
-const Value& Tuple::at(std::size_t i) const {
+const Value& ValueTuple::at(std::size_t i) const {
   if (i >= items_.size()) {
     throw std::out_of_range("Tuple: index " + std::to_string(i) + " out of range for size " +
                             std::to_string(items_.size()));
@@ -56,8 +56,8 @@ const Value& Tuple::at(std::size_t i) const {
 
 Value::Value() : data_(Array()) {}
 Value::Value(Array array) : data_(std::move(array)) {}
-Value::Value(Dict dict) : data_(std::move(dict)) {}
-Value::Value(Tuple tuple) : data_(std::move(tuple)) {}
+Value::Value(ValueDict dict) : data_(std::move(dict)) {}
+Value::Value(ValueTuple tuple) : data_(std::move(tuple)) {}
 
 const char* Value::kind() const {
   if (is_array()) return "array";
@@ -71,24 +71,24 @@ const Array& Value::array() const {
 }
 Array& Value::array() { return const_cast<Array&>(static_cast<const Value&>(*this).array()); }
 
-const Dict& Value::dict() const {
+const ValueDict& Value::dict() const {
   if (!is_dict())
     throw std::invalid_argument(std::string("Value: expected a Dict, got a ") + kind());
-  return std::get<Dict>(data_);
+  return std::get<ValueDict>(data_);
 }
-Dict& Value::dict() { return const_cast<Dict&>(static_cast<const Value&>(*this).dict()); }
+ValueDict& Value::dict() { return const_cast<ValueDict&>(static_cast<const Value&>(*this).dict()); }
 
-const Tuple& Value::tuple() const {
+const ValueTuple& Value::tuple() const {
   if (!is_tuple())
     throw std::invalid_argument(std::string("Value: expected a Tuple, got a ") + kind());
-  return std::get<Tuple>(data_);
+  return std::get<ValueTuple>(data_);
 }
 
 Value Value::clone() const {
   if (is_array()) return array().clone();
   if (is_dict()) {
-    Dict copy;
-    const Dict& source = dict();
+    ValueDict copy;
+    const ValueDict& source = dict();
     for (std::size_t i = 0; i < source.size(); ++i) {
       copy.insert(source.keys()[i], source.values()[i].clone());
     }
@@ -96,7 +96,7 @@ Value Value::clone() const {
   }
   std::vector<Value> items;
   for (const Value& item : tuple().items()) items.push_back(item.clone());
-  return Tuple(std::move(items));
+  return ValueTuple(std::move(items));
 }
 
 bool Value::equals(const Value& other) const {

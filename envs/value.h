@@ -14,10 +14,10 @@ namespace pixelgym {
 class Value;
 
 /// An ordered map from string keys to Values (insertion order is kept, as in Gymnasium's Dict).
-class Dict {
+class ValueDict {
  public:
-  Dict() = default;
-  Dict(std::initializer_list<std::pair<std::string, Value>> entries);
+  ValueDict() = default;
+  ValueDict(std::initializer_list<std::pair<std::string, Value>> entries);
 
   /// Adds `key`, or replaces its value when present (keeping its position).
   void insert(const std::string& key, Value value);
@@ -39,11 +39,11 @@ class Dict {
 };
 
 /// A fixed-length sequence of Values.
-class Tuple {
+class ValueTuple {
  public:
-  Tuple() = default;
-  Tuple(std::initializer_list<Value> items);
-  explicit Tuple(std::vector<Value> items);
+  ValueTuple() = default;
+  ValueTuple(std::initializer_list<Value> items);
+  explicit ValueTuple(std::vector<Value> items);
 
   std::size_t size() const { return items_.size(); }
   /// Throws std::out_of_range.
@@ -59,19 +59,19 @@ class Value {
  public:
   Value();             // an empty Array
   Value(Array array);  // NOLINT(google-explicit-constructor): arrays are values
-  Value(Dict dict);    // NOLINT(google-explicit-constructor)
-  Value(Tuple tuple);  // NOLINT(google-explicit-constructor)
+  Value(ValueDict dict);    // NOLINT(google-explicit-constructor)
+  Value(ValueTuple tuple);  // NOLINT(google-explicit-constructor)
 
   bool is_array() const { return std::holds_alternative<Array>(data_); }
-  bool is_dict() const { return std::holds_alternative<Dict>(data_); }
-  bool is_tuple() const { return std::holds_alternative<Tuple>(data_); }
+  bool is_dict() const { return std::holds_alternative<ValueDict>(data_); }
+  bool is_tuple() const { return std::holds_alternative<ValueTuple>(data_); }
 
   /// The held alternative; each throws std::invalid_argument naming what is held instead.
   const Array& array() const;
   Array& array();
-  const Dict& dict() const;
-  Dict& dict();
-  const Tuple& tuple() const;
+  const ValueDict& dict() const;
+  ValueDict& dict();
+  const ValueTuple& tuple() const;
 
   /// "array", "Dict" or "Tuple".
   const char* kind() const;
@@ -87,7 +87,7 @@ class Value {
   std::string to_string() const;
 
  private:
-  std::variant<Array, Dict, Tuple> data_;
+  std::variant<Array, ValueDict, ValueTuple> data_;
 };
 
 }  // namespace pixelgym

@@ -17,33 +17,33 @@ constexpr float kMeshLowDetailBelowPx = 10.0F;
 // address stays a valid key.
 struct ConvertedMesh {
   std::shared_ptr<const engine::Mesh> source;
-  std::shared_ptr<const MeshData> with_colors;
-  std::shared_ptr<const MeshData> without_colors;
+  std::shared_ptr<const render::MeshData> with_colors;
+  std::shared_ptr<const render::MeshData> without_colors;
 };
 
-std::shared_ptr<const MeshData> convert(const std::shared_ptr<const engine::Mesh>& mesh,
+std::shared_ptr<const render::MeshData> convert(const std::shared_ptr<const engine::Mesh>& mesh,
                                         bool keep_part_colors) {
   static std::mutex mutex;
   static std::map<const engine::Mesh*, ConvertedMesh> converted;
   std::lock_guard<std::mutex> lock(mutex);
   ConvertedMesh& entry = converted[mesh.get()];
-  std::shared_ptr<const MeshData>& slot =
+  std::shared_ptr<const render::MeshData>& slot =
       keep_part_colors ? entry.with_colors : entry.without_colors;
   if (slot == nullptr) {
     entry.source = mesh;
-    auto data = std::make_shared<MeshData>();
+    auto data = std::make_shared<render::MeshData>();
     data->positions = mesh->positions;
     data->normals = mesh->normals;
     data->indices = mesh->indices;
     for (const engine::Mesh::Part& part : mesh->parts) {
-      MeshData::Part out;
+      render::MeshData::Part out;
       out.first_index = part.first_index;
       out.index_count = part.index_count;
       out.rgba = part.rgba;
       out.has_color = keep_part_colors && part.has_color;
       data->parts.push_back(out);
     }
-    data->closed = is_closed_surface(*data);
+    data->closed = render::is_closed_surface(*data);
     // Drawn small (as in 84 x 84 observations), a mesh needs only a fraction of its triangles,
     // and llvmpipe pays for every one: a clustered copy with cells of a tenth of its size is
     // drawn while its half-diagonal covers fewer than kMeshLowDetailBelowPx pixels.
@@ -53,8 +53,8 @@ std::shared_ptr<const MeshData> convert(const std::shared_ptr<const engine::Mesh
     if (data->triangle_count() > kMeshLowDetailMinTriangles && half_diagonal > 0.0F) {
       // Two levels: the coarse copy has its own coarser copy, which shadows use (see Renderer).
       auto coarse =
-          std::make_shared<MeshData>(*simplify_by_clustering(*data, half_diagonal / 3.0F));
-      coarse->low_detail = simplify_by_clustering(*data, half_diagonal / 1.5F);
+          std::make_shared<render::MeshData>(*render::simplify_by_clustering(*data, half_diagonal / 3.0F));
+      coarse->low_detail = render::simplify_by_clustering(*data, half_diagonal / 1.5F);
       coarse->low_detail_radius = half_diagonal;
       coarse->low_detail_below_px = 0.0F;  // never chosen for the camera, only for shadows
       data->low_detail = std::move(coarse);
@@ -71,12 +71,12 @@ std::shared_ptr<const MeshData> convert(const std::shared_ptr<const engine::Mesh
 constexpr float kLowDetailBelowPx = 6.0F;
 
 // Unit primitives shared by every scene.
-std::shared_ptr<const MeshData> shared_primitive(engine::GeometryType type) {
-  static const auto box = make_box_mesh();
+std::shared_ptr<const render::MeshData> shared_primitive(engine::GeometryType type) {
+  static const auto box = render::make_box_mesh();
   static const auto sphere =
-      with_low_detail(*make_sphere_mesh(24), make_sphere_mesh(10), kLowDetailBelowPx);
+      render::with_low_detail(*render::make_sphere_mesh(24), render::make_sphere_mesh(10), kLowDetailBelowPx);
   static const auto cylinder =
-      with_low_detail(*make_cylinder_mesh(24), make_cylinder_mesh(10), kLowDetailBelowPx);
+      render::with_low_detail(*render::make_cylinder_mesh(24), render::make_cylinder_mesh(10), kLowDetailBelowPx);
   switch (type) {
     case engine::GeometryType::kBox:
       return box;
@@ -87,15 +87,15 @@ std::shared_ptr<const MeshData> shared_primitive(engine::GeometryType type) {
   }
 }
 
-std::shared_ptr<const MeshData> shared_capsule(double length_over_radius) {
+std::shared_ptr<const render::MeshData> shared_capsule(double length_over_radius) {
   static std::mutex mutex;
-  static std::map<long, std::shared_ptr<const MeshData>> capsules;  // by ratio in thousandths
+  static std::map<long, std::shared_ptr<const render::MeshData>> capsules;  // by ratio in thousandths
   const long key = std::lround(length_over_radius * 1000.0);
   std::lock_guard<std::mutex> lock(mutex);
   auto& slot = capsules[key];
   if (slot == nullptr) {
     const double ratio = static_cast<double>(key) / 1000.0;
-    slot = with_low_detail(*make_capsule_mesh(ratio, 24), make_capsule_mesh(ratio, 10),
+    slot = render::with_low_detail(*render::make_capsule_mesh(ratio, 24), render::make_capsule_mesh(ratio, 10),
                            kLowDetailBelowPx);
   }
   return slot;
@@ -105,7 +105,7 @@ std::shared_ptr<const MeshData> shared_capsule(double length_over_radius) {
 
 WorldScene::WorldScene(const engine::World& world) {
   for (const engine::VisualShape& shape : world.visual_shapes()) {
-    Instance instance;
+    render::Instance instance;
     const engine::Geometry& geometry = shape.geometry;
     switch (geometry.type) {
       case engine::GeometryType::kBox:
@@ -154,7 +154,7 @@ void WorldScene::update(const engine::World& world) {
 
 Eigen::AlignedBox3f WorldScene::bounds() const {
   Eigen::AlignedBox3f box;
-  for (const Instance& instance : scene_.instances) {
+  for (const render::Instance& instance : scene_.instances) {
     for (const Eigen::Vector3f& p : instance.mesh->positions) {
       box.extend(instance.X_world_instance * p.cwiseProduct(instance.scale));
     }
@@ -162,7 +162,7 @@ Eigen::AlignedBox3f WorldScene::bounds() const {
   return box;
 }
 
-Camera frame_box(const Eigen::AlignedBox3f& box, float azimuth_deg, float elevation_deg, int width,
+render::Camera frame_box(const Eigen::AlignedBox3f& box, float azimuth_deg, float elevation_deg, int width,
                  int height, float fov_y_deg) {
   if (box.isEmpty()) throw std::invalid_argument("frame_box: nothing to frame (the box is empty)");
   const Eigen::Vector3f centre = box.center();
@@ -179,7 +179,7 @@ Camera frame_box(const Eigen::AlignedBox3f& box, float azimuth_deg, float elevat
   const Eigen::Vector3f up =
       std::abs(direction.z()) > 0.99F ? Eigen::Vector3f::UnitY() : Eigen::Vector3f::UnitZ();
   const auto camera_at = [&](float distance) {
-    Camera camera = Camera::look_at(centre + distance * direction, centre, up);
+    render::Camera camera = render::Camera::look_at(centre + distance * direction, centre, up);
     camera.width = width;
     camera.height = height;
     camera.fov_y_deg = fov_y_deg;
@@ -187,7 +187,7 @@ Camera frame_box(const Eigen::AlignedBox3f& box, float azimuth_deg, float elevat
     camera.far_m = distance + 20.0F * radius + 10.0F;
     return camera;
   };
-  const auto fits = [&](const Camera& camera) {
+  const auto fits = [&](const render::Camera& camera) {
     const Eigen::Matrix4f view_projection = camera.projection_matrix() * camera.view_matrix();
     for (int corner = 0; corner < 8; ++corner) {
       const Eigen::Vector4f clip =
@@ -206,7 +206,7 @@ Camera frame_box(const Eigen::AlignedBox3f& box, float azimuth_deg, float elevat
     const float middle = 0.5F * (near_distance + far_distance);
     (fits(camera_at(middle)) ? far_distance : near_distance) = middle;
   }
-  Camera camera = camera_at(far_distance);
+  render::Camera camera = camera_at(far_distance);
   return camera;
 }
 

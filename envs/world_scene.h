@@ -20,14 +20,14 @@ class WorldScene {
   /// Copies the current visual poses of `world` (the one it was built from) into the scene.
   void update(const engine::World& world);
 
-  Scene& scene() { return scene_; }
-  const Scene& scene() const { return scene_; }
+  render::Scene& scene() { return scene_; }
+  const render::Scene& scene() const { return scene_; }
 
   /// The world-aligned box around every instance (at the last update).
   Eigen::AlignedBox3f bounds() const;
 
  private:
-  Scene scene_;
+  render::Scene scene_;
   std::vector<Eigen::Vector3f> local_scale_;
   std::vector<Eigen::Isometry3d> poses_;  // scratch for World::visual_poses
 };
@@ -35,7 +35,7 @@ class WorldScene {
 /// A camera that frames `box` whole, looking from the direction given by azimuth (degrees,
 /// counter-clockwise from +x) and elevation (degrees above the horizon). Throws
 /// std::invalid_argument for an empty box.
-Camera frame_box(const Eigen::AlignedBox3f& box, float azimuth_deg, float elevation_deg, int width,
+render::Camera frame_box(const Eigen::AlignedBox3f& box, float azimuth_deg, float elevation_deg, int width,
                  int height, float fov_y_deg = 40.0F);
 
 }  // namespace pixelgym

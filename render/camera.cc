@@ -4,7 +4,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace pixelgym {
+namespace pixelgym::render {
 namespace {
 
 constexpr int kMaxImageSize = 8192;
@@ -67,4 +67,4 @@ Eigen::Matrix4f Camera::projection_matrix() const {
   return projection;
 }
 
-}  // namespace pixelgym
+}  // namespace pixelgym::render

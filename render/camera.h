@@ -4,7 +4,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-namespace pixelgym {
+namespace pixelgym::render {
 
 /// A pinhole camera. Its frame follows OpenGL: it looks along its -z axis with +y up and +x to the
 /// right of the image. Images have row 0 at the top.
@@ -34,4 +34,4 @@ struct Camera {
   Eigen::Matrix4f projection_matrix() const;
 };
 
-}  // namespace pixelgym
+}  // namespace pixelgym::render

@@ -9,7 +9,7 @@
 
 #include "render/gl.h"
 
-namespace pixelgym {
+namespace pixelgym::render {
 namespace {
 
 void default_llvmpipe_threads() {
@@ -70,4 +70,4 @@ std::string Context::description() {
          (version != nullptr ? version : "?");
 }
 
-}  // namespace pixelgym
+}  // namespace pixelgym::render

@@ -4,7 +4,7 @@
 #include <memory>
 #include <string>
 
-namespace pixelgym {
+namespace pixelgym::render {
 
 /// Which OpenGL implementation a context comes from.
 enum class GlBackend {
@@ -43,4 +43,4 @@ class Context {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace pixelgym
+}  // namespace pixelgym::render

@@ -9,7 +9,7 @@
 #include <memory>
 #include <stdexcept>
 
-namespace pixelgym {
+namespace pixelgym::render {
 namespace {
 
 png_uint_32 png_format(int channels) {
@@ -93,4 +93,4 @@ Image read_png(const std::string& path) {
   return image;
 }
 
-}  // namespace pixelgym
+}  // namespace pixelgym::render

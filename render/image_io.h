@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-namespace pixelgym {
+namespace pixelgym::render {
 
 /// Interleaved 8-bit pixels, row 0 at the top; `channels` is 1 (gray), 3 (RGB) or 4 (RGBA).
 struct ImageView {
@@ -33,4 +33,4 @@ void write_png(const std::string& path, const ImageView& image);
 /// std::runtime_error naming the path and the reason.
 Image read_png(const std::string& path);
 
-}  // namespace pixelgym
+}  // namespace pixelgym::render

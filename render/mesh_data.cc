@@ -7,7 +7,7 @@
 #include <tuple>
 #include <utility>
 
-namespace pixelgym {
+namespace pixelgym::render {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -242,4 +242,4 @@ std::shared_ptr<const MeshData> with_low_detail(const MeshData& fine,
   return mesh;
 }
 
-}  // namespace pixelgym
+}  // namespace pixelgym::render

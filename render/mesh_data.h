@@ -6,7 +6,7 @@
 #include <memory>
 #include <vector>
 
-namespace pixelgym {
+namespace pixelgym::render {
 
 /// An immutable triangle mesh for drawing. Shared by every instance and scene that uses it; the
 /// renderer uploads it to the GPU once per context.
@@ -74,4 +74,4 @@ std::shared_ptr<const MeshData> with_low_detail(const MeshData& fine,
                                                 std::shared_ptr<const MeshData> coarse,
                                                 float below_px);
 
-}  // namespace pixelgym
+}  // namespace pixelgym::render

@@ -12,7 +12,7 @@
 #include "render/gl.h"
 #include "render/image_io.h"
 
-namespace pixelgym {
+namespace pixelgym::render {
 namespace {
 
 // --- shaders ---------------------------------------------------------------------------------
@@ -1106,4 +1106,4 @@ void Renderer::render(const Scene& scene, const Camera& camera, const RenderTarg
 
 std::string Renderer::description() { return impl_->context.description(); }
 
-}  // namespace pixelgym
+}  // namespace pixelgym::render

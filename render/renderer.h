@@ -9,7 +9,7 @@
 #include "render/context.h"
 #include "render/scene.h"
 
-namespace pixelgym {
+namespace pixelgym::render {
 
 /// Where `Renderer::render` writes; each pointer may be null to skip that output. Images are
 /// row-major with row 0 at the top and camera.width * camera.height pixels.
@@ -49,4 +49,4 @@ class Renderer {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace pixelgym
+}  // namespace pixelgym::render

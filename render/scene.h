@@ -9,7 +9,7 @@
 
 #include "render/mesh_data.h"
 
-namespace pixelgym {
+namespace pixelgym::render {
 
 /// How a surface looks. Colours are linear RGB in [0, 1].
 struct RenderMaterial {
@@ -69,4 +69,4 @@ struct Scene {
   bool shadows = true;
 };
 
-}  // namespace pixelgym
+}  // namespace pixelgym::render

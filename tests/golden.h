@@ -30,15 +30,15 @@ inline ::testing::AssertionResult matches_golden(const std::string& name, const 
   std::filesystem::create_directories(out_dir);
   const char* update = std::getenv("PIXELGYM_UPDATE_GOLDENS");
   if (update != nullptr && std::string(update) == "1") {
-    write_png(golden, {rgb, height, width, 3});
+    render::write_png(golden, {rgb, height, width, 3});
     return ::testing::AssertionSuccess() << "updated " << golden;
   }
   if (!std::filesystem::exists(golden)) {
-    write_png(out_dir + "/" + name + ".actual.png", {rgb, height, width, 3});
+    render::write_png(out_dir + "/" + name + ".actual.png", {rgb, height, width, 3});
     return ::testing::AssertionFailure() << "no golden " << golden << "; the frame is in " << out_dir
                                          << " (PIXELGYM_UPDATE_GOLDENS=1 writes goldens)";
   }
-  const Image expected = read_png(golden);
+  const render::Image expected = render::read_png(golden);
   if (expected.height != height || expected.width != width || expected.channels != 3) {
     return ::testing::AssertionFailure() << golden << " is " << expected.width << "x" << expected.height << "x"
                                          << expected.channels << ", the frame " << width << "x" << height << "x3";
@@ -60,8 +60,8 @@ inline ::testing::AssertionResult matches_golden(const std::string& name, const 
   const double mean = total / static_cast<double>(pixels * 3);
   const double far_fraction = static_cast<double>(far_off) / static_cast<double>(pixels);
   if (mean <= 1.0 && far_fraction <= 0.01) return ::testing::AssertionSuccess();
-  write_png(out_dir + "/" + name + ".actual.png", {rgb, height, width, 3});
-  write_png(out_dir + "/" + name + ".diff.png", {diff.data(), height, width, 3});
+  render::write_png(out_dir + "/" + name + ".actual.png", {rgb, height, width, 3});
+  render::write_png(out_dir + "/" + name + ".diff.png", {diff.data(), height, width, 3});
   return ::testing::AssertionFailure() << name << ": mean absolute difference " << mean << " (limit 1.0), "
                                        << 100.0 * far_fraction << "% of pixels off by more than 8 (limit 1%); "
                                        << "actual and diff images in " << out_dir;

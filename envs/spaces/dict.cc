@@ -29,14 +29,14 @@ Dict::Dict(Entries entries) : entries_(std::move(entries)) {
 }
 
 Value Dict::sample(Rng& rng) const {
-  pixelgym::Dict value;
+  pixelgym::ValueDict value;
   for (const auto& [key, space] : entries_) value.insert(key, space->sample(rng));
   return value;
 }
 
 std::string Dict::mismatch(const Value& value) const {
   if (!value.is_dict()) return std::string("expected a Dict, got a ") + value.kind();
-  const pixelgym::Dict& dict = value.dict();
+  const pixelgym::ValueDict& dict = value.dict();
   for (const auto& [key, space] : entries_) {
     if (!dict.contains(key)) return "missing key \"" + key + "\"";
     const std::string reason = space->mismatch(dict.at(key));

@@ -9,7 +9,7 @@
 
 namespace pixelgym::spaces {
 
-/// Elements are pixelgym::Dict values with exactly these keys, each value in its subspace.
+/// Elements are pixelgym::ValueDict values with exactly these keys, each value in its subspace.
 /// Keys keep the order given (pixel tasks list "pixels" first, then state arrays).
 class Dict final : public Space {
  public:

@@ -16,12 +16,12 @@ Value Tuple::sample(Rng& rng) const {
   std::vector<Value> items;
   items.reserve(spaces_.size());
   for (const SpacePtr& space : spaces_) items.push_back(space->sample(rng));
-  return pixelgym::Tuple(std::move(items));
+  return pixelgym::ValueTuple(std::move(items));
 }
 
 std::string Tuple::mismatch(const Value& value) const {
   if (!value.is_tuple()) return std::string("expected a Tuple, got a ") + value.kind();
-  const pixelgym::Tuple& tuple = value.tuple();
+  const pixelgym::ValueTuple& tuple = value.tuple();
   if (tuple.size() != spaces_.size()) {
     return "length " + std::to_string(tuple.size()) + ", expected " +
            std::to_string(spaces_.size());

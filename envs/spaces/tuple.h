@@ -7,7 +7,7 @@
 
 namespace pixelgym::spaces {
 
-/// Elements are pixelgym::Tuple values of the same length, item i in subspace i.
+/// Elements are pixelgym::ValueTuple values of the same length, item i in subspace i.
 class Tuple final : public Space {
  public:
   /// Throws std::invalid_argument for a null subspace.

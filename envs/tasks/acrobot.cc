@@ -27,9 +27,9 @@ void AcrobotTask::build(engine::World& world) {
   lower_arm_ = model->link_index("lower_arm");
 }
 
-Camera AcrobotTask::camera(const std::string& name, const engine::World& /*world*/) const {
-  Camera camera = name == "wide" ? Camera::look_at({3.0F, -6.5F, 3.0F}, {0.0F, 0.0F, 2.1F})
-                                 : Camera::look_at({0.0F, -5.8F, 2.2F}, {0.0F, 0.0F, 2.2F});
+render::Camera AcrobotTask::camera(const std::string& name, const engine::World& /*world*/) const {
+  render::Camera camera = name == "wide" ? render::Camera::look_at({3.0F, -6.5F, 3.0F}, {0.0F, 0.0F, 2.1F})
+                                 : render::Camera::look_at({0.0F, -5.8F, 2.2F}, {0.0F, 0.0F, 2.2F});
   camera.fov_y_deg = 45.0F;
   return camera;
 }
@@ -50,7 +50,7 @@ Eigen::Vector3d AcrobotTask::tip(const engine::World& world) const {
   return world.link_pose(robot_, lower_arm_) * Eigen::Vector3d(0.0, 0.0, -1.0);
 }
 
-void AcrobotTask::observe(const engine::World& world, Dict& state) const {
+void AcrobotTask::observe(const engine::World& world, ValueDict& state) const {
   const Eigen::VectorXd q = world.joint_positions(robot_);
   const Eigen::VectorXd qd = world.joint_velocities(robot_);
   state.insert("joint_pos", Array::from_vector<float>({2}, {static_cast<float>(wrap_angle(q[0])),

@@ -54,10 +54,10 @@ void ArmPushTask::build(engine::World& world) {
   goal_body_ = world.add_body(marker_body("goal", 0.025, {0.2, 0.85, 0.3, 1.0}));
 }
 
-Camera ArmPushTask::camera(const std::string& name, const engine::World& /*world*/) const {
-  Camera camera = name == "top" ? Camera::look_at({0.55F, 0.0F, 2.3F}, {0.55F, 0.0F, 0.72F},
+render::Camera ArmPushTask::camera(const std::string& name, const engine::World& /*world*/) const {
+  render::Camera camera = name == "top" ? render::Camera::look_at({0.55F, 0.0F, 2.3F}, {0.55F, 0.0F, 0.72F},
                                                   Eigen::Vector3f::UnitX())
-                                : Camera::look_at({1.4F, -1.3F, 1.6F}, {0.45F, 0.0F, 0.8F});
+                                : render::Camera::look_at({1.4F, -1.3F, 1.6F}, {0.45F, 0.0F, 0.8F});
   camera.fov_y_deg = 45.0F;
   return camera;
 }
@@ -100,7 +100,7 @@ Eigen::Vector3d ArmPushTask::goal(const engine::World& world) const {
   return world.body_pose(goal_body_).translation();
 }
 
-void ArmPushTask::observe(const engine::World& world, Dict& state) const {
+void ArmPushTask::observe(const engine::World& world, ValueDict& state) const {
   state.insert("joint_pos", float32_array(world.joint_positions(arm_)));
   state.insert("joint_vel", float32_array(world.joint_velocities(arm_)));
   state.insert("end_effector_pos", float32_array(end_effector(world)));

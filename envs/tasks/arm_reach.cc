@@ -45,10 +45,10 @@ void ArmReachTask::build(engine::World& world) {
   target_body_ = world.add_body(marker_body("target", 0.04, {0.2, 0.85, 0.3, 1.0}));
 }
 
-Camera ArmReachTask::camera(const std::string& name, const engine::World& /*world*/) const {
-  Camera camera = name == "top" ? Camera::look_at({0.35F, 0.0F, 2.4F}, {0.35F, 0.0F, 0.3F},
+render::Camera ArmReachTask::camera(const std::string& name, const engine::World& /*world*/) const {
+  render::Camera camera = name == "top" ? render::Camera::look_at({0.35F, 0.0F, 2.4F}, {0.35F, 0.0F, 0.3F},
                                                   Eigen::Vector3f::UnitX())
-                                : Camera::look_at({1.5F, -1.7F, 1.3F}, {0.25F, 0.0F, 0.45F});
+                                : render::Camera::look_at({1.5F, -1.7F, 1.3F}, {0.25F, 0.0F, 0.45F});
   camera.fov_y_deg = 45.0F;
   return camera;
 }
@@ -91,7 +91,7 @@ Eigen::Vector3d ArmReachTask::target(const engine::World& world) const {
   return world.body_pose(target_body_).translation();
 }
 
-void ArmReachTask::observe(const engine::World& world, Dict& state) const {
+void ArmReachTask::observe(const engine::World& world, ValueDict& state) const {
   Eigen::VectorXd q = world.joint_positions(robot_);
   state.insert("joint_pos", float32_array(q));
   state.insert("joint_vel", float32_array(world.joint_velocities(robot_)));

@@ -28,9 +28,9 @@ void CartPoleTask::build(engine::World& world) {
       engine::default_model_cache().load_urdf(engine::asset_path("cartpole/cartpole.urdf")));
 }
 
-Camera CartPoleTask::camera(const std::string& name, const engine::World& world) const {
+render::Camera CartPoleTask::camera(const std::string& name, const engine::World& world) const {
   const float x = name == "tracking" ? static_cast<float>(cart_position(world)) : 0.0F;
-  Camera camera = Camera::look_at({x, -4.0F, 0.9F}, {x, 0.0F, 1.3F});
+  render::Camera camera = render::Camera::look_at({x, -4.0F, 0.9F}, {x, 0.0F, 1.3F});
   camera.fov_y_deg = 50.0F;
   return camera;
 }
@@ -64,7 +64,7 @@ double CartPoleTask::pole_angular_velocity(const engine::World& world) const {
   return world.joint_velocities(robot_)[1];
 }
 
-void CartPoleTask::observe(const engine::World& world, Dict& state) const {
+void CartPoleTask::observe(const engine::World& world, ValueDict& state) const {
   const Eigen::VectorXd qd = world.joint_velocities(robot_);
   state.insert("joint_pos",
                Array::from_vector<float>({2}, {static_cast<float>(cart_position(world)),

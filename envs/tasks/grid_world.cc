@@ -115,7 +115,7 @@ StepResult GridWorld::do_step(const Value& action) {
 }
 
 Value GridWorld::observe() const {
-  if (config_.obs_mode == "pixels") return Dict{{"pixels", draw(config_.width, config_.height)}};
+  if (config_.obs_mode == "pixels") return ValueDict{{"pixels", draw(config_.width, config_.height)}};
   return Array::scalar<std::int64_t>(agent_.row * kSize + agent_.col);
 }
 

@@ -25,9 +25,9 @@ void PendulumTask::build(engine::World& world) {
       engine::default_model_cache().load_urdf(engine::asset_path("pendulum/pendulum.urdf")));
 }
 
-Camera PendulumTask::camera(const std::string& name, const engine::World& /*world*/) const {
-  Camera camera = name == "wide" ? Camera::look_at({1.2F, -3.2F, 1.6F}, {0.0F, 0.0F, 1.0F})
-                                 : Camera::look_at({0.0F, -2.2F, 1.2F}, {0.0F, 0.0F, 1.15F});
+render::Camera PendulumTask::camera(const std::string& name, const engine::World& /*world*/) const {
+  render::Camera camera = name == "wide" ? render::Camera::look_at({1.2F, -3.2F, 1.6F}, {0.0F, 0.0F, 1.0F})
+                                 : render::Camera::look_at({0.0F, -2.2F, 1.2F}, {0.0F, 0.0F, 1.15F});
   camera.fov_y_deg = 45.0F;
   return camera;
 }
@@ -50,7 +50,7 @@ double PendulumTask::angular_velocity(const engine::World& world) const {
   return world.joint_velocities(robot_)[0];
 }
 
-void PendulumTask::observe(const engine::World& world, Dict& state) const {
+void PendulumTask::observe(const engine::World& world, ValueDict& state) const {
   state.insert("joint_pos",
                Array::from_vector<float>({1}, {static_cast<float>(angle_from_upright(world))}));
   state.insert("joint_vel",

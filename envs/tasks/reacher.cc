@@ -30,9 +30,9 @@ void ReacherTask::build(engine::World& world) {
   target_body_ = world.add_body(marker_body("target", target_radius_m_, {0.2, 0.8, 0.3, 1.0}));
 }
 
-Camera ReacherTask::camera(const std::string& name, const engine::World& /*world*/) const {
-  Camera camera = name == "angled" ? Camera::look_at({0.0F, -0.55F, 0.45F}, {0.0F, 0.0F, 0.0F})
-                                   : Camera::look_at({0.0F, 0.0F, 0.75F}, {0.0F, 0.0F, 0.0F},
+render::Camera ReacherTask::camera(const std::string& name, const engine::World& /*world*/) const {
+  render::Camera camera = name == "angled" ? render::Camera::look_at({0.0F, -0.55F, 0.45F}, {0.0F, 0.0F, 0.0F})
+                                   : render::Camera::look_at({0.0F, 0.0F, 0.75F}, {0.0F, 0.0F, 0.0F},
                                                      Eigen::Vector3f::UnitY());
   camera.fov_y_deg = 45.0F;
   return camera;
@@ -64,7 +64,7 @@ Eigen::Vector3d ReacherTask::target(const engine::World& world) const {
   return world.body_pose(target_body_).translation();
 }
 
-void ReacherTask::observe(const engine::World& world, Dict& state) const {
+void ReacherTask::observe(const engine::World& world, ValueDict& state) const {
   const Eigen::VectorXd q = world.joint_positions(robot_);
   const Eigen::VectorXd qd = world.joint_velocities(robot_);
   const Eigen::Vector3d to_target = target(world) - fingertip(world);

@@ -54,7 +54,7 @@ void write_frame_png(const std::string& path, const Array& frame) {
     if (error)
       throw std::runtime_error("cannot create folder " + parent.string() + ": " + error.message());
   }
-  write_png(path, {frame.data<std::uint8_t>(), static_cast<int>(frame.shape()[0]),
+  render::write_png(path, {frame.data<std::uint8_t>(), static_cast<int>(frame.shape()[0]),
                    static_cast<int>(frame.shape()[1]), 3});
 }
 

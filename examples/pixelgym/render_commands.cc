@@ -49,10 +49,10 @@ int run_view(const ViewOptions& options) {
                                                                           {"side", {0.0F, 8.0F}},
                                                                           {"top", {-90.0F, 89.0F}}};
     const auto [azimuth, elevation] = kViews.at(options.camera);
-    Camera camera = frame_box(bounds, azimuth, elevation, options.width, options.height);
+    render::Camera camera = frame_box(bounds, azimuth, elevation, options.width, options.height);
     camera.msaa_samples = options.msaa;
     view.scene().shadows = options.shadows;
-    Renderer renderer;
+    render::Renderer renderer;
     Array frame(DType::kUInt8, {options.height, options.width, 3});
     std::vector<std::int32_t> ids(static_cast<std::size_t>(options.width) *
                                   static_cast<std::size_t>(options.height));

@@ -48,7 +48,7 @@ TEST_P(RegisteredEnvTest, SameSeedAndActionsGiveIdenticalTrajectoriesAcrossInsta
 TEST_P(RegisteredEnvTest, RejectsActionsOfTheWrongKind) {
   std::unique_ptr<Env> env = make(GetParam());
   env->reset(0);
-  EXPECT_THROW(env->step(Value(Tuple{})), std::invalid_argument);
+  EXPECT_THROW(env->step(Value(ValueTuple{})), std::invalid_argument);
   EXPECT_THROW(env->step(Array::scalar<double>(std::nan(""))), std::invalid_argument);
 }
 

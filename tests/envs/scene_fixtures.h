@@ -12,7 +12,7 @@ namespace pixelgym::testing {
 struct FixtureScene {
   std::unique_ptr<engine::World> world;
   std::unique_ptr<WorldScene> view;
-  Camera camera;
+  render::Camera camera;
 };
 
 /// The cart-pole: cart 0.3 m right of centre, pole tipped 0.4 rad; seen from the front, from a
@@ -23,7 +23,7 @@ inline FixtureScene cartpole_scene(int width, int height) {
   const int robot = f.world->add_robot(engine::default_model_cache().load_urdf(engine::asset_path("cartpole/cartpole.urdf")));
   f.world->set_joint_state(robot, (Eigen::VectorXd(2) << 0.3, 0.4).finished(), Eigen::VectorXd::Zero(2));
   f.view = std::make_unique<WorldScene>(*f.world);
-  f.camera = Camera::look_at({0, -4.0F, 0.9F}, {0, 0, 1.3F});
+  f.camera = render::Camera::look_at({0, -4.0F, 0.9F}, {0, 0, 1.3F});
   f.camera.fov_y_deg = 50.0F;
   f.camera.width = width;
   f.camera.height = height;
@@ -51,7 +51,7 @@ inline FixtureScene arm_scene(int width, int height) {
   q << 0.3, 0.9, 0.0, -1.2, 0.0, 0.9, 0.0;
   f.world->set_joint_state(arm, q, Eigen::VectorXd::Zero(7));
   f.view = std::make_unique<WorldScene>(*f.world);
-  f.camera = Camera::look_at({0.5F, -2.2F, 1.5F}, {0.45F, 0.0F, 0.65F});
+  f.camera = render::Camera::look_at({0.5F, -2.2F, 1.5F}, {0.45F, 0.0F, 0.65F});
   f.camera.width = width;
   f.camera.height = height;
   return f;

@@ -6,7 +6,7 @@ namespace pixelgym {
 namespace {
 
 TEST(ValueTest, DictKeepsInsertionOrderAndReplacesInPlace) {
-  Dict dict;
+  ValueDict dict;
   dict.insert("pixels", Array(DType::kUInt8, {2, 2, 3}));
   dict.insert("joint_pos", Array(DType::kFloat32, {2}));
   dict.insert("pixels", Array(DType::kUInt8, {4, 4, 3}));
@@ -15,7 +15,7 @@ TEST(ValueTest, DictKeepsInsertionOrderAndReplacesInPlace) {
 }
 
 TEST(ValueTest, MissingKeyNamesKeysPresent) {
-  Dict dict{{"a", Array::scalar(1.0)}};
+  ValueDict dict{{"a", Array::scalar(1.0)}};
   try {
     dict.at("b");
     FAIL();
@@ -32,8 +32,8 @@ TEST(ValueTest, WrongAlternativeThrows) {
 }
 
 TEST(ValueTest, CloneIsDeepAndEqual) {
-  Value value = Dict{{"x", Array::from_vector<float>({2}, {1, 2})},
-                     {"t", Tuple{Array::scalar<std::int64_t>(3)}}};
+  Value value = ValueDict{{"x", Array::from_vector<float>({2}, {1, 2})},
+                     {"t", ValueTuple{Array::scalar<std::int64_t>(3)}}};
   Value copy = value.clone();
   EXPECT_TRUE(copy.equals(value));
   EXPECT_FALSE(copy.shares_memory(value));
@@ -44,24 +44,24 @@ TEST(ValueTest, CloneIsDeepAndEqual) {
 }
 
 TEST(ValueTest, EqualsComparesStructure) {
-  Value a = Tuple{Array::scalar(1.0)};
-  Value b = Tuple{Array::scalar(1.0), Array::scalar(1.0)};
-  Value c = Dict{{"x", Array::scalar(1.0)}};
+  Value a = ValueTuple{Array::scalar(1.0)};
+  Value b = ValueTuple{Array::scalar(1.0), Array::scalar(1.0)};
+  Value c = ValueDict{{"x", Array::scalar(1.0)}};
   EXPECT_FALSE(a.equals(b));
   EXPECT_FALSE(a.equals(c));
-  EXPECT_FALSE(c.equals(Value(Dict{{"y", Array::scalar(1.0)}})));
+  EXPECT_FALSE(c.equals(Value(ValueDict{{"y", Array::scalar(1.0)}})));
 }
 
 TEST(ValueTest, LeavesAreDepthFirst) {
   Value value =
-      Dict{{"a", Array::scalar(1.0)}, {"b", Tuple{Array::scalar(2.0), Array::scalar(3.0)}}};
+      ValueDict{{"a", Array::scalar(1.0)}, {"b", ValueTuple{Array::scalar(2.0), Array::scalar(3.0)}}};
   const std::vector<Array> leaves = value.leaves();
   ASSERT_EQ(leaves.size(), 3U);
   EXPECT_EQ(leaves[2].item<double>(), 3.0);
 }
 
 TEST(ValueTest, ToString) {
-  Value value = Dict{{"a", Array::scalar<std::int64_t>(1)}};
+  Value value = ValueDict{{"a", Array::scalar<std::int64_t>(1)}};
   EXPECT_EQ(value.to_string(), "Dict{\"a\": int64 () 1}");
 }
 

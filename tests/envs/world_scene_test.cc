@@ -12,7 +12,7 @@ namespace {
 
 using testing::FixtureScene;
 
-Array draw(FixtureScene& f, Renderer& renderer) {
+Array draw(FixtureScene& f, render::Renderer& renderer) {
   Array frame(DType::kUInt8, {f.camera.height, f.camera.width, 3});
   renderer.render(f.view->scene(), f.camera, {frame.data<std::uint8_t>()});
   return frame;
@@ -43,7 +43,7 @@ TEST(WorldSceneTest, UpdateFollowsTheWorld) {
 TEST(WorldSceneTest, UrdfColoursOverrideMeshColoursOnlyWhenGiven) {
   FixtureScene f = testing::arm_scene(84, 84);
   // The arm's links are meshes without a URDF colour: their parts keep the .mtl colours.
-  const Instance& link1 = f.view->scene().instances[1];
+  const render::Instance& link1 = f.view->scene().instances[1];
   ASSERT_FALSE(link1.mesh->parts.empty());
   EXPECT_TRUE(link1.mesh->parts[0].has_color);
 }
@@ -51,7 +51,7 @@ TEST(WorldSceneTest, UrdfColoursOverrideMeshColoursOnlyWhenGiven) {
 TEST(WorldSceneTest, FrameBoxShowsTheWholeBox) {
   FixtureScene f = testing::arm_scene(64, 48);
   const Eigen::AlignedBox3f box = f.view->bounds();
-  const Camera camera = frame_box(box, -50.0F, 25.0F, 64, 48);
+  const render::Camera camera = frame_box(box, -50.0F, 25.0F, 64, 48);
   const Eigen::Matrix4f vp = camera.projection_matrix() * camera.view_matrix();
   for (int corner = 0; corner < 8; ++corner) {
     const Eigen::Vector3f p = box.corner(static_cast<Eigen::AlignedBox3f::CornerType>(corner));
@@ -75,7 +75,7 @@ TEST_P(GoldenTest, MatchesTheReferenceFrame) {
   const GoldenCase& c = GetParam();
   FixtureScene f =
       c.arm ? testing::arm_scene(c.size, c.size) : testing::cartpole_scene(c.size, c.size);
-  Renderer renderer;
+  render::Renderer renderer;
   const Array frame = draw(f, renderer);
   EXPECT_TRUE(testing::matches_golden(c.name, frame.data<std::uint8_t>(), c.size, c.size));
 }

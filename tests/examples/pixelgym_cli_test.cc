@@ -82,7 +82,7 @@ TEST(PixelgymCliTest, SetPassesTypedKwargsAndReportsUnknownOnes) {
   const CliRun small = run("snapshot GridWorld-v0 --seed 0 --steps 3 --out " + out +
                            " --set render_width=96 --set render_height=64");
   ASSERT_EQ(small.exit_code, 0) << small.output;
-  const Image image = read_png(out);
+  const render::Image image = render::read_png(out);
   EXPECT_EQ(image.width, 96);
   EXPECT_EQ(image.height, 64);
 
@@ -100,7 +100,7 @@ TEST(PixelgymCliTest, SnapshotIsReproducibleFromTheSeed) {
   const std::string dir = std::string(PIXELGYM_TEST_OUTPUT_DIR) + "/cli/";
   ASSERT_EQ(run("snapshot GridWorld-v0 --seed 4 --steps 7 --out " + dir + "a.png").exit_code, 0);
   ASSERT_EQ(run("snapshot GridWorld-v0 --seed 4 --steps 7 --out " + dir + "b.png").exit_code, 0);
-  EXPECT_EQ(read_png(dir + "a.png").pixels, read_png(dir + "b.png").pixels);
+  EXPECT_EQ(render::read_png(dir + "a.png").pixels, render::read_png(dir + "b.png").pixels);
 }
 
 // Each subcommand keeps its own defaults: snapshot's --steps is 0 (the frame after reset), not
@@ -112,14 +112,14 @@ TEST(PixelgymCliTest, SnapshotDefaultsToTheFrameAfterReset) {
   EXPECT_THAT(plain.output, HasSubstr("seed 2, 0 steps)"));
   ASSERT_EQ(
       run("snapshot GridWorld-v0 --seed 2 --steps 0 --out " + dir + "reset_zero.png").exit_code, 0);
-  EXPECT_EQ(read_png(dir + "reset_default.png").pixels, read_png(dir + "reset_zero.png").pixels);
+  EXPECT_EQ(render::read_png(dir + "reset_default.png").pixels, render::read_png(dir + "reset_zero.png").pixels);
 }
 
 TEST(PixelgymCliTest, SnapshotOfTheObservationIsWhatTheAgentSees) {
   const std::string out = std::string(PIXELGYM_TEST_OUTPUT_DIR) + "/cli/observation.png";
   const CliRun result = run("snapshot CartPoleSwingup-v0 --seed 0 --observation --out " + out);
   ASSERT_EQ(result.exit_code, 0) << result.output;
-  const Image image = read_png(out);
+  const render::Image image = render::read_png(out);
   EXPECT_EQ(image.width, 84);
   EXPECT_EQ(image.height, 84);
   const CliRun index = run("snapshot GridWorld-v0 --seed 0 --observation --out " + out);
@@ -185,7 +185,7 @@ TEST(PixelgymCliTest, ViewRendersEveryAssetRobotVisibly) {
     const CliRun result = run("view " + std::string(PIXELGYM_SOURCE_DIR) + "/assets/" + urdf +
                               " --out " + out + " --width 160 --height 120");
     ASSERT_EQ(result.exit_code, 0) << urdf << ": " << result.output;
-    const Image image = read_png(out);
+    const render::Image image = render::read_png(out);
     EXPECT_EQ(image.width, 160);
     EXPECT_EQ(image.height, 120);
     // Framed automatically: the robot fills a good part of the picture.

@@ -3,7 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-namespace pixelgym {
+namespace pixelgym::render {
 namespace {
 
 using ::testing::HasSubstr;
@@ -64,4 +64,4 @@ TEST(CameraTest, ProjectionPutsTheTargetAtTheImageCentreAndFlipsRows) {
 }
 
 }  // namespace
-}  // namespace pixelgym
+}  // namespace pixelgym::render

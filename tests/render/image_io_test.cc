@@ -4,7 +4,7 @@
 
 #include <filesystem>
 
-namespace pixelgym {
+namespace pixelgym::render {
 namespace {
 
 std::string output_path(const std::string& name) {
@@ -68,4 +68,4 @@ TEST(ImageIoTest, UnreadableFileThrowsNamingIt) {
 }
 
 }  // namespace
-}  // namespace pixelgym
+}  // namespace pixelgym::render

@@ -5,7 +5,7 @@
 #include <Eigen/Geometry>
 #include <utility>
 
-namespace pixelgym {
+namespace pixelgym::render {
 namespace {
 
 // Every triangle faces outward (its winding normal points away from the centre) and the vertex
@@ -74,4 +74,4 @@ TEST(MeshDataTest, PrimitiveExtents) {
 }
 
 }  // namespace
-}  // namespace pixelgym
+}  // namespace pixelgym::render

@@ -6,7 +6,7 @@
 #include <array>
 #include <thread>
 
-namespace pixelgym {
+namespace pixelgym::render {
 namespace {
 
 using ::testing::HasSubstr;
@@ -344,4 +344,4 @@ TEST(RendererTest, DescribesItsBackend) {
 }
 
 }  // namespace
-}  // namespace pixelgym
+}  // namespace pixelgym::render

@@ -47,7 +47,7 @@ TEST(BoxTest, ContainsRejectsWrongDtypeShapeBoundsAndNan) {
   EXPECT_FALSE(box.contains(Array::from_vector<float>({1, 2}, {0, 0})));
   EXPECT_FALSE(box.contains(Array::from_vector<float>({2}, {0.0F, 1.5F})));
   EXPECT_FALSE(box.contains(Array::from_vector<float>({2}, {NAN, 0.0F})));
-  EXPECT_FALSE(box.contains(Value(Dict{})));
+  EXPECT_FALSE(box.contains(Value(ValueDict{})));
   EXPECT_NE(box.mismatch(Array::from_vector<float>({2}, {NAN, 0.0F})).find("NaN"),
             std::string::npos);
   EXPECT_NE(box.mismatch(Array::from_vector<double>({2}, {0, 0})).find("float64"),

@@ -28,22 +28,22 @@ TEST(DictSpaceTest, SamplesAreContainedAcrossSeedsAndKeepKeyOrder) {
 TEST(DictSpaceTest, ContainsRejectsMissingExtraAndBadValues) {
   const Dict space = pixel_space();
   Rng rng(0);
-  pixelgym::Dict value = space.sample(rng).dict();
+  pixelgym::ValueDict value = space.sample(rng).dict();
 
-  pixelgym::Dict missing;
+  pixelgym::ValueDict missing;
   missing.insert("pixels", value.at("pixels"));
   EXPECT_NE(space.mismatch(missing).find("missing key \"joint_pos\""), std::string::npos);
 
-  pixelgym::Dict extra = value;
+  pixelgym::ValueDict extra = value;
   extra.insert("cube_pos", Array(DType::kFloat32, {3}));
   EXPECT_NE(space.mismatch(extra).find("unexpected key \"cube_pos\""), std::string::npos);
 
-  pixelgym::Dict wrong_dtype = value;
+  pixelgym::ValueDict wrong_dtype = value;
   wrong_dtype.insert("joint_pos", Array(DType::kFloat64, {2}));
   EXPECT_NE(space.mismatch(wrong_dtype).find("key \"joint_pos\": dtype float64"),
             std::string::npos);
 
-  pixelgym::Dict nan_value = value;
+  pixelgym::ValueDict nan_value = value;
   nan_value.insert("joint_pos", Array::from_vector<float>({2}, {NAN, 0.0F}));
   EXPECT_FALSE(space.contains(nan_value));
 

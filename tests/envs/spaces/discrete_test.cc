@@ -31,7 +31,7 @@ TEST(DiscreteTest, ContainsRejectsWrongDtypeShapeAndRange) {
   EXPECT_FALSE(space.contains(Array::scalar<double>(NAN)));
   EXPECT_FALSE(space.contains(Array::scalar<bool>(true)));
   EXPECT_FALSE(space.contains(Array::from_vector<std::int64_t>({1}, {1})));
-  EXPECT_FALSE(space.contains(Value(Tuple{})));
+  EXPECT_FALSE(space.contains(Value(ValueTuple{})));
   EXPECT_NE(space.mismatch(Array::scalar<std::int64_t>(4)).find("outside {0, ..., 3}"),
             std::string::npos);
 }
