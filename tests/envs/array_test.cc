@@ -120,5 +120,23 @@ TEST(ArrayTest, ToStringShowsDtypeShapeAndSmallValues) {
   EXPECT_EQ(Array(DType::kUInt8, {84, 84, 3}).to_string(), "uint8 (84, 84, 3)");
 }
 
+TEST(ArrayTest, SliceViewsRowsOfTheLeadingAxis) {
+  Array batch = Array::from_vector<std::int32_t>({4, 2}, {0, 1, 2, 3, 4, 5, 6, 7});
+  Array middle = batch.slice(1, 3);
+  EXPECT_EQ(middle.shape(), (Shape{2, 2}));
+  EXPECT_TRUE(middle.shares_memory(batch));
+  EXPECT_EQ(middle.data<std::int32_t>()[0], 2);
+  EXPECT_EQ(middle.data<std::int32_t>()[3], 5);
+  middle.data<std::int32_t>()[0] = 20;  // writes through to the batch
+  EXPECT_EQ(batch.data<std::int32_t>()[2], 20);
+  EXPECT_EQ(batch.slice(4, 4).shape(), (Shape{0, 2}));
+  EXPECT_EQ(batch.slice(0, 4).data<std::int32_t>(), batch.data<std::int32_t>());
+  // A slot of a slice is the batch's slot.
+  EXPECT_EQ(middle.index(1).data<std::int32_t>(), batch.index(2).data<std::int32_t>());
+  EXPECT_THROW(batch.slice(3, 2), std::out_of_range);
+  EXPECT_THROW(batch.slice(-1, 2), std::out_of_range);
+  EXPECT_THROW(batch.slice(0, 5), std::out_of_range);
+  EXPECT_THROW(Array::scalar(1.0F).slice(0, 0), std::out_of_range);
+}
 }  // namespace
 }  // namespace pixelgym

@@ -7,6 +7,7 @@
 #include <map>
 
 #include "envs/checker.h"
+#include "envs/pixel_env.h"
 #include "envs/registry.h"
 #include "tests/golden.h"
 
@@ -114,9 +115,15 @@ TEST_P(RegisteredEnvTest, StateModeNeedsNoRendering) {
       });
   if (!pixel_task) GTEST_SKIP() << GetParam() << " is not a pixel task";
   std::unique_ptr<Env> env = make(GetParam(), {{"obs_mode", "state"}});
+  const auto& pixel_env = dynamic_cast<const PixelEnv&>(env->unwrapped());
   const Value obs = env->reset(0).obs;
   EXPECT_FALSE(obs.dict().contains("pixels"));
   EXPECT_TRUE(env->observation_space().contains(obs));
+  for (int t = 0; t < 10; ++t) env->step(env->action_space().sample());
+  // Not a frame drawn for the observations; render() still draws on request.
+  EXPECT_EQ(pixel_env.frames_rendered(), 0);
+  env->render();
+  EXPECT_EQ(pixel_env.frames_rendered(), 1);
 }
 
 // The 84 x 84 observation after reset(seed=0), against tests/golden/env_<id>.png under the

@@ -50,7 +50,24 @@ TEST(RngTest, IntegerCoversInclusiveRangeOnly) {
   EXPECT_EQ(seen.size(), 6U);
   EXPECT_EQ(rng.integer(5, 5), 5);
   EXPECT_THROW(rng.integer(3, 2), std::invalid_argument);
-  rng.integer(INT64_MIN, INT64_MAX);  // the full range works
+}
+
+TEST(RngTest, IntegerCoversTheFullInt64Range) {
+  // The span INT64_MAX - INT64_MIN + 1 overflows 64 bits; draws must still reach both halves and
+  // the extremes' neighbourhoods (a broken span gives a constant or a narrow range).
+  Rng rng(5);
+  int negative = 0;
+  int positive = 0;
+  int beyond_2_62 = 0;
+  for (int i = 0; i < 1000; ++i) {
+    const std::int64_t x = rng.integer(INT64_MIN, INT64_MAX);
+    negative += x < 0 ? 1 : 0;
+    positive += x > 0 ? 1 : 0;
+    beyond_2_62 += (x > (std::int64_t{1} << 62) || x < -(std::int64_t{1} << 62)) ? 1 : 0;
+  }
+  EXPECT_NEAR(negative, 500, 80);
+  EXPECT_NEAR(positive, 500, 80);
+  EXPECT_NEAR(beyond_2_62, 500, 80);  // half of the range lies beyond +-2^62
 }
 
 TEST(RngTest, NormalHasUnitMoments) {

@@ -65,5 +65,15 @@ TEST(ValueTest, ToString) {
   EXPECT_EQ(value.to_string(), "Dict{\"a\": int64 () 1}");
 }
 
+TEST(ValueTest, DictEraseAndClear) {
+  ValueDict dict{{"a", Array::scalar(1.0)}, {"b", Array::scalar(2.0)}, {"c", Array::scalar(3.0)}};
+  dict.erase("b");
+  EXPECT_EQ(dict.keys(), (std::vector<std::string>{"a", "c"}));
+  EXPECT_EQ(dict.at("c").array().item<double>(), 3.0);
+  EXPECT_THROW(dict.erase("b"), std::out_of_range);
+  dict.clear();
+  EXPECT_TRUE(dict.empty());
+  EXPECT_THROW(dict.at("a"), std::out_of_range);
+}
 }  // namespace
 }  // namespace pixelgym

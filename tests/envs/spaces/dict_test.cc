@@ -68,5 +68,55 @@ TEST(DictSpaceTest, AccessToStringEquals) {
   EXPECT_EQ(space.dtype(), std::nullopt);
 }
 
+TEST(DictSpaceTest, ReplacedInsertedRemovedChangeOneEntry) {
+  const Dict space = pixel_space();  // "pixels", then "joint_pos"
+  const auto small = std::make_shared<Box>(0.0, 255.0, Shape{4, 4, 1}, DType::kUInt8);
+  const auto replaced = space.replaced("pixels", small);
+  ASSERT_EQ(replaced->entries().size(), 2U);
+  EXPECT_EQ(replaced->entries()[0].first, "pixels");  // same position
+  EXPECT_TRUE(replaced->at("pixels").equals(*small));
+  EXPECT_TRUE(replaced->at("joint_pos").equals(space.at("joint_pos")));
+  EXPECT_FALSE(space.at("pixels").equals(*small));  // the original is unchanged
+
+  const auto inserted = space.inserted("depth", small, 1);
+  ASSERT_EQ(inserted->entries().size(), 3U);
+  EXPECT_EQ(inserted->entries()[1].first, "depth");
+  EXPECT_EQ(inserted->index("joint_pos"), 2U);
+  EXPECT_EQ(space.inserted("depth", small)->entries().back().first, "depth");
+
+  const auto removed = space.removed("pixels");
+  ASSERT_EQ(removed->entries().size(), 1U);
+  EXPECT_EQ(removed->entries()[0].first, "joint_pos");
+
+  EXPECT_THROW(space.replaced("depth", small), std::out_of_range);
+  EXPECT_THROW(space.removed("depth"), std::out_of_range);
+  EXPECT_THROW(space.inserted("pixels", small), std::invalid_argument);
+  EXPECT_THROW(space.inserted("depth", small, 3), std::invalid_argument);
+  EXPECT_THROW(space.replaced("pixels", nullptr), std::invalid_argument);
+}
+
+TEST(DictSpaceTest, ZerosIsLaidOutAsTheSpace) {
+  const Dict space = pixel_space();
+  const Value zeros = space.zeros();
+  EXPECT_EQ(space.layout_mismatch(zeros), "");
+  EXPECT_TRUE(space.contains(zeros));
+  EXPECT_EQ(zeros.dict().at("pixels").array().shape(), (Shape{8, 8, 3}));
+  // Layout ignores the values (a NaN is still laid out right) but not keys, order, dtype, shape.
+  Value nan = space.zeros();
+  nan.dict().at("joint_pos").array().data<float>()[0] = std::nanf("");
+  EXPECT_EQ(space.layout_mismatch(nan), "");
+  EXPECT_FALSE(space.contains(nan));
+  pixelgym::ValueDict swapped;
+  swapped.insert("joint_pos", zeros.dict().at("joint_pos"));
+  swapped.insert("pixels", zeros.dict().at("pixels"));
+  EXPECT_NE(space.layout_mismatch(swapped), "");
+  pixelgym::ValueDict wrong_dtype = zeros.dict();
+  wrong_dtype.insert("joint_pos", Array(DType::kFloat64, {2}));
+  EXPECT_NE(space.layout_mismatch(wrong_dtype).find("float64"), std::string::npos);
+  pixelgym::ValueDict missing = zeros.dict();
+  missing.erase("pixels");
+  EXPECT_NE(space.layout_mismatch(missing), "");
+  EXPECT_NE(space.layout_mismatch(Array::scalar(1.0)), "");
+}
 }  // namespace
 }  // namespace pixelgym::spaces

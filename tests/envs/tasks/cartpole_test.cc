@@ -8,6 +8,7 @@
 
 #include "envs/pixel_env.h"
 #include "envs/registry.h"
+#include "tests/envs/tasks/scripted.h"
 
 namespace pixelgym {
 namespace {
@@ -122,6 +123,25 @@ TEST(CartPoleTest, EpisodeIsOneThousandControlStepsWhateverTheActionRepeat) {
     EXPECT_EQ(steps, 1000 / repeat);
     EXPECT_TRUE(step.truncated);
     EXPECT_LE(step.reward, static_cast<double>(repeat));
+  }
+}
+
+TEST(CartPoleTest, SwingUpStartsHangingAndBalanceStartsUpright) {
+  for (const char* id : {"CartPoleSwingup-v0", "CartPoleSwingupDiscrete-v0", "CartPoleBalance-v0",
+                         "CartPoleBalanceDiscrete-v0"}) {
+    const bool swing_up = std::string(id).find("Swingup") != std::string::npos;
+    std::unique_ptr<Env> env = make(id, {{"obs_mode", "state"}});
+    for (std::uint64_t seed = 0; seed < 20; ++seed) {
+      const Value obs = env->reset(seed).obs;
+      const double cart = testing::state(obs, "joint_pos", 0);
+      const double angle = testing::state(obs, "joint_pos", 1);  // 0 upright, in [-pi, pi)
+      EXPECT_LE(std::abs(cart), 0.25) << id << " seed " << seed;
+      if (swing_up) {
+        EXPECT_GE(std::abs(angle), 3.14159265 - 0.1) << id << " seed " << seed;
+      } else {
+        EXPECT_LE(std::abs(angle), 0.05) << id << " seed " << seed;
+      }
+    }
   }
 }
 
