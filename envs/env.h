@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "envs/array.h"
+#include "envs/errors.h"
 #include "envs/params.h"
 #include "envs/rng.h"
 #include "envs/space.h"
@@ -45,14 +46,6 @@ struct StepResult {
   bool terminated = false;
   bool truncated = false;
   Info info;
-};
-
-/// Thrown for calls in the wrong order: `step` or `render` before the first `reset`, `step` after
-/// the episode ended without a new `reset`, anything but `close` after `close`. (Gymnasium's
-/// `ResetNeeded`.)
-class ResetNeeded : public std::logic_error {
- public:
-  using std::logic_error::logic_error;
 };
 
 /// The environment protocol, named as in Gymnasium.

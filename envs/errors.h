@@ -1,0 +1,39 @@
+// The exceptions pixelgym throws, and what a language binding maps each to.
+#pragma once
+
+#include <stdexcept>
+
+namespace pixelgym {
+
+// Every error pixelgym reports is one of these standard or pixelgym exception types; the message
+// names the component, what it expected and what it was given. A binding maps them by type,
+// without reading messages:
+//
+//   C++ type                 meaning                                         Python
+//   std::out_of_range        a missing key or index: a ValueDict or          KeyError (IndexError
+//                            spaces::Dict key, an Array index or slice,      for Array/Tuple
+//                            a Task's state name                             positions)
+//   std::invalid_argument    a bad value from the caller: an action not in   ValueError
+//                            the action space, an unknown env id or kwarg,
+//                            a kwarg of the wrong type, a buffer of the
+//                            wrong layout, a malformed URDF, a bad config
+//   ResetNeeded              calls out of order: step/render before reset,   gymnasium.error.ResetNeeded
+//                            step after the episode ended, anything after    (RuntimeError without
+//                            close                                           gymnasium)
+//   std::runtime_error       the environment failing, not the caller: a      RuntimeError
+//                            file that cannot be read or written, a GL
+//                            context that cannot be made, a simulation that
+//                            went non-finite
+//
+// std::out_of_range and std::invalid_argument both derive from std::logic_error, and so does
+// ResetNeeded: catch ResetNeeded before std::logic_error when the difference matters.
+
+/// Thrown for calls in the wrong order: `step` or `render` before the first `reset`, `step` after
+/// the episode ended without a new `reset`, anything but `close` after `close`. (Gymnasium's
+/// `ResetNeeded`.)
+class ResetNeeded : public std::logic_error {
+ public:
+  using std::logic_error::logic_error;
+};
+
+}  // namespace pixelgym
