@@ -50,7 +50,7 @@ struct Scene {
   // Every double of the state, for bitwise comparison.
   std::vector<double> state() const {
     std::vector<double> values;
-    for (int robot : {arm, cube}) {
+    for (RobotId robot : {arm, cube}) {
       const Eigen::VectorXd q = world.joint_positions(robot);
       const Eigen::VectorXd qd = world.joint_velocities(robot);
       values.insert(values.end(), q.data(), q.data() + q.size());
@@ -65,8 +65,8 @@ struct Scene {
   }
 
   World world;
-  int arm = 0;
-  int cube = 0;
+  RobotId arm;
+  RobotId cube;
 };
 
 bool bit_identical(const std::vector<double>& a, const std::vector<double>& b) {
@@ -143,7 +143,7 @@ TEST(WorldTest, SixteenWorldsShareOneParsedModelAndReadMeshesOnce) {
 TEST(WorldTest, LinkPosesFollowTheJoints) {
   ModelCache cache;
   World world;
-  const int cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
+  const RobotId cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
   const int pole = world.robot_model(cartpole).link_index("pole");
   Eigen::VectorXd q(2);
   q << 0.5, M_PI / 2;  // cart 0.5 m along x, pole tipped 90 degrees about y (towards +x)
@@ -158,7 +158,7 @@ TEST(WorldTest, LinkPosesFollowTheJoints) {
 TEST(WorldTest, LinkVelocityMatchesJointRates) {
   ModelCache cache;
   World world;
-  const int cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
+  const RobotId cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
   Eigen::VectorXd qd(2);
   qd << 0.3, 2.0;
   world.set_joint_state(cartpole, Eigen::VectorXd::Zero(2), qd);
@@ -173,7 +173,7 @@ TEST(WorldTest, VelocityControlReachesItsTarget) {
   WorldConfig config;
   config.gravity_m_s2.setZero();
   World world(config);
-  const int arm = world.add_robot(cache.load_urdf(asset_path("arm/arm.urdf")));
+  const RobotId arm = world.add_robot(cache.load_urdf(asset_path("arm/arm.urdf")));
   world.set_control_mode(arm, ControlMode::kVelocity);
   Eigen::VectorXd target = Eigen::VectorXd::Zero(7);
   target[0] = 0.5;
@@ -186,7 +186,7 @@ TEST(WorldTest, JointLimitsHold) {
   ModelCache cache;
   WorldConfig config;
   World world(config);
-  const int cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
+  const RobotId cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
   world.set_joint_commands(cartpole, (Eigen::VectorXd(2) << 10.0, 0.0).finished());
   world.step(2400);
   EXPECT_LT(world.joint_positions(cartpole)[0], 2.0 + 0.02);
@@ -197,7 +197,7 @@ TEST(WorldTest, LimitsAndMotorsWorkOnRobotsWithoutCollisionShapes) {
   // island, which such a robot would not have without the world's help.
   ModelCache cache;
   World world;
-  const int reacher = world.add_robot(cache.load_urdf(asset_path("reacher/reacher.urdf")));
+  const RobotId reacher = world.add_robot(cache.load_urdf(asset_path("reacher/reacher.urdf")));
   // Push the wrist into its 2.8 rad limit. Without an island for its links the limit is ignored
   // and the wrist spins on (18.9 rad after 2 s). Bullet's limits are soft (error reduction per
   // step), so a light link under full torque rests slightly inside the limit.
@@ -218,7 +218,7 @@ TEST(WorldTest, FloatingBaseCanBeMovedAndSettles) {
   World world;
   RobotOptions options;
   options.fixed_base = false;
-  const int cube = world.add_robot(cache.load_urdf(asset_path("objects/cube.urdf")), options);
+  const RobotId cube = world.add_robot(cache.load_urdf(asset_path("objects/cube.urdf")), options);
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.translation() = Eigen::Vector3d(0.3, -0.2, 0.5);
   world.set_base_pose(cube, pose);
@@ -226,7 +226,7 @@ TEST(WorldTest, FloatingBaseCanBeMovedAndSettles) {
   world.step(480);
   EXPECT_TRUE(
       world.base_pose(cube).translation().isApprox(Eigen::Vector3d(0.3, -0.2, 0.025), 2e-3));
-  const int fixed = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
+  const RobotId fixed = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
   EXPECT_THROW(world.set_base_pose(fixed, pose), std::invalid_argument);
 }
 
@@ -271,7 +271,7 @@ TEST(WorldTest, MarkerHasNoCollision) {
   ball.geometry.type = GeometryType::kSphere;
   ball.geometry.radius_m = 0.1;
   ball.X_world_body.translation() = Eigen::Vector3d(0, 0, 0.3);  // inside the marker
-  const int b = world.add_body(ball);
+  const BodyId b = world.add_body(ball);
   world.step(240);
   EXPECT_NEAR(world.body_pose(b).translation().z(), 0.1, 2e-3) << "fell through the marker";
   for (const Contact& contact : world.contacts()) {
@@ -296,7 +296,7 @@ TEST(WorldTest, StaticMeshBodiesCollideAsTriangles) {
   ball.geometry.type = GeometryType::kSphere;
   ball.geometry.radius_m = 0.03;
   ball.X_world_body.translation() = Eigen::Vector3d(0.02, 0.01, 0.5);
-  const int b = world.add_body(ball);
+  const BodyId b = world.add_body(ball);
   world.step(480);
   EXPECT_NEAR(world.body_pose(b).translation().z(), 0.16 + 0.03, 3e-3);
   BodyOptions scaled = pedestal;
@@ -304,7 +304,7 @@ TEST(WorldTest, StaticMeshBodiesCollideAsTriangles) {
   scaled.mass_kg = 1.0;  // a moving mesh: its convex hull, scaled
   scaled.geometry.mesh_scale = Eigen::Vector3d(0.5, 0.5, 0.5);
   scaled.X_world_body.translation() = Eigen::Vector3d(2, 0, 0.3);
-  const int s = world.add_body(scaled);
+  const BodyId s = world.add_body(scaled);
   world.step(480);
   EXPECT_NEAR(world.body_pose(s).translation().z(), 0.0, 3e-3)
       << "the 0.08 m hull rests on the ground";
@@ -313,7 +313,7 @@ TEST(WorldTest, StaticMeshBodiesCollideAsTriangles) {
 TEST(WorldTest, NonFiniteStateRaisesNamingTheRobot) {
   ModelCache cache;
   World world;
-  const int cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
+  const RobotId cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
   world.set_joint_commands(cartpole, (Eigen::VectorXd(2) << 0.0, 1e308).finished());
   try {
     world.step(10);
@@ -330,14 +330,36 @@ TEST(WorldTest, BadArgumentsAreRejected) {
   ModelCache cache;
   World world;
   EXPECT_THROW(world.add_robot(nullptr), std::invalid_argument);
-  const int cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
+  const RobotId cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
   EXPECT_THROW(world.set_joint_commands(cartpole, Eigen::VectorXd::Zero(3)), std::invalid_argument);
   EXPECT_THROW(world.set_joint_commands(cartpole, Eigen::VectorXd::Constant(2, NAN)),
                std::invalid_argument);
   EXPECT_THROW(world.set_joint_state(cartpole, Eigen::VectorXd::Zero(1), Eigen::VectorXd::Zero(2)),
                std::invalid_argument);
   EXPECT_THROW(world.link_pose(cartpole, 9), std::out_of_range);
-  EXPECT_THROW(world.joint_positions(5), std::out_of_range);
+  EXPECT_THROW(world.joint_positions(RobotId{5}), std::out_of_range);
+  EXPECT_THROW(world.joint_positions(RobotId{}), std::out_of_range);
+  EXPECT_THROW(world.body_pose(BodyId{0}), std::out_of_range);
+  EXPECT_THROW(world.joint_position(cartpole, 2), std::out_of_range);
+  EXPECT_THROW(world.joint_velocity(cartpole, -1), std::out_of_range);
+  EXPECT_THROW(world.control_mode(cartpole, 2), std::out_of_range);
+  EXPECT_THROW(world.segmentation_id(cartpole, 3), std::out_of_range);
+  Eigen::VectorXd three(3);
+  EXPECT_THROW(world.joint_positions(cartpole, three), std::invalid_argument);
+  EXPECT_THROW(world.joint_velocities(cartpole, three), std::invalid_argument);
+  try {
+    world.set_joint_commands(cartpole, Eigen::Vector3d::Zero());
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_THAT(error.what(), HasSubstr("World::set_joint_commands: robot \"cartpole\" has 2 "
+                                        "degrees of freedom, got 3 commands"));
+  }
+  try {
+    world.link_pose(RobotId{7}, 0);
+    FAIL() << "no error";
+  } catch (const std::out_of_range& error) {
+    EXPECT_THAT(error.what(), HasSubstr("World::link_pose: no robot 7 (there are 1)"));
+  }
   RobotOptions floating;
   floating.fixed_base = false;
   EXPECT_THROW(world.add_robot(cache.load_urdf(asset_path("objects/table.urdf")), floating),

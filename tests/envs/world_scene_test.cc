@@ -32,7 +32,7 @@ TEST(WorldSceneTest, OneInstancePerVisualShapeWithSegmentationIds) {
 TEST(WorldSceneTest, UpdateFollowsTheWorld) {
   FixtureScene f = testing::cartpole_scene(84, 84);
   const Eigen::Isometry3f before = f.view->scene().instances.back().X_world_instance;  // the pole
-  f.world->set_joint_state(0, (Eigen::VectorXd(2) << -0.5, 0.0).finished(),
+  f.world->set_joint_state(engine::RobotId{0}, (Eigen::VectorXd(2) << -0.5, 0.0).finished(),
                            Eigen::VectorXd::Zero(2));
   f.view->update(*f.world);
   const Eigen::Isometry3f after = f.view->scene().instances.back().X_world_instance;
