@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <map>
 #include <thread>
 
 namespace pixelgym::engine {
@@ -254,6 +255,44 @@ TEST(WorldTest, VisualShapesListEveryVisualWithItsPose) {
   std::vector<Eigen::Isometry3d> later;
   world.visual_poses(later);
   EXPECT_TRUE(later.back().isApprox(poses.back())) << "a static marker does not move";
+}
+
+TEST(WorldTest, SegmentationIdsAreOnePerOwnerInTheOrderAdded) {
+  ModelCache cache;
+  World world;
+  const auto reacher_model = cache.load_urdf(asset_path("reacher/reacher.urdf"));
+  const RobotId reacher = world.add_robot(reacher_model);
+  BodyOptions target;
+  target.name = "target";
+  target.geometry.type = GeometryType::kSphere;
+  target.geometry.radius_m = 0.05;
+  target.mass_kg = 0;
+  target.collides = false;
+  const BodyId target_id = world.add_body(target);
+  const RobotId cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
+  const int reacher_links = static_cast<int>(reacher_model->links().size());
+  // Link l of the first robot has id 1 + l, the body the next id, the next robot's links after.
+  for (int l = 0; l < reacher_links; ++l) EXPECT_EQ(world.segmentation_id(reacher, l), 1 + l);
+  EXPECT_EQ(world.segmentation_id(target_id), 1 + reacher_links);
+  EXPECT_EQ(world.segmentation_id(cartpole, 0), 2 + reacher_links);
+  // Every visual shape carries its owner's id; shapes of different owners never share one.
+  std::map<std::string, int> id_of_owner;
+  std::map<int, std::string> owner_of_id;
+  for (const VisualShape& shape : world.visual_shapes()) {
+    id_of_owner.emplace(shape.owner, shape.segmentation_id);
+    EXPECT_EQ(id_of_owner.at(shape.owner), shape.segmentation_id) << shape.owner;
+    owner_of_id.emplace(shape.segmentation_id, shape.owner);
+    EXPECT_EQ(owner_of_id.at(shape.segmentation_id), shape.owner) << shape.segmentation_id;
+  }
+  EXPECT_EQ(id_of_owner.at("reacher/fingertip"),
+            world.segmentation_id(reacher, reacher_model->link_index("fingertip")));
+  EXPECT_EQ(id_of_owner.at("target"), world.segmentation_id(target_id));
+  // A reset keeps them.
+  const std::vector<VisualShape> before = world.visual_shapes();
+  world.step(10);
+  world.reset();
+  for (std::size_t i = 0; i < before.size(); ++i)
+    EXPECT_EQ(world.visual_shapes()[i].segmentation_id, before[i].segmentation_id);
 }
 
 TEST(WorldTest, MarkerHasNoCollision) {
