@@ -159,6 +159,25 @@ std::shared_ptr<const RobotModel> good_urdf(ModelCache& cache, const std::string
   return cache.load_urdf(std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/urdf_good/" + name);
 }
 
+TEST(WorldPhysicsTest, ForceOnAPrismaticJointGivesTheExpectedMotion) {
+  // tests/data/urdf_good/slider.urdf: 2 kg on a horizontal rail, so F = 4 N gives a = 2 m/s^2:
+  // after 0.25 s, v = 0.5 m/s and x = 0.0625 m (well inside the [-0.5, 0.3] m limits).
+  ModelCache cache;
+  for (const double force : {4.0, -4.0}) {
+    World world;
+    const RobotId robot = world.add_robot(good_urdf(cache, "slider.urdf"));
+    world.set_joint_commands(robot, Eigen::Matrix<double, 1, 1>(force));
+    world.step(60);
+    const double a = force / 2.0;
+    EXPECT_NEAR(world.joint_velocity(robot, 0), a * 0.25, 1e-3 * std::abs(a * 0.25));
+    // Bullet integrates semi-implicitly (velocity first), so after n steps of dt the position is
+    // a dt^2 n (n + 1) / 2 = a t (t + dt) / 2: half a step ahead of a t^2 / 2.
+    const double dt = world.config().timestep_s;
+    const double x = 0.5 * a * 0.25 * (0.25 + dt);
+    EXPECT_NEAR(world.joint_position(robot, 0), x, 1e-3 * std::abs(x));
+  }
+}
+
 TEST(WorldPhysicsTest, JointDampingDecaysVelocityExponentially) {
   ModelCache cache;
   World world;

@@ -169,6 +169,36 @@ TEST(WorldTest, LinkVelocityMatchesJointRates) {
   EXPECT_TRUE(v.isApprox(Eigen::Vector3d(0.3, 0, 0), 1e-9)) << v.transpose();
 }
 
+TEST(WorldTest, LinkVelocityAwayFromTheJointsMatchesTheAnalyticValue) {
+  // The reacher's fingertip frame is 0.12 m beyond the wrist, which is 0.12 m beyond the
+  // shoulder; both hinges turn about z. Its velocity depends on both rates:
+  //   v = 0.12 q1' (-sin q1, cos q1) + 0.12 (q1' + q2') (-sin(q1 + q2), cos(q1 + q2)).
+  ModelCache cache;
+  World world;
+  const auto model = cache.load_urdf(asset_path("reacher/reacher.urdf"));
+  const RobotId reacher = world.add_robot(model);
+  const Eigen::Vector2d q(0.4, -0.7);
+  const Eigen::Vector2d qd(1.5, -2.0);
+  world.set_joint_state(reacher, q, qd);
+  const double a = q[0];
+  const double b = q[0] + q[1];
+  const Eigen::Vector3d elbow = 0.12 * qd[0] * Eigen::Vector3d(-std::sin(a), std::cos(a), 0);
+  const Eigen::Vector3d tip =
+      elbow + 0.12 * (qd[0] + qd[1]) * Eigen::Vector3d(-std::sin(b), std::cos(b), 0);
+  const Eigen::Vector3d v_tip = world.link_linear_velocity(reacher, model->link_index("fingertip"));
+  EXPECT_TRUE(v_tip.isApprox(tip, 1e-9)) << v_tip.transpose() << " vs " << tip.transpose();
+  const Eigen::Vector3d v_hand = world.link_linear_velocity(reacher, model->link_index("hand"));
+  EXPECT_TRUE(v_hand.isApprox(elbow, 1e-9)) << v_hand.transpose() << " vs " << elbow.transpose();
+  // And after a step, against a finite difference of the fingertip's position.
+  const Eigen::Vector3d before =
+      world.link_pose(reacher, model->link_index("fingertip")).translation();
+  world.step();
+  const Eigen::Vector3d after =
+      world.link_pose(reacher, model->link_index("fingertip")).translation();
+  const Eigen::Vector3d v_now = world.link_linear_velocity(reacher, model->link_index("fingertip"));
+  EXPECT_LT((v_now - (after - before) / world.config().timestep_s).norm(), 0.02 * v_now.norm());
+}
+
 TEST(WorldTest, VelocityControlReachesItsTarget) {
   ModelCache cache;
   WorldConfig config;
@@ -184,13 +214,50 @@ TEST(WorldTest, VelocityControlReachesItsTarget) {
 }
 
 TEST(WorldTest, JointLimitsHold) {
+  // The cart's rail is a prismatic joint limited to [-2, 2] m: pushed hard either way, the cart
+  // comes to rest at that end (not before it, not beyond it).
   ModelCache cache;
-  WorldConfig config;
-  World world(config);
-  const RobotId cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
-  world.set_joint_commands(cartpole, (Eigen::VectorXd(2) << 10.0, 0.0).finished());
-  world.step(2400);
-  EXPECT_LT(world.joint_positions(cartpole)[0], 2.0 + 0.02);
+  for (const double force : {10.0, -10.0}) {
+    World world;
+    const RobotId cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
+    world.set_joint_commands(cartpole, Eigen::Vector2d(force, 0.0));
+    world.step(2400);
+    EXPECT_NEAR(world.joint_position(cartpole, 0), force > 0 ? 2.0 : -2.0, 0.02)
+        << "pushed with " << force << " N";
+  }
+}
+
+std::shared_ptr<const RobotModel> slider(ModelCache& cache) {
+  return cache.load_urdf(std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/urdf_good/slider.urdf");
+}
+
+TEST(WorldTest, PrismaticLimitsHoldOnBothSides) {
+  // tests/data/urdf_good/slider.urdf: a 2 kg carriage on a rail limited to [-0.5, 0.3] m.
+  ModelCache cache;
+  for (const double force : {50.0, -50.0}) {
+    World world;
+    const RobotId robot = world.add_robot(slider(cache));
+    world.set_joint_commands(robot, Eigen::Matrix<double, 1, 1>(force));
+    world.step(480);
+    EXPECT_NEAR(world.joint_position(robot, 0), force > 0 ? 0.3 : -0.5, 0.01)
+        << "pushed with " << force << " N";
+    EXPECT_NEAR(world.joint_velocity(robot, 0), 0.0, 0.01) << "not resting on the limit";
+  }
+}
+
+TEST(WorldTest, PrismaticJointsFollowVelocityAndPositionCommands) {
+  ModelCache cache;
+  World world;
+  const RobotId robot = world.add_robot(slider(cache));
+  world.set_control_mode(robot, ControlMode::kVelocity);
+  world.set_joint_commands(robot, Eigen::Matrix<double, 1, 1>(-0.2));
+  world.step(240);
+  EXPECT_NEAR(world.joint_velocity(robot, 0), -0.2, 1e-3);
+  EXPECT_NEAR(world.joint_position(robot, 0), -0.2, 0.01);  // about 1 s at -0.2 m/s
+  world.set_control_mode(robot, ControlMode::kPosition);
+  world.set_joint_commands(robot, Eigen::Matrix<double, 1, 1>(0.15));
+  world.step(720);
+  EXPECT_NEAR(world.joint_position(robot, 0), 0.15, 1e-3);
 }
 
 TEST(WorldTest, LimitsAndMotorsWorkOnRobotsWithoutCollisionShapes) {
