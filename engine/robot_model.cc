@@ -101,7 +101,7 @@ XmlFacts inspect_xml(const std::string& path) {
       }
     }
   }
-  if (links.empty()) fail(path, "has no links");
+  if (links.empty()) fail(path, "has no links (a robot needs at least one <link>)");
 
   std::map<std::string, std::string> parent_joint_of;  // child link -> joint
   std::map<std::string, std::vector<std::string>> children_of;
