@@ -13,7 +13,7 @@ namespace {
 // would drive it.
 void step_robot(benchmark::State& state, const std::string& urdf, ControlMode mode) {
   World world;
-  const int robot = world.add_robot(default_model_cache().load_urdf(asset_path(urdf)));
+  const RobotId robot = world.add_robot(default_model_cache().load_urdf(asset_path(urdf)));
   world.set_control_mode(robot, mode);
   const int dofs = world.num_dofs(robot);
   Eigen::VectorXd command(dofs);
@@ -51,7 +51,7 @@ void BM_ArmPosition(benchmark::State& state) {
 void BM_ArmTableCube(benchmark::State& state) {
   World world;
   ModelCache& cache = default_model_cache();
-  const int arm = world.add_robot(cache.load_urdf(asset_path("arm/arm.urdf")));
+  const RobotId arm = world.add_robot(cache.load_urdf(asset_path("arm/arm.urdf")));
   RobotOptions table;
   table.X_world_base.translation() = Eigen::Vector3d(0.6, 0, 0);
   world.add_robot(cache.load_urdf(asset_path("objects/table.urdf")), table);

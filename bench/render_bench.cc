@@ -36,15 +36,15 @@ int main(int argc, char** argv) {
   pixelgym::render::Renderer renderer;
   std::vector<std::uint8_t> rgb(static_cast<std::size_t>(width) * static_cast<std::size_t>(height) *
                                 3);
-  const int dofs = f.world->num_dofs(0);
-  Eigen::VectorXd q = f.world->joint_positions(0);
+  const int dofs = f.world->num_dofs(pixelgym::engine::RobotId{0});
+  Eigen::VectorXd q = f.world->joint_positions(pixelgym::engine::RobotId{0});
   const Eigen::VectorXd q0 = q;
   unsigned long checksum = 0;
   std::chrono::steady_clock::time_point start;
   for (int i = -100; i < frames; ++i) {
     if (i == 0) start = std::chrono::steady_clock::now();
     for (int d = 0; d < dofs; ++d) q[d] = q0[d] + 0.4 * std::sin(0.01 * i + d);
-    f.world->set_joint_state(0, q, Eigen::VectorXd::Zero(dofs));
+    f.world->set_joint_state(pixelgym::engine::RobotId{0}, q, Eigen::VectorXd::Zero(dofs));
     f.view->update(*f.world);
     renderer.render(f.view->scene(), f.camera, {rgb.data()});
     checksum += rgb[rgb.size() / 2];

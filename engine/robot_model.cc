@@ -101,7 +101,7 @@ XmlFacts inspect_xml(const std::string& path) {
       }
     }
   }
-  if (links.empty()) fail(path, "has no links");
+  if (links.empty()) fail(path, "has no links (a robot needs at least one <link>)");
 
   std::map<std::string, std::string> parent_joint_of;  // child link -> joint
   std::map<std::string, std::vector<std::string>> children_of;
@@ -303,26 +303,42 @@ std::string resolve_uri(const std::string& uri, const std::string& urdf_path) {
   const std::string kPackage = "package://";
   if (uri.rfind(kFile, 0) == 0)
     return fs::path(uri.substr(kFile.size())).lexically_normal().string();
-  if (uri.rfind(kPackage, 0) != 0) {
+  // What to look for under each folder: the path itself, or for package://NAME/REST, NAME/REST
+  // and then REST.
+  std::vector<fs::path> wanted;
+  if (uri.rfind(kPackage, 0) == 0) {
+    const std::string rest = uri.substr(kPackage.size());
+    const std::size_t slash = rest.find('/');
+    wanted.emplace_back(rest);
+    if (slash != std::string::npos) wanted.emplace_back(rest.substr(slash + 1));
+  } else {
     const fs::path file(uri);
-    return (file.is_absolute() ? file : urdf_folder / file).lexically_normal().string();
+    if (file.is_absolute()) return file.lexically_normal().string();
+    wanted.push_back(file);
   }
-  const std::string rest = uri.substr(kPackage.size());
-  const std::size_t slash = rest.find('/');
-  const std::string inside_package = slash == std::string::npos ? rest : rest.substr(slash + 1);
+  // The URDF's folder and every parent up to the root, then the asset search path.
   std::vector<fs::path> roots;
-  for (fs::path folder = urdf_folder; !folder.empty(); folder = folder.parent_path()) {
+  for (fs::path folder = urdf_folder;; folder = folder.parent_path()) {
     roots.push_back(folder);
-    if (folder == folder.parent_path() || roots.size() > 4) break;
+    if (folder == folder.parent_path() || folder.empty()) break;
   }
-  for (const std::string& folder : asset_search_path()) roots.emplace_back(folder);
+  const std::vector<std::string> asset_folders = asset_search_path();
+  roots.insert(roots.end(), asset_folders.begin(), asset_folders.end());
   for (const fs::path& root : roots) {
-    for (const fs::path& candidate : {root / rest, root / inside_package}) {
-      if (fs::exists(candidate)) return candidate.lexically_normal().string();
+    for (const fs::path& relative : wanted) {
+      const fs::path candidate = root / relative;
+      if (fs::is_regular_file(candidate)) return candidate.lexically_normal().string();
     }
   }
-  throw UrdfError("cannot resolve \"" + uri + "\": looked for \"" + rest + "\" beside " +
-                  urdf_folder.string() + ", in its parents and in the asset search path");
+  std::string looked_for = "\"" + wanted[0].string() + "\"";
+  if (wanted.size() > 1) looked_for += " or \"" + wanted[1].string() + "\"";
+  std::string searched;
+  for (const std::string& folder : asset_folders)
+    searched += (searched.empty() ? "" : ", ") + folder;
+  throw UrdfError("cannot resolve \"" + uri + "\": no file " + looked_for + " in " +
+                  urdf_folder.string() + " (the URDF's folder), its parent folders, or the asset " +
+                  "search path (" + searched + "; PIXELGYM_ASSET_PATH adds folders before " +
+                  "pixelgym's assets)");
 }
 
 std::shared_ptr<const RobotModel> parse_urdf(const std::string& path, MeshCache& meshes) {

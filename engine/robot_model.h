@@ -137,9 +137,11 @@ class RobotModel {
 std::vector<std::string> asset_search_path();
 
 /// The absolute path of `uri` as used inside the URDF at `urdf_path`: `file://` and absolute
-/// paths as they are, relative paths against the URDF's folder, `package://NAME/REST` by looking
-/// for NAME/REST (then REST) in the URDF's folder, its parents, and asset_search_path(). Throws
-/// UrdfError when nothing is found.
+/// paths as they are; a relative path, or `package://NAME/REST` (as NAME/REST, then REST), is
+/// looked for in the URDF's folder, then each of its parent folders up to the root, then each
+/// folder of asset_search_path() (PIXELGYM_ASSET_PATH's, then pixelgym's assets/); the first
+/// file found wins. Throws UrdfError naming the URI, what was looked for and where, when nothing
+/// is found.
 std::string resolve_uri(const std::string& uri, const std::string& urdf_path);
 
 /// Parses a URDF and imports its meshes through `meshes`. Throws UrdfError naming the file and

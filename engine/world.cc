@@ -132,12 +132,14 @@ struct World::Impl {
     std::vector<std::unique_ptr<btMultiBodyConstraint>> constraints;
     std::vector<btMultiBodyJointMotor*> motors;           // per dof, owned by `constraints`
     std::vector<btMultiBodyJointMotor*> friction_motors;  // per dof or null
+    int first_segmentation_id = 0;                        // of link 0; link l has this + l
   };
 
   struct Body {
     BodyOptions options;
     ShapeHolder shape;
     std::unique_ptr<btRigidBody> rigid;  // rebuilt by build()
+    int segmentation_id = 0;
   };
 
   // What a visual shape is attached to.
@@ -371,23 +373,18 @@ struct World::Impl {
   void check_finite(std::int64_t step) const {
     for (const Robot& robot : robots) {
       const btMultiBody& body = *robot.body;
-      bool finite = body.getBaseWorldTransform().getOrigin().length2() < BT_INFINITY &&
-                    std::isfinite(body.getBaseVel().length2()) &&
-                    std::isfinite(body.getBaseOmega().length2());
-      std::string where = "its base";
+      const bool base_finite = body.getBaseWorldTransform().getOrigin().length2() < BT_INFINITY &&
+                               std::isfinite(body.getBaseVel().length2()) &&
+                               std::isfinite(body.getBaseOmega().length2());
+      if (!base_finite) throw_non_finite(robot, "its base", step);
       for (const Dof& dof : robot.dofs) {
-        if (!finite) break;
         if (!std::isfinite(body.getJointPos(dof.bullet_link)) ||
             !std::isfinite(body.getJointVel(dof.bullet_link))) {
-          finite = false;
-          where =
-              "joint \"" + robot.model->joints()[static_cast<std::size_t>(dof.joint)].name + "\"";
+          throw_non_finite(
+              robot,
+              "joint \"" + robot.model->joints()[static_cast<std::size_t>(dof.joint)].name + "\"",
+              step);
         }
-      }
-      if (!finite) {
-        throw std::runtime_error("World: robot \"" + robot.model->name() +
-                                 "\" has a non-finite state (" + where + ") after step " +
-                                 std::to_string(step));
       }
     }
     for (const Body& body : bodies) {
@@ -399,6 +396,13 @@ struct World::Impl {
                                  "\" has a non-finite state after step " + std::to_string(step));
       }
     }
+  }
+
+  [[noreturn]] static void throw_non_finite(const Robot& robot, const std::string& where,
+                                            std::int64_t step) {
+    throw std::runtime_error("World: robot \"" + robot.model->name() +
+                             "\" has a non-finite state (" + where + ") after step " +
+                             std::to_string(step));
   }
 
   Eigen::Isometry3d link_pose(const Robot& robot, int link) const {
@@ -424,6 +428,12 @@ struct World::Impl {
   std::unordered_map<const btCollisionObject*, std::string> names;
   btAlignedObjectArray<btQuaternion> scratch_rotations;
   btAlignedObjectArray<btVector3> scratch_origins;
+  // Scratch of link_linear_velocity, kept so that the query allocates nothing once warm (this
+  // is why a World's const queries are not safe to call from two threads at once).
+  mutable btAlignedObjectArray<btScalar> scratch_jacobian;
+  mutable btAlignedObjectArray<btScalar> scratch_r;
+  mutable btAlignedObjectArray<btVector3> scratch_v;
+  mutable btAlignedObjectArray<btMatrix3x3> scratch_m;
 };
 
 World::World(WorldConfig config) : config_((config.validate(), config)) {
@@ -432,7 +442,7 @@ World::World(WorldConfig config) : config_((config.validate(), config)) {
 
 World::~World() = default;
 
-int World::add_robot(std::shared_ptr<const RobotModel> model, RobotOptions options) {
+RobotId World::add_robot(std::shared_ptr<const RobotModel> model, RobotOptions options) {
   if (model == nullptr) throw std::invalid_argument("World::add_robot: model is null");
   const auto& links = model->links();
   if (!options.fixed_base) {
@@ -448,6 +458,7 @@ int World::add_robot(std::shared_ptr<const RobotModel> model, RobotOptions optio
   Impl::Robot robot;
   robot.model = model;
   robot.options = options;
+  robot.first_segmentation_id = next_segmentation_id_;
   const int robot_index = static_cast<int>(impl_->robots.size());
   for (std::size_t l = 0; l < links.size(); ++l) {
     const LinkModel& link = links[l];
@@ -464,8 +475,7 @@ int World::add_robot(std::shared_ptr<const RobotModel> model, RobotOptions optio
       holder.shape = std::move(compound);
     }
     robot.shapes.push_back(std::move(holder));
-    const int segmentation_id =
-        static_cast<int>(impl_->names.size()) + 1 + static_cast<int>(visual_shapes_.size());
+    const int segmentation_id = robot.first_segmentation_id + static_cast<int>(l);
     for (const VisualElement& visual : link.visuals) {
       visual_shapes_.push_back(
           {visual.geometry, visual.material, model->name() + "/" + link.name, segmentation_id});
@@ -479,11 +489,12 @@ int World::add_robot(std::shared_ptr<const RobotModel> model, RobotOptions optio
     robot.dofs.push_back(dof);
   }
   impl_->robots.push_back(std::move(robot));
+  next_segmentation_id_ += static_cast<int>(links.size());
   impl_->rebuild();
-  return robot_index;
+  return RobotId{robot_index};
 }
 
-int World::add_body(BodyOptions options) {
+BodyId World::add_body(BodyOptions options) {
   if (!(options.mass_kg >= 0)) {
     throw std::invalid_argument("World::add_body: body \"" + options.name + "\" has negative mass");
   }
@@ -509,13 +520,14 @@ int World::add_body(BodyOptions options) {
   } else {
     body.shape.shape = primitive_shape(options.geometry);
   }
+  body.segmentation_id = next_segmentation_id_++;
   const int body_index = static_cast<int>(impl_->bodies.size());
-  visual_shapes_.push_back({options.geometry, options.material, options.name,
-                            static_cast<int>(visual_shapes_.size()) + 1});
+  visual_shapes_.push_back(
+      {options.geometry, options.material, options.name, body.segmentation_id});
   impl_->visual_refs.push_back({-1, body_index, Eigen::Isometry3d::Identity()});
   impl_->bodies.push_back(std::move(body));
   impl_->rebuild();
-  return body_index;
+  return BodyId{body_index};
 }
 
 void World::step(int steps) {
@@ -540,84 +552,135 @@ void World::reset() {
 
 double World::time_s() const { return static_cast<double>(step_count_) * config_.timestep_s; }
 
-void World::check_robot(int robot) const {
-  if (robot < 0 || robot >= num_robots()) {
-    throw std::out_of_range("World: no robot " + std::to_string(robot) + " (there are " +
+void World::check_robot(RobotId robot, const char* caller) const {
+  if (robot.index < 0 || robot.index >= num_robots()) {
+    throw std::out_of_range(std::string("World::") + caller + ": no robot " +
+                            std::to_string(robot.index) + " (there are " +
                             std::to_string(num_robots()) + ")");
   }
 }
 
-void World::check_body(int body) const {
-  if (body < 0 || body >= num_bodies()) {
-    throw std::out_of_range("World: no body " + std::to_string(body) + " (there are " +
+void World::check_body(BodyId body, const char* caller) const {
+  if (body.index < 0 || body.index >= num_bodies()) {
+    throw std::out_of_range(std::string("World::") + caller + ": no body " +
+                            std::to_string(body.index) + " (there are " +
                             std::to_string(num_bodies()) + ")");
   }
 }
 
+namespace {
+
+// The size check of the vector-valued joint queries and commands; builds its message only when
+// it throws.
+void check_dof_count(const char* caller, const std::string& robot_name, std::size_t dofs,
+                     Eigen::Index given, const char* what) {
+  if (given != static_cast<Eigen::Index>(dofs)) {
+    throw std::invalid_argument(std::string("World::") + caller + ": robot \"" + robot_name +
+                                "\" has " + std::to_string(dofs) + " degrees of freedom, got " +
+                                std::to_string(given) + " " + what);
+  }
+}
+
+}  // namespace
+
 int World::num_robots() const { return static_cast<int>(impl_->robots.size()); }
 
-const RobotModel& World::robot_model(int robot) const {
-  check_robot(robot);
-  return *impl_->robots[static_cast<std::size_t>(robot)].model;
+const RobotModel& World::robot_model(RobotId robot) const {
+  check_robot(robot, "robot_model");
+  return *impl_->robots[static_cast<std::size_t>(robot.index)].model;
 }
 
-int World::num_dofs(int robot) const {
-  check_robot(robot);
-  return static_cast<int>(impl_->robots[static_cast<std::size_t>(robot)].dofs.size());
+int World::num_dofs(RobotId robot) const {
+  check_robot(robot, "num_dofs");
+  return static_cast<int>(impl_->robots[static_cast<std::size_t>(robot.index)].dofs.size());
 }
 
-Eigen::VectorXd World::joint_positions(int robot) const {
-  check_robot(robot);
-  const Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot)];
-  Eigen::VectorXd q(static_cast<Eigen::Index>(r.dofs.size()));
+void World::joint_positions(RobotId robot, Eigen::Ref<Eigen::VectorXd> out) const {
+  check_robot(robot, "joint_positions");
+  const Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot.index)];
+  check_dof_count("joint_positions", r.model->name(), r.dofs.size(), out.size(), "outputs");
   for (std::size_t d = 0; d < r.dofs.size(); ++d) {
-    q[static_cast<Eigen::Index>(d)] = r.body->getJointPos(r.dofs[d].bullet_link);
+    out[static_cast<Eigen::Index>(d)] = r.body->getJointPos(r.dofs[d].bullet_link);
   }
+}
+
+void World::joint_velocities(RobotId robot, Eigen::Ref<Eigen::VectorXd> out) const {
+  check_robot(robot, "joint_velocities");
+  const Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot.index)];
+  check_dof_count("joint_velocities", r.model->name(), r.dofs.size(), out.size(), "outputs");
+  for (std::size_t d = 0; d < r.dofs.size(); ++d) {
+    out[static_cast<Eigen::Index>(d)] = r.body->getJointVel(r.dofs[d].bullet_link);
+  }
+}
+
+namespace {
+
+void check_dof(const char* caller, const std::string& robot_name, std::size_t dofs, int dof) {
+  if (dof < 0 || dof >= static_cast<int>(dofs)) {
+    throw std::out_of_range(std::string("World::") + caller + ": robot \"" + robot_name +
+                            "\" has no dof " + std::to_string(dof) + " (it has " +
+                            std::to_string(dofs) + ")");
+  }
+}
+
+}  // namespace
+
+double World::joint_position(RobotId robot, int dof) const {
+  check_robot(robot, "joint_position");
+  const Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot.index)];
+  check_dof("joint_position", r.model->name(), r.dofs.size(), dof);
+  return r.body->getJointPos(r.dofs[static_cast<std::size_t>(dof)].bullet_link);
+}
+
+double World::joint_velocity(RobotId robot, int dof) const {
+  check_robot(robot, "joint_velocity");
+  const Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot.index)];
+  check_dof("joint_velocity", r.model->name(), r.dofs.size(), dof);
+  return r.body->getJointVel(r.dofs[static_cast<std::size_t>(dof)].bullet_link);
+}
+
+Eigen::VectorXd World::joint_positions(RobotId robot) const {
+  Eigen::VectorXd q(num_dofs(robot));
+  joint_positions(robot, q);
   return q;
 }
 
-Eigen::VectorXd World::joint_velocities(int robot) const {
-  check_robot(robot);
-  const Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot)];
-  Eigen::VectorXd qd(static_cast<Eigen::Index>(r.dofs.size()));
-  for (std::size_t d = 0; d < r.dofs.size(); ++d) {
-    qd[static_cast<Eigen::Index>(d)] = r.body->getJointVel(r.dofs[d].bullet_link);
-  }
+Eigen::VectorXd World::joint_velocities(RobotId robot) const {
+  Eigen::VectorXd qd(num_dofs(robot));
+  joint_velocities(robot, qd);
   return qd;
 }
 
-void World::set_joint_state(int robot, const Eigen::VectorXd& positions,
-                            const Eigen::VectorXd& velocities) {
-  check_robot(robot);
-  Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot)];
-  const auto n = static_cast<Eigen::Index>(r.dofs.size());
-  if (positions.size() != n || velocities.size() != n) {
-    throw std::invalid_argument("World::set_joint_state: robot \"" + r.model->name() + "\" has " +
-                                std::to_string(n) + " degrees of freedom, got " +
-                                std::to_string(positions.size()) + " positions and " +
-                                std::to_string(velocities.size()) + " velocities");
-  }
+void World::set_joint_state(RobotId robot, const Eigen::Ref<const Eigen::VectorXd>& positions,
+                            const Eigen::Ref<const Eigen::VectorXd>& velocities) {
+  check_robot(robot, "set_joint_state");
+  Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot.index)];
+  check_dof_count("set_joint_state", r.model->name(), r.dofs.size(), positions.size(), "positions");
+  check_dof_count("set_joint_state", r.model->name(), r.dofs.size(), velocities.size(),
+                  "velocities");
   if (!positions.allFinite() || !velocities.allFinite()) {
     throw std::invalid_argument("World::set_joint_state: non-finite value for robot \"" +
                                 r.model->name() + "\"");
   }
-  for (Eigen::Index d = 0; d < n; ++d) {
-    r.body->setJointPos(r.dofs[static_cast<std::size_t>(d)].bullet_link, positions[d]);
-    r.body->setJointVel(r.dofs[static_cast<std::size_t>(d)].bullet_link, velocities[d]);
+  for (std::size_t d = 0; d < r.dofs.size(); ++d) {
+    const auto i = static_cast<Eigen::Index>(d);
+    r.body->setJointPos(r.dofs[d].bullet_link, positions[i]);
+    r.body->setJointVel(r.dofs[d].bullet_link, velocities[i]);
   }
   impl_->update_kinematics(r);
 }
 
-void World::set_control_mode(int robot, int dof, ControlMode mode, double max_force,
+void World::set_control_mode(RobotId robot, int dof, ControlMode mode, double max_force,
                              double position_gain, double velocity_gain) {
-  check_robot(robot);
-  Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot)];
-  if (dof < 0 || dof >= static_cast<int>(r.dofs.size())) {
-    throw std::out_of_range("World::set_control_mode: robot \"" + r.model->name() +
-                            "\" has no dof " + std::to_string(dof));
-  }
+  check_robot(robot, "set_control_mode");
+  Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot.index)];
+  check_dof("set_control_mode", r.model->name(), r.dofs.size(), dof);
   if (!(max_force >= 0) || !(position_gain >= 0) || !(velocity_gain >= 0)) {
-    throw std::invalid_argument("World::set_control_mode: max_force and gains must be >= 0");
+    std::ostringstream message;
+    message << "World::set_control_mode: max_force and gains must be >= 0, got max_force "
+            << max_force << ", position_gain " << position_gain << ", velocity_gain "
+            << velocity_gain;
+    throw std::invalid_argument(message.str());
   }
   Impl::Dof& d = r.dofs[static_cast<std::size_t>(dof)];
   d.mode = mode;
@@ -627,27 +690,25 @@ void World::set_control_mode(int robot, int dof, ControlMode mode, double max_fo
   d.velocity_gain = velocity_gain;
 }
 
-void World::set_control_mode(int robot, ControlMode mode, double max_force, double position_gain,
-                             double velocity_gain) {
+void World::set_control_mode(RobotId robot, ControlMode mode, double max_force,
+                             double position_gain, double velocity_gain) {
   for (int d = 0; d < num_dofs(robot); ++d) {
     set_control_mode(robot, d, mode, max_force, position_gain, velocity_gain);
   }
 }
 
-ControlMode World::control_mode(int robot, int dof) const {
-  check_robot(robot);
-  return impl_->robots[static_cast<std::size_t>(robot)].dofs.at(static_cast<std::size_t>(dof)).mode;
+ControlMode World::control_mode(RobotId robot, int dof) const {
+  check_robot(robot, "control_mode");
+  const Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot.index)];
+  check_dof("control_mode", r.model->name(), r.dofs.size(), dof);
+  return r.dofs[static_cast<std::size_t>(dof)].mode;
 }
 
-void World::set_joint_commands(int robot, const Eigen::VectorXd& commands) {
-  check_robot(robot);
-  Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot)];
-  if (commands.size() != static_cast<Eigen::Index>(r.dofs.size())) {
-    throw std::invalid_argument("World::set_joint_commands: robot \"" + r.model->name() +
-                                "\" has " + std::to_string(r.dofs.size()) +
-                                " degrees of freedom, got " + std::to_string(commands.size()) +
-                                " commands");
-  }
+void World::set_joint_commands(RobotId robot, const Eigen::Ref<const Eigen::VectorXd>& commands) {
+  check_robot(robot, "set_joint_commands");
+  Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot.index)];
+  check_dof_count("set_joint_commands", r.model->name(), r.dofs.size(), commands.size(),
+                  "commands");
   if (!commands.allFinite()) {
     throw std::invalid_argument("World::set_joint_commands: non-finite command for robot \"" +
                                 r.model->name() + "\"");
@@ -656,20 +717,30 @@ void World::set_joint_commands(int robot, const Eigen::VectorXd& commands) {
     r.dofs[d].command = commands[static_cast<Eigen::Index>(d)];
 }
 
-Eigen::Isometry3d World::link_pose(int robot, int link) const {
-  check_robot(robot);
-  const Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot)];
-  if (link < 0 || link >= static_cast<int>(r.model->links().size())) {
-    throw std::out_of_range("World::link_pose: robot \"" + r.model->name() + "\" has no link " +
-                            std::to_string(link));
+namespace {
+
+void check_link(const char* caller, const RobotModel& model, int link) {
+  if (link < 0 || link >= static_cast<int>(model.links().size())) {
+    throw std::out_of_range(std::string("World::") + caller + ": robot \"" + model.name() +
+                            "\" has no link " + std::to_string(link) + " (it has " +
+                            std::to_string(model.links().size()) + ")");
   }
+}
+
+}  // namespace
+
+Eigen::Isometry3d World::link_pose(RobotId robot, int link) const {
+  check_robot(robot, "link_pose");
+  const Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot.index)];
+  check_link("link_pose", *r.model, link);
   return impl_->link_pose(r, link);
 }
 
-Eigen::Vector3d World::link_linear_velocity(int robot, int link) const {
-  check_robot(robot);
-  const Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot)];
-  const Eigen::Isometry3d X_world_link = link_pose(robot, link);
+Eigen::Vector3d World::link_linear_velocity(RobotId robot, int link) const {
+  check_robot(robot, "link_linear_velocity");
+  const Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot.index)];
+  check_link("link_linear_velocity", *r.model, link);
+  const Eigen::Isometry3d X_world_link = impl_->link_pose(r, link);
   if (link == 0) {
     const Eigen::Vector3d com = from_bt(r.body->getBaseWorldTransform().getOrigin());
     return from_bt(r.body->getBaseVel()) +
@@ -678,29 +749,31 @@ Eigen::Vector3d World::link_linear_velocity(int robot, int link) const {
   // v = J u along each world axis, with J the contact Jacobian of the link's origin.
   const btMultiBody& body = *r.body;
   const int n = body.getNumDofs() + 6;
-  std::vector<btScalar> jacobian(static_cast<std::size_t>(n));
-  btAlignedObjectArray<btScalar> scratch_r;
-  btAlignedObjectArray<btVector3> scratch_v;
-  btAlignedObjectArray<btMatrix3x3> scratch_m;
+  btAlignedObjectArray<btScalar>& jacobian = impl_->scratch_jacobian;
+  jacobian.resize(n);
   const btScalar* u = body.getVelocityVector();
   Eigen::Vector3d velocity;
   for (int axis = 0; axis < 3; ++axis) {
     btVector3 direction(0, 0, 0);
     direction[axis] = 1;
     body.fillContactJacobianMultiDof(link - 1, to_bt(X_world_link.translation()), direction,
-                                     jacobian.data(), scratch_r, scratch_v, scratch_m);
+                                     &jacobian[0], impl_->scratch_r, impl_->scratch_v,
+                                     impl_->scratch_m);
     double v = 0;
-    for (int k = 0; k < n; ++k) v += jacobian[static_cast<std::size_t>(k)] * u[k];
+    for (int k = 0; k < n; ++k) v += jacobian[k] * u[k];
     velocity[axis] = v;
   }
   return velocity;
 }
 
-Eigen::Isometry3d World::base_pose(int robot) const { return link_pose(robot, 0); }
+Eigen::Isometry3d World::base_pose(RobotId robot) const {
+  check_robot(robot, "base_pose");
+  return impl_->link_pose(impl_->robots[static_cast<std::size_t>(robot.index)], 0);
+}
 
-void World::set_base_pose(int robot, const Eigen::Isometry3d& X_world_base) {
-  check_robot(robot);
-  Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot)];
+void World::set_base_pose(RobotId robot, const Eigen::Isometry3d& X_world_base) {
+  check_robot(robot, "set_base_pose");
+  Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot.index)];
   if (r.options.fixed_base) {
     throw std::invalid_argument("World::set_base_pose: robot \"" + r.model->name() +
                                 "\" has a fixed base");
@@ -715,34 +788,47 @@ void World::set_base_pose(int robot, const Eigen::Isometry3d& X_world_base) {
   impl_->update_kinematics(r);
 }
 
+int World::segmentation_id(RobotId robot, int link) const {
+  check_robot(robot, "segmentation_id");
+  const Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot.index)];
+  check_link("segmentation_id", *r.model, link);
+  return r.first_segmentation_id + link;
+}
+
 int World::num_bodies() const { return static_cast<int>(impl_->bodies.size()); }
 
-const BodyOptions& World::body_options(int body) const {
-  check_body(body);
-  return impl_->bodies[static_cast<std::size_t>(body)].options;
+const BodyOptions& World::body_options(BodyId body) const {
+  check_body(body, "body_options");
+  return impl_->bodies[static_cast<std::size_t>(body.index)].options;
 }
 
-Eigen::Isometry3d World::body_pose(int body) const {
-  check_body(body);
-  return from_bt(impl_->bodies[static_cast<std::size_t>(body)].rigid->getWorldTransform());
+Eigen::Isometry3d World::body_pose(BodyId body) const {
+  check_body(body, "body_pose");
+  return from_bt(impl_->bodies[static_cast<std::size_t>(body.index)].rigid->getWorldTransform());
 }
 
-Eigen::Vector3d World::body_linear_velocity(int body) const {
-  check_body(body);
-  return from_bt(impl_->bodies[static_cast<std::size_t>(body)].rigid->getLinearVelocity());
+Eigen::Vector3d World::body_linear_velocity(BodyId body) const {
+  check_body(body, "body_linear_velocity");
+  return from_bt(impl_->bodies[static_cast<std::size_t>(body.index)].rigid->getLinearVelocity());
 }
 
-void World::set_body_pose(int body, const Eigen::Isometry3d& X_world_body) {
-  check_body(body);
+void World::set_body_pose(BodyId body, const Eigen::Isometry3d& X_world_body) {
+  check_body(body, "set_body_pose");
+  Impl::Body& b = impl_->bodies[static_cast<std::size_t>(body.index)];
   if (!X_world_body.matrix().allFinite()) {
     throw std::invalid_argument("World::set_body_pose: non-finite pose for body \"" +
-                                body_options(body).name + "\"");
+                                b.options.name + "\"");
   }
-  btRigidBody& rigid = *impl_->bodies[static_cast<std::size_t>(body)].rigid;
+  btRigidBody& rigid = *b.rigid;
   rigid.setWorldTransform(to_bt(X_world_body));
   rigid.setLinearVelocity(btVector3(0, 0, 0));
   rigid.setAngularVelocity(btVector3(0, 0, 0));
   rigid.clearForces();
+}
+
+int World::segmentation_id(BodyId body) const {
+  check_body(body, "segmentation_id");
+  return impl_->bodies[static_cast<std::size_t>(body.index)].segmentation_id;
 }
 
 std::vector<Contact> World::contacts() const {

@@ -72,19 +72,46 @@ struct Contact {
   double normal_force_n = 0.0;
 };
 
+/// Names a robot of one World: what `World::add_robot` returned. Only meaningful for that world.
+struct RobotId {
+  int index = -1;
+};
+inline bool operator==(RobotId a, RobotId b) { return a.index == b.index; }
+inline bool operator!=(RobotId a, RobotId b) { return a.index != b.index; }
+
+/// Names a free body of one World: what `World::add_body` returned. Only meaningful for that world.
+struct BodyId {
+  int index = -1;
+};
+inline bool operator==(BodyId a, BodyId b) { return a.index == b.index; }
+inline bool operator!=(BodyId a, BodyId b) { return a.index != b.index; }
+
 /// Something the renderer draws. Its pose comes from `visual_poses()`, in the same order.
 struct VisualShape {
   Geometry geometry;
   Material material;
   /// "robot/link" or the body name.
   std::string owner;
-  /// 1-based id of the owner (a robot link or a body), for segmentation images.
+  /// The id of the owner (a robot link or a body) in segmentation images: see World.
   int segmentation_id = 0;
 };
 
 /// Owns one btMultiBodyDynamicsWorld and every Bullet object in it; nothing is shared with other
-/// worlds except immutable models and meshes, so worlds in different threads are independent.
-/// Robots and bodies are identified by the index `add_robot` / `add_body` returned.
+/// worlds except immutable models and meshes, so worlds in different threads are independent. A
+/// World is used by one thread at a time (its const queries included: some keep scratch space).
+/// Robots and bodies are named by the RobotId / BodyId that `add_robot` / `add_body` returned;
+/// an id of another world, or a default one, throws std::out_of_range.
+///
+/// Segmentation ids: every owner of visual shapes, i.e. every link of every robot (with or
+/// without visuals) and every body, has its own id, handed out 1, 2, 3, ... in the order things
+/// are added: `add_robot` gives link l of RobotModel::links() the robot's first id + l, `add_body`
+/// gives the body the next id. 0 is never used (renderers keep it for the background). Ids do not
+/// change for the life of the world (reset() keeps them).
+///
+/// Allocation: step(), set_joint_commands() and the per-step queries (the out-parameter
+/// joint_positions / joint_velocities, joint_position, joint_velocity, link_pose,
+/// link_linear_velocity, base_pose, body_pose, body_linear_velocity) allocate no heap memory
+/// once the world has stepped once; error messages are built only when they are thrown.
 ///
 /// Determinism: the same additions and commands give bit-identical states. `reset()` rebuilds
 /// every Bullet object (solver caches and contact manifolds included), so a reset world matches a
@@ -98,13 +125,12 @@ class World {
   World(const World&) = delete;
   World& operator=(const World&) = delete;
 
-  /// Adds a robot built from `model`; returns its index. Throws std::invalid_argument for a null
-  /// model or a floating base whose root link has no positive mass and inertia.
-  int add_robot(std::shared_ptr<const RobotModel> model, RobotOptions options = {});
-  /// Adds a free body; returns its index. A static mesh body collides as its triangles, a moving
-  /// one as its convex hull. Throws std::invalid_argument for a negative mass or a mesh geometry
-  /// without a mesh.
-  int add_body(BodyOptions options);
+  /// Adds a robot built from `model`. Throws std::invalid_argument for a null model or a
+  /// floating base whose root link has no positive mass and inertia.
+  RobotId add_robot(std::shared_ptr<const RobotModel> model, RobotOptions options = {});
+  /// Adds a free body. A static mesh body collides as its triangles, a moving one as its convex
+  /// hull. Throws std::invalid_argument for a negative mass or a mesh geometry without a mesh.
+  BodyId add_body(BodyOptions options);
 
   /// Advances `steps` physics steps of config().timestep_s with the current controls.
   void step(int steps = 1);
@@ -118,46 +144,60 @@ class World {
 
   // --- robots -------------------------------------------------------------------------------
   int num_robots() const;
-  const RobotModel& robot_model(int robot) const;
+  const RobotModel& robot_model(RobotId robot) const;
   /// Degrees of freedom: the robot's movable joints in RobotModel::movable_joints() order.
-  int num_dofs(int robot) const;
-  Eigen::VectorXd joint_positions(int robot) const;
-  Eigen::VectorXd joint_velocities(int robot) const;
+  int num_dofs(RobotId robot) const;
+  /// Writes the joint positions (rad or m) into `out`, which must have num_dofs(robot) entries
+  /// (else std::invalid_argument). Allocates nothing.
+  void joint_positions(RobotId robot, Eigen::Ref<Eigen::VectorXd> out) const;
+  /// Writes the joint velocities (rad/s or m/s) into `out`, as joint_positions.
+  void joint_velocities(RobotId robot, Eigen::Ref<Eigen::VectorXd> out) const;
+  /// The position of degree of freedom `dof`; std::out_of_range for a dof the robot lacks.
+  double joint_position(RobotId robot, int dof) const;
+  /// The velocity of degree of freedom `dof`; std::out_of_range for a dof the robot lacks.
+  double joint_velocity(RobotId robot, int dof) const;
+  /// Convenience forms that return a new vector (they allocate).
+  Eigen::VectorXd joint_positions(RobotId robot) const;
+  Eigen::VectorXd joint_velocities(RobotId robot) const;
   /// Sets positions and velocities of every degree of freedom. Throws std::invalid_argument on a
   /// size mismatch or a non-finite value.
-  void set_joint_state(int robot, const Eigen::VectorXd& positions,
-                       const Eigen::VectorXd& velocities);
+  void set_joint_state(RobotId robot, const Eigen::Ref<const Eigen::VectorXd>& positions,
+                       const Eigen::Ref<const Eigen::VectorXd>& velocities);
 
   /// Switches degree of freedom `dof` to `mode`. For kVelocity and kPosition, `max_force` bounds
   /// the motor (0: the URDF effort limit, or unbounded when it has none); `position_gain` and
   /// `velocity_gain` are Bullet's motor gains (as PyBullet's positionGain / velocityGain).
-  void set_control_mode(int robot, int dof, ControlMode mode, double max_force = 0.0,
+  void set_control_mode(RobotId robot, int dof, ControlMode mode, double max_force = 0.0,
                         double position_gain = 0.3, double velocity_gain = 1.0);
   /// Sets every degree of freedom to `mode` with the same settings.
-  void set_control_mode(int robot, ControlMode mode, double max_force = 0.0,
+  void set_control_mode(RobotId robot, ControlMode mode, double max_force = 0.0,
                         double position_gain = 0.3, double velocity_gain = 1.0);
-  ControlMode control_mode(int robot, int dof) const;
+  ControlMode control_mode(RobotId robot, int dof) const;
   /// The command of each degree of freedom: a torque (kTorque), a velocity (kVelocity) or a
   /// position (kPosition), per its mode. Held until changed. Throws std::invalid_argument on a size
-  /// mismatch or a non-finite value.
-  void set_joint_commands(int robot, const Eigen::VectorXd& commands);
+  /// mismatch or a non-finite value. Allocates nothing (fixed-size vectors bind without a copy).
+  void set_joint_commands(RobotId robot, const Eigen::Ref<const Eigen::VectorXd>& commands);
 
   /// World pose of the URDF frame of link `link` (an index into RobotModel::links()).
-  Eigen::Isometry3d link_pose(int robot, int link) const;
+  Eigen::Isometry3d link_pose(RobotId robot, int link) const;
   /// World linear velocity of the origin of link `link`'s URDF frame, in m/s.
-  Eigen::Vector3d link_linear_velocity(int robot, int link) const;
-  Eigen::Isometry3d base_pose(int robot) const;
+  Eigen::Vector3d link_linear_velocity(RobotId robot, int link) const;
+  Eigen::Isometry3d base_pose(RobotId robot) const;
   /// Moves a floating-base robot's root link frame to `X_world_base` and stops its base. Throws
   /// std::invalid_argument for a fixed-base robot or a non-finite pose.
-  void set_base_pose(int robot, const Eigen::Isometry3d& X_world_base);
+  void set_base_pose(RobotId robot, const Eigen::Isometry3d& X_world_base);
+  /// The segmentation id of link `link` of `robot` (see the class comment).
+  int segmentation_id(RobotId robot, int link) const;
 
   // --- free bodies --------------------------------------------------------------------------
   int num_bodies() const;
-  const BodyOptions& body_options(int body) const;
-  Eigen::Isometry3d body_pose(int body) const;
-  Eigen::Vector3d body_linear_velocity(int body) const;
-  /// Moves a body and stops it.
-  void set_body_pose(int body, const Eigen::Isometry3d& X_world_body);
+  const BodyOptions& body_options(BodyId body) const;
+  Eigen::Isometry3d body_pose(BodyId body) const;
+  Eigen::Vector3d body_linear_velocity(BodyId body) const;
+  /// Moves a body and stops it. Throws std::invalid_argument for a non-finite pose.
+  void set_body_pose(BodyId body, const Eigen::Isometry3d& X_world_body);
+  /// The segmentation id of `body` (see the class comment).
+  int segmentation_id(BodyId body) const;
 
   // --- contacts and visuals -----------------------------------------------------------------
   /// Contact points of the last step (with positive normal force or penetration).
@@ -170,13 +210,15 @@ class World {
  private:
   struct Impl;
 
-  void check_robot(int robot) const;
-  void check_body(int body) const;
+  // Throw std::out_of_range naming `caller` for an id this world did not hand out.
+  void check_robot(RobotId robot, const char* caller) const;
+  void check_body(BodyId body, const char* caller) const;
 
   WorldConfig config_;
   std::unique_ptr<Impl> impl_;
   std::vector<VisualShape> visual_shapes_;
   std::int64_t step_count_ = 0;
+  int next_segmentation_id_ = 1;
 };
 
 }  // namespace pixelgym::engine

@@ -37,7 +37,7 @@ class PixelEnv final : public Env {
   const TaskConfig& config() const { return config_; }
   /// The simulation, for inspection and scripted controllers (do not add bodies to it).
   const engine::World& world() const { return *world_; }
-  /// The render scene of the world, as of the last frame drawn.
+  /// The render scene of world(), as of the last observation or render() (for tests and tools).
   const WorldScene& scene() const { return *scene_; }
   /// Control steps taken in this episode.
   int control_steps() const { return control_steps_; }

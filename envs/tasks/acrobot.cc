@@ -42,8 +42,7 @@ void AcrobotTask::initialize_episode(engine::World& world, Rng& rng) {
 
 void AcrobotTask::before_step(const Value& action, engine::World& world) {
   world.set_joint_commands(
-      robot_,
-      (Eigen::VectorXd(2) << 0.0, kMaxTorqueNm * action.array().element_as_double(0)).finished());
+      robot_, Eigen::Vector2d(0.0, kMaxTorqueNm * action.array().element_as_double(0)));
 }
 
 Eigen::Vector3d AcrobotTask::tip(const engine::World& world) const {

@@ -37,7 +37,7 @@ class AcrobotTask final : public Task {
   static EnvSpec spec_v0();
 
  private:
-  int robot_ = 0;
+  engine::RobotId robot_;
   int lower_arm_ = 0;
 };
 

@@ -83,7 +83,7 @@ void ArmPushTask::initialize_episode(engine::World& world, Rng& rng) {
 
 void ArmPushTask::before_step(const Value& action, engine::World& world) {
   const Array& a = action.array();
-  Eigen::VectorXd velocity(7);
+  Eigen::Matrix<double, 7, 1> velocity;
   for (int d = 0; d < 7; ++d) velocity[d] = kMaxJointSpeed * a.element_as_double(d);
   world.set_joint_commands(arm_, velocity);
 }

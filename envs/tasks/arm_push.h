@@ -49,10 +49,10 @@ class ArmPushTask final : public Task {
   static EnvSpec spec_v0();
 
  private:
-  int arm_ = 0;
-  int cube_ = 0;
+  engine::RobotId arm_;
+  engine::RobotId cube_;
   int end_effector_link_ = 0;
-  int goal_body_ = 0;
+  engine::BodyId goal_body_;
 };
 
 }  // namespace pixelgym

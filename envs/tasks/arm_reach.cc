@@ -75,7 +75,7 @@ void ArmReachTask::initialize_episode(engine::World& world, Rng& rng) {
 
 void ArmReachTask::before_step(const Value& action, engine::World& world) {
   const Array& a = action.array();
-  Eigen::VectorXd command(7);
+  Eigen::Matrix<double, 7, 1> command;
   for (int d = 0; d < 7; ++d) {
     const double u = a.element_as_double(d);
     command[d] = torque_control_ ? u * effort_limits_[d] : u * kMaxJointSpeed;

@@ -42,9 +42,9 @@ class ArmReachTask final : public Task {
 
  private:
   bool torque_control_;
-  int robot_ = 0;
+  engine::RobotId robot_;
   int end_effector_link_ = 0;
-  int target_body_ = 0;
+  engine::BodyId target_body_;
   Eigen::VectorXd effort_limits_;
 };
 

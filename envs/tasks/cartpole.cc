@@ -49,19 +49,19 @@ void CartPoleTask::initialize_episode(engine::World& world, Rng& rng) {
 void CartPoleTask::before_step(const Value& action, engine::World& world) {
   const Array& a = action.array();
   control_ = discrete_ ? static_cast<double>(a.element_as_double(0)) - 1.0 : a.element_as_double(0);
-  world.set_joint_commands(robot_, (Eigen::VectorXd(2) << kMaxForceN * control_, 0.0).finished());
+  world.set_joint_commands(robot_, Eigen::Vector2d(kMaxForceN * control_, 0.0));
 }
 
 double CartPoleTask::cart_position(const engine::World& world) const {
-  return world.joint_positions(robot_)[0];
+  return world.joint_position(robot_, 0);
 }
 
 double CartPoleTask::pole_angle(const engine::World& world) const {
-  return wrap_angle(world.joint_positions(robot_)[1]);
+  return wrap_angle(world.joint_position(robot_, 1));
 }
 
 double CartPoleTask::pole_angular_velocity(const engine::World& world) const {
-  return world.joint_velocities(robot_)[1];
+  return world.joint_velocity(robot_, 1);
 }
 
 void CartPoleTask::observe(const engine::World& world, StateSlots& state) const {

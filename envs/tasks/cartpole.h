@@ -51,7 +51,7 @@ class CartPoleTask final : public Task {
   bool swing_up_;
   bool discrete_;
   SpacePtr action_space_;
-  int robot_ = 0;
+  engine::RobotId robot_;
   double control_ = 0.0;
 };
 

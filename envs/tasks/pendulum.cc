@@ -39,15 +39,15 @@ void PendulumTask::initialize_episode(engine::World& world, Rng& rng) {
 
 void PendulumTask::before_step(const Value& action, engine::World& world) {
   world.set_joint_commands(
-      robot_, Eigen::VectorXd::Constant(1, kMaxTorqueNm * action.array().element_as_double(0)));
+      robot_, Eigen::Matrix<double, 1, 1>(kMaxTorqueNm * action.array().element_as_double(0)));
 }
 
 double PendulumTask::angle_from_upright(const engine::World& world) const {
-  return wrap_angle(world.joint_positions(robot_)[0] - kPi);
+  return wrap_angle(world.joint_position(robot_, 0) - kPi);
 }
 
 double PendulumTask::angular_velocity(const engine::World& world) const {
-  return world.joint_velocities(robot_)[0];
+  return world.joint_velocity(robot_, 0);
 }
 
 void PendulumTask::observe(const engine::World& world, StateSlots& state) const {

@@ -37,7 +37,7 @@ class PendulumTask final : public Task {
   static EnvSpec spec_v0();
 
  private:
-  int robot_ = 0;
+  engine::RobotId robot_;
 };
 
 }  // namespace pixelgym

@@ -51,9 +51,8 @@ void ReacherTask::initialize_episode(engine::World& world, Rng& rng) {
 
 void ReacherTask::before_step(const Value& action, engine::World& world) {
   const Array& a = action.array();
-  world.set_joint_commands(robot_, (Eigen::VectorXd(2) << kMaxTorqueNm * a.element_as_double(0),
-                                    kMaxTorqueNm * a.element_as_double(1))
-                                       .finished());
+  world.set_joint_commands(robot_, Eigen::Vector2d(kMaxTorqueNm * a.element_as_double(0),
+                                                   kMaxTorqueNm * a.element_as_double(1)));
 }
 
 Eigen::Vector3d ReacherTask::fingertip(const engine::World& world) const {

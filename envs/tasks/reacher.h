@@ -40,9 +40,9 @@ class ReacherTask final : public Task {
 
  private:
   double target_radius_m_;
-  int robot_ = 0;
+  engine::RobotId robot_;
   int fingertip_link_ = 0;
-  int target_body_ = 0;
+  engine::BodyId target_body_;
 };
 
 }  // namespace pixelgym

@@ -12,12 +12,17 @@
 namespace pixelgym::cli {
 namespace {
 
+// "1 triangle", "2 triangles".
+std::string count(std::size_t n, const std::string& singular, const std::string& plural) {
+  return std::to_string(n) + " " + (n == 1 ? singular : plural);
+}
+
 std::string describe(const engine::Geometry& geometry) {
   std::ostringstream out;
   out << engine::geometry_type_name(geometry.type);
   if (geometry.type == engine::GeometryType::kMesh) {
     out << " " << std::filesystem::path(geometry.mesh->path).filename().string() << " ("
-        << geometry.mesh->triangle_count() << " triangles)";
+        << count(geometry.mesh->triangle_count(), "triangle", "triangles") << ")";
   }
   return out.str();
 }
@@ -37,7 +42,7 @@ int run_inspect(const std::string& path, bool floating_base) {
   engine::World world;
   engine::RobotOptions options;
   options.fixed_base = !floating_base;
-  const int robot = world.add_robot(model, options);
+  const engine::RobotId robot = world.add_robot(model, options);
   world.step();
 
   std::cout << std::fixed << std::setprecision(3);
@@ -78,16 +83,24 @@ int run_inspect(const std::string& path, bool floating_base) {
       if (geometry.type != engine::GeometryType::kMesh || !files.insert(geometry.mesh->path).second)
         return;
       triangles += geometry.mesh->triangle_count();
-      mesh_lines << "  " << geometry.mesh->path << "   " << geometry.mesh->triangle_count()
-                 << " triangles\n";
+      mesh_lines << "  " << geometry.mesh->path << "   "
+                 << count(geometry.mesh->triangle_count(), "triangle", "triangles") << "\n";
     };
     for (const auto& visual : link.visuals) add(visual.geometry);
     for (const auto& collision : link.collisions) add(collision.geometry);
   }
-  std::cout << "mesh files (" << files.size() << ", " << triangles << " triangles):\n"
+  std::cout << "mesh files (" << files.size() << ", " << count(triangles, "triangle", "triangles")
+            << "):\n"
             << mesh_lines.str();
-  std::cout << "simulates: " << world.num_dofs(robot) << " degrees of freedom, "
-            << (floating_base ? "floating" : "fixed") << " base\n";
+  // A floating base adds its six degrees of freedom (three translations, three rotations) to
+  // those of the joints.
+  const auto joint_dofs = static_cast<std::size_t>(world.num_dofs(robot));
+  const std::size_t base_dofs = floating_base ? 6 : 0;
+  std::cout << "simulates: "
+            << count(joint_dofs + base_dofs, "degree of freedom", "degrees of freedom") << " ("
+            << count(joint_dofs, "joint", "joints");
+  if (floating_base) std::cout << " + 6 of the floating base";
+  std::cout << "), " << (floating_base ? "floating" : "fixed") << " base\n";
   return 0;
 }
 

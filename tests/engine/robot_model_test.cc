@@ -3,7 +3,11 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdint>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 
 namespace pixelgym::engine {
 namespace {
@@ -140,7 +144,8 @@ INSTANTIATE_TEST_SUITE_P(
                       BadCase{"reversed_limits.urdf", "lower limit 1.5 > upper limit -1.5"},
                       BadCase{"planar_joint.urdf", "type planar, which pixelgym does not support"},
                       BadCase{"floating_joint.urdf", "type floating"},
-                      BadCase{"missing_mesh.urdf", "does_not_exist.obj: file not found"},
+                      BadCase{"missing_mesh.urdf",
+                              "cannot resolve \"../meshes/does_not_exist.obj\": no file"},
                       BadCase{"unsupported_mesh_format.urdf", "unsupported format \".xyz\""},
                       BadCase{"mesh_without_triangles.urdf", "has no triangles"},
                       BadCase{"unreadable_mesh.urdf", "garbage.stl: cannot be read"},
@@ -179,9 +184,112 @@ TEST(RobotModelTest, ResolvesRelativeFileAndPackageUris) {
   const std::string link1 = asset_path("arm/meshes/link1.obj");
   EXPECT_EQ(resolve_uri("meshes/link1.obj", urdf), link1);
   EXPECT_EQ(resolve_uri("file://" + link1, urdf), link1);
+  EXPECT_EQ(resolve_uri(link1, urdf), link1);
   EXPECT_EQ(resolve_uri("package://arm/meshes/link1.obj", urdf), link1);
   EXPECT_EQ(resolve_uri("package://anything/meshes/link1.obj", urdf), link1);
   EXPECT_THROW(resolve_uri("package://arm/meshes/nothing.obj", urdf), UrdfError);
+  // A relative path that is nowhere near the URDF is found in pixelgym's assets/.
+  const std::string elsewhere =
+      (std::filesystem::temp_directory_path() / "x" / "robot.urdf").string();
+  EXPECT_EQ(resolve_uri("arm/meshes/link1.obj", elsewhere), link1);
+}
+
+TEST(RobotModelTest, RelativeMeshUrisResolveAgainstTheUrdfsParentFolders) {
+  // tests/data/urdf_good/nested/relative_to_a_parent.urdf names "meshes/two_tone.obj", which is
+  // in tests/data/meshes: two folders up.
+  MeshCache meshes;
+  const auto model = parse_urdf(
+      std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/urdf_good/nested/relative_to_a_parent.urdf",
+      meshes);
+  ASSERT_EQ(model->links()[0].visuals.size(), 1U);
+  EXPECT_EQ(model->links()[0].visuals[0].geometry.mesh->path,
+            std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/meshes/two_tone.obj");
+}
+
+// A folder under the system's temporary folder, removed with everything in it at the end.
+class TemporaryFolder {
+ public:
+  explicit TemporaryFolder(const std::string& name)
+      : path_(std::filesystem::temp_directory_path() /
+              (name + "_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+               "_" + std::to_string(reinterpret_cast<std::uintptr_t>(this)))) {
+    std::filesystem::create_directories(path_);
+  }
+  ~TemporaryFolder() { std::filesystem::remove_all(path_); }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+void write_file(const std::filesystem::path& path, const std::string& text) {
+  std::filesystem::create_directories(path.parent_path());
+  std::ofstream(path) << text;
+}
+
+TEST(RobotModelTest, RelativeMeshUrisResolveThroughPixelgymAssetPath) {
+  TemporaryFolder robot("pixelgym_robot");
+  TemporaryFolder library("pixelgym_asset_library");
+  const std::string urdf = (robot.path() / "robot.urdf").string();
+  write_file(urdf,
+             "<robot name=\"r\"><link name=\"base\"><visual><geometry>"
+             "<mesh filename=\"shared/triangle.obj\"/></geometry></visual></link></robot>");
+  const std::filesystem::path mesh = library.path() / "shared" / "triangle.obj";
+  write_file(mesh, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+
+  const char* previous = std::getenv("PIXELGYM_ASSET_PATH");
+  const std::string saved = previous == nullptr ? "" : previous;
+  // Not found without the library on the path; the message says what and where.
+  ::unsetenv("PIXELGYM_ASSET_PATH");
+  try {
+    MeshCache meshes;
+    parse_urdf(urdf, meshes);
+    ADD_FAILURE() << "shared/triangle.obj was found without PIXELGYM_ASSET_PATH";
+  } catch (const UrdfError& error) {
+    EXPECT_THAT(error.what(), HasSubstr("cannot resolve \"shared/triangle.obj\": no file"));
+    EXPECT_THAT(error.what(), HasSubstr(robot.path().string() + " (the URDF's folder)"));
+    EXPECT_THAT(error.what(), HasSubstr("PIXELGYM_ASSET_PATH"));
+  }
+  // Found in the second folder of PIXELGYM_ASSET_PATH (the first does not have it).
+  ::setenv("PIXELGYM_ASSET_PATH", ("/nonexistent/folder:" + library.path().string()).c_str(), 1);
+  MeshCache meshes;
+  const auto model = parse_urdf(urdf, meshes);
+  EXPECT_EQ(model->links()[0].visuals[0].geometry.mesh->path, mesh.lexically_normal().string());
+  // A file beside the URDF comes first.
+  write_file(robot.path() / "shared" / "triangle.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  EXPECT_EQ(resolve_uri("shared/triangle.obj", urdf),
+            (robot.path() / "shared" / "triangle.obj").lexically_normal().string());
+  if (previous == nullptr) {
+    ::unsetenv("PIXELGYM_ASSET_PATH");
+  } else {
+    ::setenv("PIXELGYM_ASSET_PATH", saved.c_str(), 1);
+  }
+}
+
+TEST(RobotModelTest, UrdfColoursAreReadBesideTheMeshsOwnColours) {
+  // tests/data/urdf_good/coloured_mesh.urdf: one two-colour mesh, with an inline colour, a named
+  // colour defined at the robot level, and no colour.
+  MeshCache meshes;
+  const auto model = parse_urdf(
+      std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/urdf_good/coloured_mesh.urdf", meshes);
+  const std::vector<VisualElement>& visuals = model->links()[0].visuals;
+  ASSERT_EQ(visuals.size(), 3U);
+  EXPECT_TRUE(visuals[0].material.has_rgba);
+  EXPECT_TRUE(visuals[0].material.rgba.isApprox(Eigen::Vector4d(0.1, 0.7, 0.2, 1.0), 1e-6));
+  EXPECT_TRUE(visuals[1].material.has_rgba);
+  EXPECT_TRUE(visuals[1].material.rgba.isApprox(Eigen::Vector4d(0.8, 0.1, 0.1, 1.0), 1e-6));
+  EXPECT_FALSE(visuals[2].material.has_rgba);
+  // The mesh keeps its own colours either way (whether they are drawn is the scene's choice).
+  const Mesh& mesh = *visuals[2].geometry.mesh;
+  EXPECT_EQ(visuals[0].geometry.mesh.get(), &mesh) << "one file, read once";
+  ASSERT_EQ(mesh.parts.size(), 2U);
+  EXPECT_TRUE(mesh.parts[0].has_color);
+  EXPECT_TRUE(mesh.parts[1].has_color);
+  std::vector<Eigen::Vector4f> colours = {mesh.parts[0].rgba, mesh.parts[1].rgba};
+  std::sort(colours.begin(), colours.end(),
+            [](const Eigen::Vector4f& a, const Eigen::Vector4f& b) { return a.z() > b.z(); });
+  EXPECT_TRUE(colours[0].head<3>().isApprox(Eigen::Vector3f(0.1F, 0.2F, 0.9F), 1e-3F));  // top
+  EXPECT_TRUE(colours[1].head<3>().isApprox(Eigen::Vector3f(0.9F, 0.8F, 0.1F), 1e-3F));  // sides
 }
 
 TEST(ModelCacheTest, ParsesOnceAndReadsEachMeshOnce) {

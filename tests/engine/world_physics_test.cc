@@ -33,7 +33,7 @@ TEST(WorldPhysicsTest, PendulumSmallAnglePeriodWithinOnePercent) {
   const double expected = 2 * M_PI * std::sqrt(p.pivot_inertia / (p.mass * kG * p.com_distance));
 
   World world;
-  const int robot = world.add_robot(model);
+  const RobotId robot = world.add_robot(model);
   world.set_joint_state(robot, Eigen::VectorXd::Constant(1, 0.05), Eigen::VectorXd::Zero(1));
   // Times of upward zero crossings, linearly interpolated between steps.
   std::vector<double> crossings;
@@ -61,7 +61,7 @@ TEST(WorldPhysicsTest, UndampedPendulumEnergyDriftBelowOnePercentOverTenSeconds)
   const auto model = cache.load_urdf(asset_path("pendulum/pendulum.urdf"));
   const PendulumProperties p = pendulum_properties(*model);
   World world;
-  const int robot = world.add_robot(model);
+  const RobotId robot = world.add_robot(model);
   world.set_joint_state(robot, Eigen::VectorXd::Constant(1, 1.0), Eigen::VectorXd::Zero(1));
   // Energy above the lowest point of the centre of mass.
   const auto energy = [&] {
@@ -92,7 +92,7 @@ TEST(WorldPhysicsTest, FreeFallMatchesHalfGTSquared) {
     ball.geometry.type = GeometryType::kSphere;
     ball.geometry.radius_m = 0.1;
     ball.X_world_body.translation() = Eigen::Vector3d(0, 0, 100);
-    const int body = world.add_body(ball);
+    const BodyId body = world.add_body(ball);
     const int steps = static_cast<int>(std::lround(1.0 / dt));
     world.step(steps);
     const double fallen = 100.0 - world.body_pose(body).translation().z();
@@ -109,7 +109,7 @@ TEST(WorldPhysicsTest, FreeFallMatchesHalfGTSquared) {
 TEST(WorldPhysicsTest, PositionControlledArmJointsSettleWithinOneHundredthRadian) {
   ModelCache cache;
   World world;
-  const int arm = world.add_robot(cache.load_urdf(asset_path("arm/arm.urdf")));
+  const RobotId arm = world.add_robot(cache.load_urdf(asset_path("arm/arm.urdf")));
   ASSERT_EQ(world.num_dofs(arm), 7);
   world.set_control_mode(arm, ControlMode::kPosition);
   Eigen::VectorXd target(7);
@@ -128,7 +128,7 @@ TEST(WorldPhysicsTest, CubeRestsOnTheGroundWithItsWeightInContacts) {
   RobotOptions options;
   options.fixed_base = false;
   options.X_world_base.translation() = Eigen::Vector3d(0, 0, 0.2);
-  const int cube = world.add_robot(cache.load_urdf(asset_path("objects/cube.urdf")), options);
+  const RobotId cube = world.add_robot(cache.load_urdf(asset_path("objects/cube.urdf")), options);
   world.step(480);
   EXPECT_NEAR(world.base_pose(cube).translation().z(), 0.025, 2e-3);
   double normal_force = 0.0;
@@ -147,7 +147,7 @@ TEST(WorldPhysicsTest, TorqueOnAFreeJointGivesTheExpectedAcceleration) {
   config.gravity_m_s2.setZero();
   World world(config);
   const auto model = cache.load_urdf(asset_path("pendulum/pendulum.urdf"));
-  const int robot = world.add_robot(model);
+  const RobotId robot = world.add_robot(model);
   const double torque = 1.5;  // within the 2 N m effort limit
   world.set_joint_commands(robot, Eigen::VectorXd::Constant(1, torque));
   world.step(240);
@@ -159,10 +159,29 @@ std::shared_ptr<const RobotModel> good_urdf(ModelCache& cache, const std::string
   return cache.load_urdf(std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/urdf_good/" + name);
 }
 
+TEST(WorldPhysicsTest, ForceOnAPrismaticJointGivesTheExpectedMotion) {
+  // tests/data/urdf_good/slider.urdf: 2 kg on a horizontal rail, so F = 4 N gives a = 2 m/s^2:
+  // after 0.25 s, v = 0.5 m/s and x = 0.0625 m (well inside the [-0.5, 0.3] m limits).
+  ModelCache cache;
+  for (const double force : {4.0, -4.0}) {
+    World world;
+    const RobotId robot = world.add_robot(good_urdf(cache, "slider.urdf"));
+    world.set_joint_commands(robot, Eigen::Matrix<double, 1, 1>(force));
+    world.step(60);
+    const double a = force / 2.0;
+    EXPECT_NEAR(world.joint_velocity(robot, 0), a * 0.25, 1e-3 * std::abs(a * 0.25));
+    // Bullet integrates semi-implicitly (velocity first), so after n steps of dt the position is
+    // a dt^2 n (n + 1) / 2 = a t (t + dt) / 2: half a step ahead of a t^2 / 2.
+    const double dt = world.config().timestep_s;
+    const double x = 0.5 * a * 0.25 * (0.25 + dt);
+    EXPECT_NEAR(world.joint_position(robot, 0), x, 1e-3 * std::abs(x));
+  }
+}
+
 TEST(WorldPhysicsTest, JointDampingDecaysVelocityExponentially) {
   ModelCache cache;
   World world;
-  const int wheel = world.add_robot(good_urdf(cache, "damped_wheel.urdf"));
+  const RobotId wheel = world.add_robot(good_urdf(cache, "damped_wheel.urdf"));
   world.set_joint_state(wheel, Eigen::VectorXd::Zero(1), Eigen::VectorXd::Constant(1, 2.0));
   world.step(120);  // 0.5 s = one time constant I / c
   EXPECT_NEAR(world.joint_velocities(wheel)[0] / (2.0 * std::exp(-1.0)), 1.0, 0.01);
@@ -171,7 +190,7 @@ TEST(WorldPhysicsTest, JointDampingDecaysVelocityExponentially) {
 TEST(WorldPhysicsTest, JointFrictionStopsTheJointAndHoldsIt) {
   ModelCache cache;
   World world;
-  const int wheel = world.add_robot(good_urdf(cache, "rubbing_wheel.urdf"));
+  const RobotId wheel = world.add_robot(good_urdf(cache, "rubbing_wheel.urdf"));
   world.set_joint_state(wheel, Eigen::VectorXd::Zero(1), Eigen::VectorXd::Constant(1, 1.0));
   world.step(24);  // 0.1 s: friction 0.05 N m on I = 0.01 decelerates at 5 rad/s^2
   EXPECT_NEAR(world.joint_velocities(wheel)[0], 0.5, 0.02);

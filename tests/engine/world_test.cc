@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <map>
 #include <thread>
 
 namespace pixelgym::engine {
@@ -50,7 +51,7 @@ struct Scene {
   // Every double of the state, for bitwise comparison.
   std::vector<double> state() const {
     std::vector<double> values;
-    for (int robot : {arm, cube}) {
+    for (RobotId robot : {arm, cube}) {
       const Eigen::VectorXd q = world.joint_positions(robot);
       const Eigen::VectorXd qd = world.joint_velocities(robot);
       values.insert(values.end(), q.data(), q.data() + q.size());
@@ -65,8 +66,8 @@ struct Scene {
   }
 
   World world;
-  int arm = 0;
-  int cube = 0;
+  RobotId arm;
+  RobotId cube;
 };
 
 bool bit_identical(const std::vector<double>& a, const std::vector<double>& b) {
@@ -143,7 +144,7 @@ TEST(WorldTest, SixteenWorldsShareOneParsedModelAndReadMeshesOnce) {
 TEST(WorldTest, LinkPosesFollowTheJoints) {
   ModelCache cache;
   World world;
-  const int cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
+  const RobotId cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
   const int pole = world.robot_model(cartpole).link_index("pole");
   Eigen::VectorXd q(2);
   q << 0.5, M_PI / 2;  // cart 0.5 m along x, pole tipped 90 degrees about y (towards +x)
@@ -158,7 +159,7 @@ TEST(WorldTest, LinkPosesFollowTheJoints) {
 TEST(WorldTest, LinkVelocityMatchesJointRates) {
   ModelCache cache;
   World world;
-  const int cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
+  const RobotId cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
   Eigen::VectorXd qd(2);
   qd << 0.3, 2.0;
   world.set_joint_state(cartpole, Eigen::VectorXd::Zero(2), qd);
@@ -168,12 +169,42 @@ TEST(WorldTest, LinkVelocityMatchesJointRates) {
   EXPECT_TRUE(v.isApprox(Eigen::Vector3d(0.3, 0, 0), 1e-9)) << v.transpose();
 }
 
+TEST(WorldTest, LinkVelocityAwayFromTheJointsMatchesTheAnalyticValue) {
+  // The reacher's fingertip frame is 0.12 m beyond the wrist, which is 0.12 m beyond the
+  // shoulder; both hinges turn about z. Its velocity depends on both rates:
+  //   v = 0.12 q1' (-sin q1, cos q1) + 0.12 (q1' + q2') (-sin(q1 + q2), cos(q1 + q2)).
+  ModelCache cache;
+  World world;
+  const auto model = cache.load_urdf(asset_path("reacher/reacher.urdf"));
+  const RobotId reacher = world.add_robot(model);
+  const Eigen::Vector2d q(0.4, -0.7);
+  const Eigen::Vector2d qd(1.5, -2.0);
+  world.set_joint_state(reacher, q, qd);
+  const double a = q[0];
+  const double b = q[0] + q[1];
+  const Eigen::Vector3d elbow = 0.12 * qd[0] * Eigen::Vector3d(-std::sin(a), std::cos(a), 0);
+  const Eigen::Vector3d tip =
+      elbow + 0.12 * (qd[0] + qd[1]) * Eigen::Vector3d(-std::sin(b), std::cos(b), 0);
+  const Eigen::Vector3d v_tip = world.link_linear_velocity(reacher, model->link_index("fingertip"));
+  EXPECT_TRUE(v_tip.isApprox(tip, 1e-9)) << v_tip.transpose() << " vs " << tip.transpose();
+  const Eigen::Vector3d v_hand = world.link_linear_velocity(reacher, model->link_index("hand"));
+  EXPECT_TRUE(v_hand.isApprox(elbow, 1e-9)) << v_hand.transpose() << " vs " << elbow.transpose();
+  // And after a step, against a finite difference of the fingertip's position.
+  const Eigen::Vector3d before =
+      world.link_pose(reacher, model->link_index("fingertip")).translation();
+  world.step();
+  const Eigen::Vector3d after =
+      world.link_pose(reacher, model->link_index("fingertip")).translation();
+  const Eigen::Vector3d v_now = world.link_linear_velocity(reacher, model->link_index("fingertip"));
+  EXPECT_LT((v_now - (after - before) / world.config().timestep_s).norm(), 0.02 * v_now.norm());
+}
+
 TEST(WorldTest, VelocityControlReachesItsTarget) {
   ModelCache cache;
   WorldConfig config;
   config.gravity_m_s2.setZero();
   World world(config);
-  const int arm = world.add_robot(cache.load_urdf(asset_path("arm/arm.urdf")));
+  const RobotId arm = world.add_robot(cache.load_urdf(asset_path("arm/arm.urdf")));
   world.set_control_mode(arm, ControlMode::kVelocity);
   Eigen::VectorXd target = Eigen::VectorXd::Zero(7);
   target[0] = 0.5;
@@ -183,13 +214,50 @@ TEST(WorldTest, VelocityControlReachesItsTarget) {
 }
 
 TEST(WorldTest, JointLimitsHold) {
+  // The cart's rail is a prismatic joint limited to [-2, 2] m: pushed hard either way, the cart
+  // comes to rest at that end (not before it, not beyond it).
   ModelCache cache;
-  WorldConfig config;
-  World world(config);
-  const int cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
-  world.set_joint_commands(cartpole, (Eigen::VectorXd(2) << 10.0, 0.0).finished());
-  world.step(2400);
-  EXPECT_LT(world.joint_positions(cartpole)[0], 2.0 + 0.02);
+  for (const double force : {10.0, -10.0}) {
+    World world;
+    const RobotId cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
+    world.set_joint_commands(cartpole, Eigen::Vector2d(force, 0.0));
+    world.step(2400);
+    EXPECT_NEAR(world.joint_position(cartpole, 0), force > 0 ? 2.0 : -2.0, 0.02)
+        << "pushed with " << force << " N";
+  }
+}
+
+std::shared_ptr<const RobotModel> slider(ModelCache& cache) {
+  return cache.load_urdf(std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/urdf_good/slider.urdf");
+}
+
+TEST(WorldTest, PrismaticLimitsHoldOnBothSides) {
+  // tests/data/urdf_good/slider.urdf: a 2 kg carriage on a rail limited to [-0.5, 0.3] m.
+  ModelCache cache;
+  for (const double force : {50.0, -50.0}) {
+    World world;
+    const RobotId robot = world.add_robot(slider(cache));
+    world.set_joint_commands(robot, Eigen::Matrix<double, 1, 1>(force));
+    world.step(480);
+    EXPECT_NEAR(world.joint_position(robot, 0), force > 0 ? 0.3 : -0.5, 0.01)
+        << "pushed with " << force << " N";
+    EXPECT_NEAR(world.joint_velocity(robot, 0), 0.0, 0.01) << "not resting on the limit";
+  }
+}
+
+TEST(WorldTest, PrismaticJointsFollowVelocityAndPositionCommands) {
+  ModelCache cache;
+  World world;
+  const RobotId robot = world.add_robot(slider(cache));
+  world.set_control_mode(robot, ControlMode::kVelocity);
+  world.set_joint_commands(robot, Eigen::Matrix<double, 1, 1>(-0.2));
+  world.step(240);
+  EXPECT_NEAR(world.joint_velocity(robot, 0), -0.2, 1e-3);
+  EXPECT_NEAR(world.joint_position(robot, 0), -0.2, 0.01);  // about 1 s at -0.2 m/s
+  world.set_control_mode(robot, ControlMode::kPosition);
+  world.set_joint_commands(robot, Eigen::Matrix<double, 1, 1>(0.15));
+  world.step(720);
+  EXPECT_NEAR(world.joint_position(robot, 0), 0.15, 1e-3);
 }
 
 TEST(WorldTest, LimitsAndMotorsWorkOnRobotsWithoutCollisionShapes) {
@@ -197,7 +265,7 @@ TEST(WorldTest, LimitsAndMotorsWorkOnRobotsWithoutCollisionShapes) {
   // island, which such a robot would not have without the world's help.
   ModelCache cache;
   World world;
-  const int reacher = world.add_robot(cache.load_urdf(asset_path("reacher/reacher.urdf")));
+  const RobotId reacher = world.add_robot(cache.load_urdf(asset_path("reacher/reacher.urdf")));
   // Push the wrist into its 2.8 rad limit. Without an island for its links the limit is ignored
   // and the wrist spins on (18.9 rad after 2 s). Bullet's limits are soft (error reduction per
   // step), so a light link under full torque rests slightly inside the limit.
@@ -218,7 +286,7 @@ TEST(WorldTest, FloatingBaseCanBeMovedAndSettles) {
   World world;
   RobotOptions options;
   options.fixed_base = false;
-  const int cube = world.add_robot(cache.load_urdf(asset_path("objects/cube.urdf")), options);
+  const RobotId cube = world.add_robot(cache.load_urdf(asset_path("objects/cube.urdf")), options);
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.translation() = Eigen::Vector3d(0.3, -0.2, 0.5);
   world.set_base_pose(cube, pose);
@@ -226,7 +294,7 @@ TEST(WorldTest, FloatingBaseCanBeMovedAndSettles) {
   world.step(480);
   EXPECT_TRUE(
       world.base_pose(cube).translation().isApprox(Eigen::Vector3d(0.3, -0.2, 0.025), 2e-3));
-  const int fixed = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
+  const RobotId fixed = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
   EXPECT_THROW(world.set_base_pose(fixed, pose), std::invalid_argument);
 }
 
@@ -256,6 +324,44 @@ TEST(WorldTest, VisualShapesListEveryVisualWithItsPose) {
   EXPECT_TRUE(later.back().isApprox(poses.back())) << "a static marker does not move";
 }
 
+TEST(WorldTest, SegmentationIdsAreOnePerOwnerInTheOrderAdded) {
+  ModelCache cache;
+  World world;
+  const auto reacher_model = cache.load_urdf(asset_path("reacher/reacher.urdf"));
+  const RobotId reacher = world.add_robot(reacher_model);
+  BodyOptions target;
+  target.name = "target";
+  target.geometry.type = GeometryType::kSphere;
+  target.geometry.radius_m = 0.05;
+  target.mass_kg = 0;
+  target.collides = false;
+  const BodyId target_id = world.add_body(target);
+  const RobotId cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
+  const int reacher_links = static_cast<int>(reacher_model->links().size());
+  // Link l of the first robot has id 1 + l, the body the next id, the next robot's links after.
+  for (int l = 0; l < reacher_links; ++l) EXPECT_EQ(world.segmentation_id(reacher, l), 1 + l);
+  EXPECT_EQ(world.segmentation_id(target_id), 1 + reacher_links);
+  EXPECT_EQ(world.segmentation_id(cartpole, 0), 2 + reacher_links);
+  // Every visual shape carries its owner's id; shapes of different owners never share one.
+  std::map<std::string, int> id_of_owner;
+  std::map<int, std::string> owner_of_id;
+  for (const VisualShape& shape : world.visual_shapes()) {
+    id_of_owner.emplace(shape.owner, shape.segmentation_id);
+    EXPECT_EQ(id_of_owner.at(shape.owner), shape.segmentation_id) << shape.owner;
+    owner_of_id.emplace(shape.segmentation_id, shape.owner);
+    EXPECT_EQ(owner_of_id.at(shape.segmentation_id), shape.owner) << shape.segmentation_id;
+  }
+  EXPECT_EQ(id_of_owner.at("reacher/fingertip"),
+            world.segmentation_id(reacher, reacher_model->link_index("fingertip")));
+  EXPECT_EQ(id_of_owner.at("target"), world.segmentation_id(target_id));
+  // A reset keeps them.
+  const std::vector<VisualShape> before = world.visual_shapes();
+  world.step(10);
+  world.reset();
+  for (std::size_t i = 0; i < before.size(); ++i)
+    EXPECT_EQ(world.visual_shapes()[i].segmentation_id, before[i].segmentation_id);
+}
+
 TEST(WorldTest, MarkerHasNoCollision) {
   ModelCache cache;
   World world;
@@ -271,7 +377,7 @@ TEST(WorldTest, MarkerHasNoCollision) {
   ball.geometry.type = GeometryType::kSphere;
   ball.geometry.radius_m = 0.1;
   ball.X_world_body.translation() = Eigen::Vector3d(0, 0, 0.3);  // inside the marker
-  const int b = world.add_body(ball);
+  const BodyId b = world.add_body(ball);
   world.step(240);
   EXPECT_NEAR(world.body_pose(b).translation().z(), 0.1, 2e-3) << "fell through the marker";
   for (const Contact& contact : world.contacts()) {
@@ -296,7 +402,7 @@ TEST(WorldTest, StaticMeshBodiesCollideAsTriangles) {
   ball.geometry.type = GeometryType::kSphere;
   ball.geometry.radius_m = 0.03;
   ball.X_world_body.translation() = Eigen::Vector3d(0.02, 0.01, 0.5);
-  const int b = world.add_body(ball);
+  const BodyId b = world.add_body(ball);
   world.step(480);
   EXPECT_NEAR(world.body_pose(b).translation().z(), 0.16 + 0.03, 3e-3);
   BodyOptions scaled = pedestal;
@@ -304,7 +410,7 @@ TEST(WorldTest, StaticMeshBodiesCollideAsTriangles) {
   scaled.mass_kg = 1.0;  // a moving mesh: its convex hull, scaled
   scaled.geometry.mesh_scale = Eigen::Vector3d(0.5, 0.5, 0.5);
   scaled.X_world_body.translation() = Eigen::Vector3d(2, 0, 0.3);
-  const int s = world.add_body(scaled);
+  const BodyId s = world.add_body(scaled);
   world.step(480);
   EXPECT_NEAR(world.body_pose(s).translation().z(), 0.0, 3e-3)
       << "the 0.08 m hull rests on the ground";
@@ -313,7 +419,7 @@ TEST(WorldTest, StaticMeshBodiesCollideAsTriangles) {
 TEST(WorldTest, NonFiniteStateRaisesNamingTheRobot) {
   ModelCache cache;
   World world;
-  const int cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
+  const RobotId cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
   world.set_joint_commands(cartpole, (Eigen::VectorXd(2) << 0.0, 1e308).finished());
   try {
     world.step(10);
@@ -330,14 +436,36 @@ TEST(WorldTest, BadArgumentsAreRejected) {
   ModelCache cache;
   World world;
   EXPECT_THROW(world.add_robot(nullptr), std::invalid_argument);
-  const int cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
+  const RobotId cartpole = world.add_robot(cache.load_urdf(asset_path("cartpole/cartpole.urdf")));
   EXPECT_THROW(world.set_joint_commands(cartpole, Eigen::VectorXd::Zero(3)), std::invalid_argument);
   EXPECT_THROW(world.set_joint_commands(cartpole, Eigen::VectorXd::Constant(2, NAN)),
                std::invalid_argument);
   EXPECT_THROW(world.set_joint_state(cartpole, Eigen::VectorXd::Zero(1), Eigen::VectorXd::Zero(2)),
                std::invalid_argument);
   EXPECT_THROW(world.link_pose(cartpole, 9), std::out_of_range);
-  EXPECT_THROW(world.joint_positions(5), std::out_of_range);
+  EXPECT_THROW(world.joint_positions(RobotId{5}), std::out_of_range);
+  EXPECT_THROW(world.joint_positions(RobotId{}), std::out_of_range);
+  EXPECT_THROW(world.body_pose(BodyId{0}), std::out_of_range);
+  EXPECT_THROW(world.joint_position(cartpole, 2), std::out_of_range);
+  EXPECT_THROW(world.joint_velocity(cartpole, -1), std::out_of_range);
+  EXPECT_THROW(world.control_mode(cartpole, 2), std::out_of_range);
+  EXPECT_THROW(world.segmentation_id(cartpole, 3), std::out_of_range);
+  Eigen::VectorXd three(3);
+  EXPECT_THROW(world.joint_positions(cartpole, three), std::invalid_argument);
+  EXPECT_THROW(world.joint_velocities(cartpole, three), std::invalid_argument);
+  try {
+    world.set_joint_commands(cartpole, Eigen::Vector3d::Zero());
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_THAT(error.what(), HasSubstr("World::set_joint_commands: robot \"cartpole\" has 2 "
+                                        "degrees of freedom, got 3 commands"));
+  }
+  try {
+    world.link_pose(RobotId{7}, 0);
+    FAIL() << "no error";
+  } catch (const std::out_of_range& error) {
+    EXPECT_THAT(error.what(), HasSubstr("World::link_pose: no robot 7 (there are 1)"));
+  }
   RobotOptions floating;
   floating.fixed_base = false;
   EXPECT_THROW(world.add_robot(cache.load_urdf(asset_path("objects/table.urdf")), floating),

@@ -32,7 +32,7 @@ TEST(WorldSceneTest, OneInstancePerVisualShapeWithSegmentationIds) {
 TEST(WorldSceneTest, UpdateFollowsTheWorld) {
   FixtureScene f = testing::cartpole_scene(84, 84);
   const Eigen::Isometry3f before = f.view->scene().instances.back().X_world_instance;  // the pole
-  f.world->set_joint_state(0, (Eigen::VectorXd(2) << -0.5, 0.0).finished(),
+  f.world->set_joint_state(engine::RobotId{0}, (Eigen::VectorXd(2) << -0.5, 0.0).finished(),
                            Eigen::VectorXd::Zero(2));
   f.view->update(*f.world);
   const Eigen::Isometry3f after = f.view->scene().instances.back().X_world_instance;
@@ -46,6 +46,47 @@ TEST(WorldSceneTest, UrdfColoursOverrideMeshColoursOnlyWhenGiven) {
   const render::Instance& link1 = f.view->scene().instances[1];
   ASSERT_FALSE(link1.mesh->parts.empty());
   EXPECT_TRUE(link1.mesh->parts[0].has_color);
+}
+
+TEST(WorldSceneTest, UrdfColoursOverrideTheMeshsOwnColours) {
+  // tests/data/urdf_good/coloured_mesh.urdf: the same blue-topped, yellow-sided mesh three times
+  // along x, with an inline green, a named red and no URDF colour. Seen from above, the tops are
+  // green, red and (the mesh's own) blue.
+  FixtureScene f;
+  f.world = std::make_unique<engine::World>();
+  f.world->add_robot(engine::default_model_cache().load_urdf(
+      std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/urdf_good/coloured_mesh.urdf"));
+  f.view = std::make_unique<WorldScene>(*f.world);
+  const std::vector<render::Instance>& instances = f.view->scene().instances;
+  ASSERT_EQ(instances.size(), 3U);
+  for (int i = 0; i < 2; ++i) {
+    for (const render::MeshData::Part& part : instances[i].mesh->parts)
+      EXPECT_FALSE(part.has_color) << "instance " << i << ": the URDF colour must win";
+  }
+  EXPECT_TRUE(instances[0].material.base_color.isApprox(Eigen::Vector4f(0.1F, 0.7F, 0.2F, 1.0F)));
+  EXPECT_TRUE(instances[1].material.base_color.isApprox(Eigen::Vector4f(0.8F, 0.1F, 0.1F, 1.0F)));
+  for (const render::MeshData::Part& part : instances[2].mesh->parts) EXPECT_TRUE(part.has_color);
+
+  f.camera = render::Camera::look_at({0.0F, 0.0F, 1.5F}, {0.0F, 0.0F, 0.0F},
+                                     Eigen::Vector3f::UnitY());
+  f.camera.width = 84;
+  f.camera.height = 84;
+  render::Renderer renderer;
+  const Array frame = draw(f, renderer);
+  const Eigen::Matrix4f view_projection = f.camera.projection_matrix() * f.camera.view_matrix();
+  const auto top_colour = [&](float x) {
+    const Eigen::Vector4f clip = view_projection * Eigen::Vector4f(x, 0.0F, 0.2F, 1.0F);
+    const int column = static_cast<int>((clip.x() / clip.w() * 0.5F + 0.5F) * 84.0F);
+    const int row = static_cast<int>((clip.y() / clip.w() * 0.5F + 0.5F) * 84.0F);
+    const std::uint8_t* pixel = frame.data<std::uint8_t>() + (row * 84 + column) * 3;
+    return Eigen::Vector3i(pixel[0], pixel[1], pixel[2]);
+  };
+  const Eigen::Vector3i green = top_colour(-0.3F);
+  const Eigen::Vector3i red = top_colour(0.0F);
+  const Eigen::Vector3i blue = top_colour(0.3F);
+  EXPECT_GT(green.y(), std::max(green.x(), green.z()) + 40) << green.transpose();
+  EXPECT_GT(red.x(), std::max(red.y(), red.z()) + 40) << red.transpose();
+  EXPECT_GT(blue.z(), std::max(blue.x(), blue.y()) + 40) << blue.transpose();
 }
 
 TEST(WorldSceneTest, FrameBoxShowsTheWholeBox) {

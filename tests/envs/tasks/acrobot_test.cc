@@ -30,7 +30,7 @@ engine::World& world_of(Env& env) {
 }
 
 void set_state(Env& env, const Eigen::Vector4d& s) {
-  world_of(env).set_joint_state(0, (Eigen::VectorXd(2) << s[0], s[1]).finished(),
+  world_of(env).set_joint_state(engine::RobotId{0}, (Eigen::VectorXd(2) << s[0], s[1]).finished(),
                                 (Eigen::VectorXd(2) << s[2], s[3]).finished());
 }
 

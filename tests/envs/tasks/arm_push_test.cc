@@ -108,7 +108,7 @@ class ScriptedPush {
 
  private:
   std::unique_ptr<engine::World> world_;
-  int robot_ = 0;
+  engine::RobotId robot_;
   int end_effector_ = 0;
   int hand_ = 0;
   int phase_ = 0;

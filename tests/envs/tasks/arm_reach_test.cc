@@ -58,7 +58,7 @@ class JacobianController {
   }
 
   std::unique_ptr<engine::World> world_;
-  int robot_ = 0;
+  engine::RobotId robot_;
   int end_effector_ = 0;
 };
 
