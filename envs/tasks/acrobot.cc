@@ -50,10 +50,9 @@ Eigen::Vector3d AcrobotTask::tip(const engine::World& world) const {
 }
 
 void AcrobotTask::observe(const engine::World& world, StateSlots& state) const {
-  const Eigen::VectorXd q = world.joint_positions(robot_);
-  const Eigen::VectorXd qd = world.joint_velocities(robot_);
-  state.set("joint_pos", {wrap_angle(q[0]), wrap_angle(q[1])});
-  state.set("joint_vel", qd);
+  state.set("joint_pos", {wrap_angle(world.joint_position(robot_, 0)),
+                          wrap_angle(world.joint_position(robot_, 1))});
+  state.set("joint_vel", {world.joint_velocity(robot_, 0), world.joint_velocity(robot_, 1)});
 }
 
 double AcrobotTask::reward(const engine::World& world) const {

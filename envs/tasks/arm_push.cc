@@ -103,8 +103,11 @@ Eigen::Vector3d ArmPushTask::goal(const engine::World& world) const {
 void ArmPushTask::observe(const engine::World& world, StateSlots& state) const {
   const Eigen::Vector3d hand = end_effector(world);
   const Eigen::Vector3d c = cube(world);
-  state.set("joint_pos", world.joint_positions(arm_));
-  state.set("joint_vel", world.joint_velocities(arm_));
+  Eigen::Matrix<double, 7, 1> joints;
+  world.joint_positions(arm_, joints);
+  state.set("joint_pos", joints);
+  world.joint_velocities(arm_, joints);
+  state.set("joint_vel", joints);
   state.set("end_effector_pos", hand);
   state.set("to_cube", c - hand);
   state.set("cube_to_goal", (goal(world) - c).head<2>());

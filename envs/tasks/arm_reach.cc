@@ -92,8 +92,11 @@ Eigen::Vector3d ArmReachTask::target(const engine::World& world) const {
 }
 
 void ArmReachTask::observe(const engine::World& world, StateSlots& state) const {
-  state.set("joint_pos", world.joint_positions(robot_));
-  state.set("joint_vel", world.joint_velocities(robot_));
+  Eigen::Matrix<double, 7, 1> joints;
+  world.joint_positions(robot_, joints);
+  state.set("joint_pos", joints);
+  world.joint_velocities(robot_, joints);
+  state.set("joint_vel", joints);
   state.set("end_effector_pos", end_effector(world));
   state.set("target_pos", target(world));
 }

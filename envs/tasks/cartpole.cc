@@ -65,9 +65,8 @@ double CartPoleTask::pole_angular_velocity(const engine::World& world) const {
 }
 
 void CartPoleTask::observe(const engine::World& world, StateSlots& state) const {
-  const Eigen::VectorXd qd = world.joint_velocities(robot_);
   state.set("joint_pos", {cart_position(world), pole_angle(world)});
-  state.set("joint_vel", qd);
+  state.set("joint_vel", {world.joint_velocity(robot_, 0), pole_angular_velocity(world)});
 }
 
 double CartPoleTask::reward(const engine::World& world) const {
