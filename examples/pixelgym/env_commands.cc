@@ -67,8 +67,8 @@ struct InfoArguments {
 };
 
 int run_info(const InfoArguments& args) {
+  std::unique_ptr<Env> env = make_env(args.id, args.sets);  // first: an unknown id is a usage error
   const auto spec = default_registry().spec(args.id);
-  std::unique_ptr<Env> env = make_env(args.id, args.sets);
   const std::string max_steps =
       spec->max_episode_steps ? std::to_string(*spec->max_episode_steps) : "none";
   std::cout << args.id << ": " << spec->description << "\n"
