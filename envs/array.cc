@@ -130,6 +130,21 @@ Array Array::index(std::int64_t i) const {
   return view;
 }
 
+Array Array::slice(std::int64_t begin, std::int64_t end) const {
+  if (shape_.empty()) throw std::out_of_range("Array::slice: a 0-dimensional array has no rows");
+  if (begin < 0 || begin > end || end > shape_[0]) {
+    throw std::out_of_range("Array::slice: rows [" + std::to_string(begin) + ", " +
+                            std::to_string(end) + ") out of range for shape " +
+                            shape_to_string(shape_));
+  }
+  Array view = *this;
+  view.shape_[0] = end - begin;
+  view.size_ = shape_size(view.shape_);
+  const std::int64_t row_size = shape_[0] == 0 ? 0 : size_ / shape_[0];
+  view.data_ = data_ + begin * row_size * static_cast<std::int64_t>(dtype_size(dtype_));
+  return view;
+}
+
 Array Array::reshape(Shape shape) const {
   if (shape_size(shape) != size_) {
     throw std::invalid_argument("Array::reshape: cannot view " + std::to_string(size_) +

@@ -122,6 +122,10 @@ class Array {
   /// The sub-array at position `i` of the leading dimension, sharing memory (numpy's `a[i]`).
   /// Throws std::out_of_range.
   Array index(std::int64_t i) const;
+  /// Rows [begin, end) of the leading dimension, sharing memory (numpy's `a[begin:end]`): a slot
+  /// range of a batch, a window of a frame ring. Throws std::out_of_range unless
+  /// 0 <= begin <= end <= shape()[0].
+  Array slice(std::int64_t begin, std::int64_t end) const;
   /// The same memory seen with another shape of the same size. Throws std::invalid_argument.
   Array reshape(Shape shape) const;
   /// Copies `source`'s elements into this array's memory. Throws std::invalid_argument on a

@@ -11,8 +11,36 @@ Rng& Env::rng() {
   return *rng_;
 }
 
+namespace {
+
+// Throws unless `obs` is laid out as `space` (structure, dtypes, shapes; values not checked).
+void require_layout(const Env& env, const Space& space, const Value& obs, const char* method) {
+  const std::string reason = space.layout_mismatch(obs);
+  if (!reason.empty()) {
+    throw std::invalid_argument(env.name() + ": " + method + " buffer is not laid out as " +
+                                space.to_string() + ": " + reason);
+  }
+}
+
+}  // namespace
+
 ResetResult Env::reset(std::optional<std::uint64_t> seed, const Options& options) {
+  ResetResult result;
+  result.obs = observation_space().zeros();
+  reset_into(result, seed, options);
+  return result;
+}
+
+StepResult Env::step(const Value& action) {
+  StepResult result;
+  result.obs = observation_space().zeros();
+  step_into(action, result);
+  return result;
+}
+
+void Env::reset_into(ResetResult& out, std::optional<std::uint64_t> seed, const Options& options) {
   if (closed_) throw ResetNeeded(name() + ": reset() called after close()");
+  require_layout(*this, observation_space(), out.obs, "reset_into()");
   if (seed) {
     rng_.emplace(*seed);
   } else if (!rng_) {
@@ -20,13 +48,13 @@ ResetResult Env::reset(std::optional<std::uint64_t> seed, const Options& options
   }
   // Until do_reset returns, the env is in no valid episode.
   has_reset_ = false;
-  ResetResult result = do_reset(seed, options);
+  out.info.clear();
+  do_reset(seed, options, out);
   has_reset_ = true;
   episode_over_ = false;
-  return result;
 }
 
-StepResult Env::step(const Value& action) {
+void Env::step_into(const Value& action, StepResult& out) {
   if (closed_) throw ResetNeeded(name() + ": step() called after close()");
   if (!has_reset_) throw ResetNeeded(name() + ": step() called before reset(); call reset() first");
   if (episode_over_) {
@@ -34,12 +62,20 @@ StepResult Env::step(const Value& action) {
                       ": step() called after the episode ended (terminated or truncated); "
                       "call reset() to start a new episode");
   }
-  require_contains(action_space(), action, name() + ": step() action");
+  const std::string reason = action_space().mismatch(action);  // empty: no allocation
+  if (!reason.empty()) {
+    throw std::invalid_argument(name() + ": step() action: " + action.to_string() +
+                                " is not in " + action_space().to_string() + ": " + reason);
+  }
+  require_layout(*this, observation_space(), out.obs, "step_into()");
   // Should do_step throw, the episode is in an unknown state: require a reset.
   episode_over_ = true;
-  StepResult result = do_step(action);
-  episode_over_ = result.terminated || result.truncated;
-  return result;
+  out.reward = 0.0;
+  out.terminated = false;
+  out.truncated = false;
+  out.info.clear();
+  do_step(action, out);
+  episode_over_ = out.terminated || out.truncated;
 }
 
 Array Env::render() {

@@ -31,14 +31,14 @@ struct Metadata {
   double render_fps = 0.0;
 };
 
-/// What `reset` returns.
+/// What `reset` returns, and where `reset_into` writes.
 struct ResetResult {
   Value obs;
   Info info;
 };
 
-/// What `step` returns. `terminated`: the task's own end (goal reached, pole fell);
-/// `truncated`: cut off from outside the task (a time limit).
+/// What `step` returns, and where `step_into` writes. `terminated`: the task's own end (goal
+/// reached, pole fell); `truncated`: cut off from outside the task (a time limit).
 struct StepResult {
   Value obs;
   double reward = 0.0;
@@ -73,11 +73,24 @@ class Env {
   Env(const Env&) = delete;
   Env& operator=(const Env&) = delete;
 
-  /// Starts an episode. Throws ResetNeeded after `close()`.
+  /// Starts an episode; the observation is a new Value of its own. Throws ResetNeeded after
+  /// `close()`.
   ResetResult reset(std::optional<std::uint64_t> seed = std::nullopt, const Options& options = {});
-  /// Advances one step. Throws ResetNeeded when called out of order and std::invalid_argument
-  /// when `action` is not in `action_space()` (naming the space and the value).
+  /// Advances one step; the observation is a new Value of its own (never aliased with an earlier
+  /// one). Throws ResetNeeded when called out of order and std::invalid_argument when `action`
+  /// is not in `action_space()` (naming the space and the value).
   StepResult step(const Value& action);
+
+  /// The buffer path, which `reset` and `step` also take after allocating `out.obs`: the
+  /// observation is written into the arrays of `out.obs`, memory the caller owns and laid out as
+  /// `observation_space()` (make one with `observation_space().zeros()`, or view a slot of a
+  /// batch); `reward`, the flags and `info` are overwritten. Nothing is allocated on this path
+  /// once the env is warmed up (pixel tasks; wrappers keep their own buffers). The env keeps no
+  /// reference to `out`. Throws as `reset` / `step` do, and std::invalid_argument when `out.obs`
+  /// is not laid out as `observation_space()`.
+  void reset_into(ResetResult& out, std::optional<std::uint64_t> seed = std::nullopt,
+                  const Options& options = {});
+  void step_into(const Value& action, StepResult& out);
   /// The current frame as an (H, W, 3) uint8 array (render mode "rgb_array"). Throws
   /// ResetNeeded before the first `reset` or after `close`.
   Array render();
@@ -109,11 +122,14 @@ class Env {
   /// The class name used in messages when the env is not registered.
   virtual std::string type_name() const { return "Env"; }
 
-  /// Starts an episode; `rng()` is already seeded. `seed` is passed on so that wrappers can
-  /// forward it to the env they wrap.
-  virtual ResetResult do_reset(std::optional<std::uint64_t> seed, const Options& options) = 0;
-  /// Advances one step with an action already known to be in `action_space()`.
-  virtual StepResult do_step(const Value& action) = 0;
+  /// Starts an episode, writing the observation into the arrays of `out.obs` (laid out as
+  /// `observation_space()`; `out.info` is empty). `rng()` is already seeded. `seed` is passed on
+  /// so that wrappers can forward it to the env they wrap.
+  virtual void do_reset(std::optional<std::uint64_t> seed, const Options& options,
+                        ResetResult& out) = 0;
+  /// Advances one step with an action already known to be in `action_space()`, writing into
+  /// `out` as do_reset does (`out.reward` is 0, the flags false and `out.info` empty on entry).
+  virtual void do_step(const Value& action, StepResult& out) = 0;
   virtual Array do_render() = 0;
   /// Called at most once.
   virtual void do_close() {}

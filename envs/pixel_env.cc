@@ -27,6 +27,28 @@ int read_size(const Params& params, const std::string& key, const std::string& e
 
 }  // namespace
 
+void StateSlots::set(const char* name, std::initializer_list<double> values) {
+  float* out = slot(name, static_cast<std::int64_t>(values.size()));
+  for (const double value : values) *out++ = static_cast<float>(value);
+}
+
+float* StateSlots::slot(const char* name, std::int64_t size) {
+  for (std::size_t i = 0; i < specs_.size(); ++i) {
+    if (specs_[i].name != name) continue;
+    Array& array = arrays_[i].array();
+    if (array.size() != size) {
+      throw std::invalid_argument("Task::observe: state \"" + specs_[i].name + "\" has " +
+                                  std::to_string(array.size()) + " elements, got " +
+                                  std::to_string(size) + " values");
+    }
+    return array.data<float>();
+  }
+  std::string names;
+  for (const StateSpec& spec : specs_) names += (names.empty() ? "\"" : ", \"") + spec.name + "\"";
+  throw std::out_of_range("Task::observe: no state \"" + std::string(name) + "\" (states: " +
+                          names + ")");
+}
+
 std::vector<ParamSpec> TaskConfig::params() {
   const TaskConfig d;
   return {{"width", d.width, "observation image width in pixels"},
@@ -68,31 +90,43 @@ TaskConfig TaskConfig::from_params(const Params& params, const std::vector<std::
   return c;
 }
 
-PixelEnv::PixelEnv(std::unique_ptr<Task> task, TaskConfig config, std::string name)
-    : task_(std::move(task)), config_(std::move(config)), name_(std::move(name)) {
-  if (task_ == nullptr) throw std::invalid_argument("PixelEnv: task is null");
-  const std::vector<std::string> cameras = task_->camera_names();
-  camera_ = config_.camera.empty() ? cameras.at(0) : config_.camera;
-  // Spaces from the config and the task alone.
+EnvDescription PixelEnv::describe(const Task& task, const TaskConfig& config) {
+  EnvDescription description;
+  description.cameras = task.camera_names();
   spaces::Dict::Entries entries;
-  if (config_.has_pixels()) {
+  if (config.has_pixels()) {
     entries.emplace_back(
-        "pixels", std::make_shared<spaces::Box>(0.0, 255.0, Shape{config_.height, config_.width, 3},
+        "pixels", std::make_shared<spaces::Box>(0.0, 255.0, Shape{config.height, config.width, 3},
                                                 DType::kUInt8));
   }
-  if (config_.has_state()) {
+  if (config.has_state()) {
     const double inf = std::numeric_limits<double>::infinity();
-    for (const StateSpec& spec : task_->state_specs()) {
+    for (const StateSpec& spec : task.state_specs()) {
       entries.emplace_back(spec.name,
                            std::make_shared<spaces::Box>(-inf, inf, spec.shape, DType::kFloat32));
     }
   }
-  observation_space_ = std::make_shared<spaces::Dict>(std::move(entries));
-  action_space_ = task_->action_space();
+  description.observation_space = std::make_shared<spaces::Dict>(std::move(entries));
+  description.action_space = task.action_space();
+  // The episode ends after the task's control steps, counted in env steps of action_repeat.
+  description.max_episode_steps =
+      (task.episode_length() + config.action_repeat - 1) / config.action_repeat;
+  description.metadata.render_fps = 1.0 / (task.control_timestep_s() * config.action_repeat);
+  return description;
+}
+
+PixelEnv::PixelEnv(std::unique_ptr<Task> task, TaskConfig config, std::string name)
+    : task_(std::move(task)), config_(std::move(config)), name_(std::move(name)) {
+  if (task_ == nullptr) throw std::invalid_argument("PixelEnv: task is null");
+  EnvDescription description = describe(*task_, config_);
+  camera_ = config_.camera.empty() ? description.cameras.at(0) : config_.camera;
+  observation_space_ = std::move(description.observation_space);
+  action_space_ = std::move(description.action_space);
+  metadata_ = std::move(description.metadata);
+  if (config_.has_state()) state_specs_ = task_->state_specs();
   const engine::WorldConfig world_config = task_->world_config();
   substeps_ = std::max(
       1, static_cast<int>(std::lround(task_->control_timestep_s() / world_config.timestep_s)));
-  metadata_.render_fps = 1.0 / (task_->control_timestep_s() * config_.action_repeat);
   world_ = std::make_unique<engine::World>(world_config);
   task_->build(*world_);
   scene_ = std::make_unique<WorldScene>(*world_);
@@ -106,7 +140,8 @@ render::Renderer& PixelEnv::renderer() {
   return *renderer_;
 }
 
-ResetResult PixelEnv::do_reset(std::optional<std::uint64_t> /*seed*/, const Options& options) {
+void PixelEnv::do_reset(std::optional<std::uint64_t> /*seed*/, const Options& options,
+                        ResetResult& out) {
   if (!options.empty()) {
     throw std::invalid_argument(name() + ": reset() takes no options, got \"" +
                                 options.begin()->first + "\"");
@@ -114,41 +149,52 @@ ResetResult PixelEnv::do_reset(std::optional<std::uint64_t> /*seed*/, const Opti
   world_->reset();
   task_->initialize_episode(*world_, rng());
   control_steps_ = 0;
-  return {observe(), {}};
+  observe(out.obs);
 }
 
-StepResult PixelEnv::do_step(const Value& action) {
-  StepResult result;
+void PixelEnv::do_step(const Value& action, StepResult& out) {
   for (int r = 0; r < config_.action_repeat; ++r) {
     task_->before_step(action, *world_);
     world_->step(substeps_);
     ++control_steps_;
-    result.reward += task_->reward(*world_);
-    result.terminated = task_->terminated(*world_);
-    if (result.terminated || control_steps_ >= task_->episode_length()) break;
+    out.reward += task_->reward(*world_);
+    out.terminated = task_->terminated(*world_);
+    if (out.terminated) break;
   }
-  result.truncated = !result.terminated && control_steps_ >= task_->episode_length();
-  result.obs = observe();
-  return result;
+  observe(out.obs);
 }
 
-Value PixelEnv::observe() {
-  ValueDict obs;
-  if (config_.has_pixels())
-    obs.insert("pixels", render_camera(camera_, config_.width, config_.height, 0));
-  if (config_.has_state()) task_->observe(*world_, obs);
-  return obs;
+void PixelEnv::observe(Value& obs) {
+  // Entries in observation_space() order: "pixels" first when present, then the state arrays.
+  std::vector<Value>& slots = obs.dict().values();
+  std::size_t next = 0;
+  if (config_.has_pixels()) render_camera_into(camera_, 0, slots[next++].array());
+  if (config_.has_state()) {
+    StateSlots state(state_specs_, slots.data() + next);
+    task_->observe(*world_, state);
+  }
 }
 
 Array PixelEnv::render_camera(const std::string& camera, int width, int height, int msaa_samples) {
+  Array frame(DType::kUInt8, {height, width, 3});
+  render_camera_into(camera, msaa_samples, frame);
+  return frame;
+}
+
+void PixelEnv::render_camera_into(const std::string& camera, int msaa_samples, Array& frame) {
+  const Shape& shape = frame.shape();
+  if (frame.dtype() != DType::kUInt8 || shape.size() != 3 || shape[2] != 3) {
+    throw std::invalid_argument(name() + ": a frame must be a uint8 (height, width, 3) array, got " +
+                                std::string(dtype_name(frame.dtype())) + " " +
+                                shape_to_string(shape));
+  }
   scene_->update(*world_);
   render::Camera view = task_->camera(camera, *world_);
-  view.width = width;
-  view.height = height;
+  view.height = static_cast<int>(shape[0]);
+  view.width = static_cast<int>(shape[1]);
   view.msaa_samples = msaa_samples;
-  Array frame(DType::kUInt8, {height, width, 3});
   renderer().render(scene_->scene(), view, {frame.data<std::uint8_t>()});
-  return frame;
+  ++frames_rendered_;
 }
 
 Array PixelEnv::do_render() {
@@ -165,19 +211,18 @@ EnvSpec pixel_task_spec(const std::string& id, const std::string& description,
   spec.description = description;
   spec.params = TaskConfig::params();
   spec.params.insert(spec.params.end(), extra_params.begin(), extra_params.end());
-  spec.factory = [id, make_task = std::move(make_task)](const Params& kwargs) {
+  spec.factory = [id, make_task](const Params& kwargs) {
     std::unique_ptr<Task> task = make_task(kwargs);
     TaskConfig config = TaskConfig::from_params(kwargs, task->camera_names(), id);
     return std::make_unique<PixelEnv>(std::move(task), std::move(config), id);
   };
+  spec.describe = [id, make_task](const Params& kwargs) {
+    const std::unique_ptr<Task> task = make_task(kwargs);
+    return PixelEnv::describe(*task, TaskConfig::from_params(kwargs, task->camera_names(), id));
+  };
+  // The default time limit: the one describe gives for default kwargs.
+  spec.max_episode_steps = spec.describe(resolve_params(spec.params, {}, id)).max_episode_steps;
   return spec;
-}
-
-Array float32_array(const Eigen::VectorXd& values) {
-  Array array(DType::kFloat32, {static_cast<std::int64_t>(values.size())});
-  for (Eigen::Index i = 0; i < values.size(); ++i)
-    array.data<float>()[i] = static_cast<float>(values[i]);
-  return array;
 }
 
 engine::BodyOptions marker_body(const std::string& name, double radius_m,

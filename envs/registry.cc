@@ -90,25 +90,63 @@ std::shared_ptr<const EnvSpec> Registry::spec(const std::string& id) const {
   throw std::invalid_argument(message);
 }
 
-std::unique_ptr<Env> Registry::make(const std::string& id, const Params& kwargs) const {
-  const std::shared_ptr<const EnvSpec> env_spec = spec(id);
-  std::vector<ParamSpec> accepted = env_spec->params;
+Registry::Resolved Registry::resolve(const std::string& id, const Params& kwargs) const {
+  Resolved out;
+  out.spec = spec(id);
+  std::vector<ParamSpec> accepted = out.spec->params;
   accepted.push_back({kMaxEpisodeStepsKey,
-                      Param(env_spec->max_episode_steps ? *env_spec->max_episode_steps : 0),
+                      Param(out.spec->max_episode_steps ? *out.spec->max_episode_steps : 0),
                       "steps before TimeLimit truncates the episode; 0 for no limit"});
-  Params resolved = resolve_params(accepted, kwargs, id);
-  const std::int64_t max_episode_steps = resolved.at(kMaxEpisodeStepsKey).as_int();
+  out.kwargs = resolve_params(accepted, kwargs, id);
+  const std::int64_t max_episode_steps = out.kwargs.at(kMaxEpisodeStepsKey).as_int();
   if (max_episode_steps < 0) {
     throw std::invalid_argument(id +
                                 ": kwarg \"max_episode_steps\" must be >= 0 (0: no limit), got " +
                                 std::to_string(max_episode_steps));
   }
-  resolved.erase(kMaxEpisodeStepsKey);
+  out.kwargs.erase(kMaxEpisodeStepsKey);
+  if (kwargs.count(kMaxEpisodeStepsKey) != 0) {
+    out.max_episode_steps = max_episode_steps;  // the caller's choice wins
+  } else if (out.spec->describe) {
+    const std::optional<std::int64_t> limit = out.spec->describe(out.kwargs).max_episode_steps;
+    out.max_episode_steps = limit.value_or(0);
+  } else {
+    out.max_episode_steps = max_episode_steps;
+  }
+  return out;
+}
 
-  std::unique_ptr<Env> env = env_spec->factory(resolved);
+EnvDescription Registry::describe(const std::string& id, const Params& kwargs) const {
+  const Resolved resolved = resolve(id, kwargs);
+  EnvDescription description;
+  if (resolved.spec->describe) {
+    description = resolved.spec->describe(resolved.kwargs);
+  } else {
+    // No describe: build the env and keep it alive behind its spaces (aliasing pointers).
+    std::shared_ptr<Env> env = resolved.spec->factory(resolved.kwargs);
+    if (env == nullptr) throw std::runtime_error(id + ": the registered factory returned null");
+    description.observation_space = SpacePtr(env, &env->observation_space());
+    description.action_space = SpacePtr(env, &env->action_space());
+    description.metadata = env->metadata();
+  }
+  description.max_episode_steps.reset();
+  if (resolved.max_episode_steps > 0) description.max_episode_steps = resolved.max_episode_steps;
+  return description;
+}
+
+std::unique_ptr<Env> Registry::make(const std::string& id, const Params& kwargs) const {
+  const Resolved resolved = resolve(id, kwargs);
+  std::unique_ptr<Env> env = resolved.spec->factory(resolved.kwargs);
   if (env == nullptr) throw std::runtime_error(id + ": the registered factory returned null");
-  env->set_spec(env_spec);
-  if (max_episode_steps > 0) env = std::make_unique<TimeLimit>(std::move(env), max_episode_steps);
+  // The made env's spec says what it was made with (as gymnasium's env.spec does).
+  auto made = std::make_shared<EnvSpec>(*resolved.spec);
+  made->kwargs = resolved.kwargs;
+  made->max_episode_steps.reset();
+  if (resolved.max_episode_steps > 0) made->max_episode_steps = resolved.max_episode_steps;
+  env->set_spec(made);
+  if (resolved.max_episode_steps > 0) {
+    env = std::make_unique<TimeLimit>(std::move(env), resolved.max_episode_steps);
+  }
   return env;
 }
 
@@ -148,6 +186,10 @@ std::unique_ptr<Env> make(const std::string& id, const Params& kwargs) {
 }
 
 void register_env(EnvSpec spec) { default_registry().register_env(std::move(spec)); }
+
+EnvDescription describe(const std::string& id, const Params& kwargs) {
+  return default_registry().describe(id, kwargs);
+}
 
 std::vector<std::string> registered_ids() { return default_registry().registered_ids(); }
 

@@ -14,6 +14,18 @@
 
 namespace pixelgym {
 
+/// What an env made with some kwargs offers, known without making it: no Bullet world and no GL
+/// context are built to answer (`pixelgym info` prints it).
+struct EnvDescription {
+  SpacePtr observation_space;
+  SpacePtr action_space;
+  /// The step at which `make` truncates (TimeLimit), in env steps; std::nullopt for no limit.
+  std::optional<std::int64_t> max_episode_steps;
+  /// The camera names a pixel task accepts as its "camera" kwarg, default first; empty otherwise.
+  std::vector<std::string> cameras;
+  Metadata metadata;
+};
+
 /// How to make one registered env.
 struct EnvSpec {
   /// "Name-vN": changing a task's dynamics, reward or observation bumps N.
@@ -22,10 +34,18 @@ struct EnvSpec {
   std::string description;
   /// The kwargs the env accepts, with types, defaults and docs (its Config's fields).
   std::vector<ParamSpec> params;
-  /// When set, `make` wraps the env in TimeLimit with this many steps.
+  /// When set, `make` wraps the env in TimeLimit with this many steps (with default kwargs;
+  /// `describe` may give another limit for other kwargs, e.g. a pixel task's action_repeat).
+  /// On the spec of an env that `make` returned: the limit that env truncates at.
   std::optional<std::int64_t> max_episode_steps;
+  /// On the spec of an env that `make` returned: the kwargs it was made with, resolved (every
+  /// declared key present, max_episode_steps excluded). Empty in the registry.
+  Params kwargs;
   /// Builds the env from kwargs already resolved against `params` (every key present, typed).
   std::function<std::unique_ptr<Env>(const Params& kwargs)> factory;
+  /// Describes the env `factory` would build from the same kwargs without building it. Optional:
+  /// when unset, Registry::describe builds the env to read its spaces.
+  std::function<EnvDescription(const Params& kwargs)> describe;
 };
 
 /// A set of env specs. The process-wide default one (used by the free functions below) holds
@@ -42,6 +62,10 @@ class Registry {
   /// defaults) or a kwarg of the wrong type.
   std::unique_ptr<Env> make(const std::string& id, const Params& kwargs = {}) const;
 
+  /// What `make(id, kwargs)` would return — spaces, time limit, cameras, metadata — computed
+  /// from the spec alone when it has a `describe` (no world, no GL context). Throws like `make`.
+  EnvDescription describe(const std::string& id, const Params& kwargs = {}) const;
+
   /// The spec registered as `id`; throws like `make` for an unknown id.
   std::shared_ptr<const EnvSpec> spec(const std::string& id) const;
 
@@ -54,6 +78,14 @@ class Registry {
   std::vector<std::string> closest_ids(const std::string& id, std::size_t count = 3) const;
 
  private:
+  /// The spec, the kwargs resolved against it, and the time limit they give (0: none).
+  struct Resolved {
+    std::shared_ptr<const EnvSpec> spec;
+    Params kwargs;
+    std::int64_t max_episode_steps = 0;
+  };
+  Resolved resolve(const std::string& id, const Params& kwargs) const;
+
   mutable std::mutex mutex_;
   std::vector<std::shared_ptr<const EnvSpec>> specs_;
 };
@@ -63,6 +95,8 @@ Registry& default_registry();
 
 /// `default_registry().make(id, kwargs)`.
 std::unique_ptr<Env> make(const std::string& id, const Params& kwargs = {});
+/// `default_registry().describe(id, kwargs)`.
+EnvDescription describe(const std::string& id, const Params& kwargs = {});
 /// `default_registry().register_env(spec)`.
 void register_env(EnvSpec spec);
 /// `default_registry().registered_ids()`.

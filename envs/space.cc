@@ -15,6 +15,24 @@ std::uint64_t Space::seed(std::optional<std::uint64_t> seed) const {
   return used;
 }
 
+Value Space::zeros() const { return Array(*dtype(), *shape()); }
+
+std::string Space::layout_mismatch(const Value& value) const {
+  return array_layout_mismatch(value, *dtype(), *shape());
+}
+
+std::string array_layout_mismatch(const Value& value, DType dtype, const Shape& shape) {
+  if (!value.is_array()) return std::string("expected an array, got a ") + value.kind();
+  const Array& array = value.array();
+  if (array.dtype() != dtype) {
+    return std::string("dtype ") + dtype_name(array.dtype()) + ", expected " + dtype_name(dtype);
+  }
+  if (array.shape() != shape) {
+    return "shape " + shape_to_string(array.shape()) + ", expected " + shape_to_string(shape);
+  }
+  return "";
+}
+
 void require_contains(const Space& space, const Value& value, const std::string& context) {
   const std::string reason = space.mismatch(value);
   if (!reason.empty()) {

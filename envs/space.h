@@ -34,6 +34,14 @@ class Space {
   /// Why `value` is not an element ("dtype float32, expected int64"), or "" when it is.
   virtual std::string mismatch(const Value& value) const = 0;
 
+  /// A zero-filled Value laid out as an element of this space (structure, dtypes, shapes): the
+  /// buffer that Env::reset_into / step_into write into. Not always an element itself
+  /// (Discrete(3, start=1) holds no 0).
+  virtual Value zeros() const;
+  /// Why `value` is not laid out as an element of this space (structure, dtype, shape; the
+  /// values themselves are not looked at), or "" when it is; allocates nothing when it is.
+  virtual std::string layout_mismatch(const Value& value) const;
+
   /// The shape of an element; std::nullopt for Dict and Tuple spaces (as in Gymnasium).
   virtual std::optional<Shape> shape() const = 0;
   /// The dtype of an element; std::nullopt for Dict and Tuple spaces.
@@ -54,6 +62,10 @@ class Space {
 
 /// Spaces are shared, never copied: a Dict space holds its subspaces this way.
 using SpacePtr = std::shared_ptr<const Space>;
+
+/// Why `value` is not an array of `dtype` and `shape`, or "" (allocating nothing) when it is; for
+/// the `layout_mismatch` of spaces whose elements are arrays.
+std::string array_layout_mismatch(const Value& value, DType dtype, const Shape& shape);
 
 /// Throws std::invalid_argument "<context>: <value> is not in <space>: <reason>" unless `space`
 /// contains `value`.

@@ -1,6 +1,9 @@
 // Task: what one pixel task is — its world, cameras, actions, observations, reward, termination.
 #pragma once
 
+#include <Eigen/Core>
+#include <cstdint>
+#include <initializer_list>
 #include <memory>
 #include <string>
 #include <utility>
@@ -49,6 +52,30 @@ struct StateSpec {
   Shape shape;
 };
 
+/// Where Task::observe writes: the float32 state arrays of one observation, in memory the caller
+/// owns (slots of the observation PixelEnv writes into). Writing allocates nothing.
+class StateSlots {
+ public:
+  /// `arrays[i]` is the slot of `specs[i]`: a float32 array of its shape. Both must outlive this.
+  StateSlots(const std::vector<StateSpec>& specs, Value* arrays) : specs_(specs), arrays_(arrays) {}
+
+  /// Writes `values` (any Eigen vector or expression, converted to float32) into the slot
+  /// named `name`. Throws std::out_of_range for a name not in the task's state_specs() and
+  /// std::invalid_argument when the sizes differ.
+  template <typename Derived>
+  void set(const char* name, const Eigen::MatrixBase<Derived>& values) {
+    float* out = slot(name, static_cast<std::int64_t>(values.size()));
+    for (Eigen::Index i = 0; i < values.size(); ++i) out[i] = static_cast<float>(values(i));
+  }
+  void set(const char* name, std::initializer_list<double> values);
+
+ private:
+  float* slot(const char* name, std::int64_t size);
+
+  const std::vector<StateSpec>& specs_;
+  Value* arrays_;
+};
+
 /// One task, written like dm_control's suite files: how its world is built, named quantities,
 /// then initialize_episode / before_step / observe / reward / terminated. PixelEnv runs it.
 /// Everything that fixes the spaces (action_space, state_specs, camera_names) is known without a
@@ -65,7 +92,8 @@ class Task {
   /// Seconds of simulated time per control step, and the physics steps that make it.
   virtual double control_timestep_s() const = 0;
   virtual engine::WorldConfig world_config() const = 0;
-  /// Control steps per episode; PixelEnv truncates after them (whatever the action repeat).
+  /// Control steps per episode: the registry's TimeLimit truncates after
+  /// ceil(episode_length / action_repeat) env steps unless `make` is given max_episode_steps.
   virtual int episode_length() const { return 1000; }
 
   /// Adds the robots and bodies.
@@ -78,8 +106,8 @@ class Task {
   virtual void initialize_episode(engine::World& world, Rng& rng) = 0;
   /// Applies an action already known to be in action_space().
   virtual void before_step(const Value& action, engine::World& world) = 0;
-  /// Writes every state array of state_specs() into `state` (each a new float32 array).
-  virtual void observe(const engine::World& world, ValueDict& state) const = 0;
+  /// Writes every state array of state_specs() into its slot.
+  virtual void observe(const engine::World& world, StateSlots& state) const = 0;
   /// This control step's reward, in [0, 1].
   virtual double reward(const engine::World& world) const = 0;
   virtual bool terminated(const engine::World& /*world*/) const { return false; }

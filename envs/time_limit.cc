@@ -13,16 +13,16 @@ TimeLimit::TimeLimit(std::unique_ptr<Env> env, std::int64_t max_episode_steps)
   }
 }
 
-ResetResult TimeLimit::do_reset(std::optional<std::uint64_t> seed, const Options& options) {
+void TimeLimit::do_reset(std::optional<std::uint64_t> seed, const Options& options,
+                         ResetResult& out) {
   elapsed_steps_ = 0;
-  return env_->reset(seed, options);
+  env_->reset_into(out, seed, options);
 }
 
-StepResult TimeLimit::do_step(const Value& action) {
-  StepResult result = env_->step(action);
+void TimeLimit::do_step(const Value& action, StepResult& out) {
+  env_->step_into(action, out);
   ++elapsed_steps_;
-  if (elapsed_steps_ >= max_episode_steps_) result.truncated = true;
-  return result;
+  if (elapsed_steps_ >= max_episode_steps_) out.truncated = true;
 }
 
 }  // namespace pixelgym

@@ -21,8 +21,9 @@ class TimeLimit final : public Wrapper {
 
  protected:
   std::string type_name() const override { return "TimeLimit"; }
-  ResetResult do_reset(std::optional<std::uint64_t> seed, const Options& options) override;
-  StepResult do_step(const Value& action) override;
+  void do_reset(std::optional<std::uint64_t> seed, const Options& options,
+                ResetResult& out) override;
+  void do_step(const Value& action, StepResult& out) override;
 
  private:
   std::int64_t max_episode_steps_;

@@ -26,6 +26,18 @@ void ValueDict::insert(const std::string& key, Value value) {
   values_.push_back(std::move(value));
 }
 
+void ValueDict::erase(const std::string& key) {
+  at(key);  // throws for a missing key
+  const auto i = find(key);
+  keys_.erase(keys_.begin() + i);
+  values_.erase(values_.begin() + i);
+}
+
+void ValueDict::clear() {
+  keys_.clear();
+  values_.clear();
+}
+
 bool ValueDict::contains(const std::string& key) const { return find(key) >= 0; }
 
 const Value& ValueDict::at(const std::string& key) const {

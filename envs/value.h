@@ -21,6 +21,10 @@ class ValueDict {
 
   /// Adds `key`, or replaces its value when present (keeping its position).
   void insert(const std::string& key, Value value);
+  /// Removes `key`. Throws std::out_of_range naming the key and the keys present.
+  void erase(const std::string& key);
+  /// Removes every entry (keeping the memory for the next ones).
+  void clear();
   bool contains(const std::string& key) const;
   /// Throws std::out_of_range naming the key and the keys present.
   const Value& at(const std::string& key) const;
@@ -72,6 +76,9 @@ class Value {
   const ValueDict& dict() const;
   ValueDict& dict();
   const ValueTuple& tuple() const;
+
+  /// Exchanges contents with `other` without copying or allocating.
+  void swap(Value& other) noexcept { data_.swap(other.data_); }
 
   /// "array", "Dict" or "Tuple".
   const char* kind() const;

@@ -1,6 +1,7 @@
 #include "envs/wrapper.h"
 
 #include <stdexcept>
+#include <utility>
 
 namespace pixelgym {
 
@@ -8,11 +9,12 @@ Wrapper::Wrapper(std::unique_ptr<Env> env) : env_(std::move(env)) {
   if (env_ == nullptr) throw std::invalid_argument("Wrapper: the env to wrap is null");
 }
 
-ResetResult Wrapper::do_reset(std::optional<std::uint64_t> seed, const Options& options) {
-  return env_->reset(seed, options);
+void Wrapper::do_reset(std::optional<std::uint64_t> seed, const Options& options,
+                       ResetResult& out) {
+  env_->reset_into(out, seed, options);
 }
 
-StepResult Wrapper::do_step(const Value& action) { return env_->step(action); }
+void Wrapper::do_step(const Value& action, StepResult& out) { env_->step_into(action, out); }
 
 Array Wrapper::do_render() { return env_->render(); }
 
@@ -27,17 +29,41 @@ void ObservationWrapper::set_observation_space(SpacePtr space) {
   observation_space_ = std::move(space);
 }
 
-ResetResult ObservationWrapper::do_reset(std::optional<std::uint64_t> seed,
-                                         const Options& options) {
-  ResetResult result = env_->reset(seed, options);
-  result.obs = observation(result.obs);
-  return result;
+namespace {
+
+// Swaps `a` and `b` now and again when it goes out of scope, even by an exception: the inner env
+// writes into this wrapper's buffer through the caller's result, which gets its own buffer back.
+class SwapBack {
+ public:
+  SwapBack(Value& a, Value& b) : a_(a), b_(b) { a_.swap(b_); }
+  ~SwapBack() { a_.swap(b_); }
+  SwapBack(const SwapBack&) = delete;
+  SwapBack& operator=(const SwapBack&) = delete;
+
+ private:
+  Value& a_;
+  Value& b_;
+};
+
+}  // namespace
+
+void ObservationWrapper::do_reset(std::optional<std::uint64_t> seed, const Options& options,
+                                  ResetResult& out) {
+  if (!inner_obs_) inner_obs_ = env_->observation_space().zeros();
+  {
+    SwapBack swap(out.obs, *inner_obs_);
+    env_->reset_into(out, seed, options);
+  }
+  observation(*inner_obs_, out.obs);
 }
 
-StepResult ObservationWrapper::do_step(const Value& action) {
-  StepResult result = env_->step(action);
-  result.obs = observation(result.obs);
-  return result;
+void ObservationWrapper::do_step(const Value& action, StepResult& out) {
+  if (!inner_obs_) inner_obs_ = env_->observation_space().zeros();
+  {
+    SwapBack swap(out.obs, *inner_obs_);
+    env_->step_into(action, out);
+  }
+  observation(*inner_obs_, out.obs);
 }
 
 const Space& ActionWrapper::action_space() const {
@@ -49,12 +75,15 @@ void ActionWrapper::set_action_space(SpacePtr space) {
   action_space_ = std::move(space);
 }
 
-StepResult ActionWrapper::do_step(const Value& action) { return env_->step(this->action(action)); }
+void ActionWrapper::do_step(const Value& action, StepResult& out) {
+  if (!inner_action_) inner_action_ = env_->action_space().zeros();
+  this->action(action, *inner_action_);
+  env_->step_into(*inner_action_, out);
+}
 
-StepResult RewardWrapper::do_step(const Value& action) {
-  StepResult result = env_->step(action);
-  result.reward = reward(result.reward);
-  return result;
+void RewardWrapper::do_step(const Value& action, StepResult& out) {
+  env_->step_into(action, out);
+  out.reward = reward(out.reward);
 }
 
 }  // namespace pixelgym

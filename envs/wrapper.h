@@ -2,6 +2,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "envs/env.h"
@@ -32,8 +33,10 @@ class Wrapper : public Env {
 
  protected:
   std::string type_name() const override { return "Wrapper"; }
-  ResetResult do_reset(std::optional<std::uint64_t> seed, const Options& options) override;
-  StepResult do_step(const Value& action) override;
+  /// Forward to the inner env's reset_into / step_into with the same `out`.
+  void do_reset(std::optional<std::uint64_t> seed, const Options& options,
+                ResetResult& out) override;
+  void do_step(const Value& action, StepResult& out) override;
   Array do_render() override;
   void do_close() override;
 
@@ -42,19 +45,27 @@ class Wrapper : public Env {
 
 /// A wrapper that transforms observations. Subclasses implement `observation()` and, when it
 /// changes the space, call `set_observation_space()` from their constructor.
+///
+/// The inner env writes into a buffer this wrapper owns (allocated on the first reset), and
+/// `observation()` writes the transformed observation into the caller's; so a stack of
+/// observation wrappers allocates nothing per step beyond what `observation()` does.
 class ObservationWrapper : public Wrapper {
  public:
   using Wrapper::Wrapper;
   const Space& observation_space() const override;
 
  protected:
-  virtual Value observation(const Value& obs) = 0;
+  /// Writes the transform of `obs` (laid out as the inner env's observation space) into the
+  /// arrays of `out` (laid out as observation_space()).
+  virtual void observation(const Value& obs, Value& out) = 0;
   void set_observation_space(SpacePtr space);
-  ResetResult do_reset(std::optional<std::uint64_t> seed, const Options& options) override;
-  StepResult do_step(const Value& action) override;
+  void do_reset(std::optional<std::uint64_t> seed, const Options& options,
+                ResetResult& out) override;
+  void do_step(const Value& action, StepResult& out) override;
 
  private:
   SpacePtr observation_space_;  // null: the inner env's
+  std::optional<Value> inner_obs_;  // the inner env's observation, allocated on the first reset
 };
 
 /// A wrapper that transforms actions before the inner env sees them. Subclasses implement
@@ -65,12 +76,15 @@ class ActionWrapper : public Wrapper {
   const Space& action_space() const override;
 
  protected:
-  virtual Value action(const Value& action) = 0;
+  /// Writes the inner env's action for `action` into the arrays of `out` (laid out as the inner
+  /// env's action space, owned by this wrapper).
+  virtual void action(const Value& action, Value& out) = 0;
   void set_action_space(SpacePtr space);
-  StepResult do_step(const Value& action) override;
+  void do_step(const Value& action, StepResult& out) override;
 
  private:
   SpacePtr action_space_;  // null: the inner env's
+  std::optional<Value> inner_action_;  // allocated on the first step
 };
 
 /// A wrapper that transforms rewards. Subclasses implement `reward()`.
@@ -80,7 +94,7 @@ class RewardWrapper : public Wrapper {
 
  protected:
   virtual double reward(double reward) = 0;
-  StepResult do_step(const Value& action) override;
+  void do_step(const Value& action, StepResult& out) override;
 };
 
 }  // namespace pixelgym

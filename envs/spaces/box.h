@@ -27,6 +27,9 @@ class Box final : public Space {
   Value sample(Rng& rng) const override;
   std::string mismatch(const Value& value) const override;
   std::optional<Shape> shape() const override { return shape_; }
+  std::string layout_mismatch(const Value& value) const override {
+    return array_layout_mismatch(value, dtype_, shape_);
+  }
   std::optional<DType> dtype() const override { return dtype_; }
   std::string to_string() const override;
   bool equals(const Space& other) const override;

@@ -11,6 +11,12 @@ std::string key_list(const Dict::Entries& entries) {
   return text.empty() ? "none" : text;
 }
 
+std::string key_list(const std::vector<std::string>& keys) {
+  std::string text;
+  for (const auto& key : keys) text += (text.empty() ? "\"" : ", \"") + key + "\"";
+  return text.empty() ? "none" : text;
+}
+
 }  // namespace
 
 Dict::Dict(Entries entries) : entries_(std::move(entries)) {
@@ -48,6 +54,28 @@ std::string Dict::mismatch(const Value& value) const {
   return "";
 }
 
+Value Dict::zeros() const {
+  pixelgym::ValueDict value;
+  for (const auto& [key, space] : entries_) value.insert(key, space->zeros());
+  return value;
+}
+
+std::string Dict::layout_mismatch(const Value& value) const {
+  if (!value.is_dict()) return std::string("expected a Dict, got a ") + value.kind();
+  const pixelgym::ValueDict& dict = value.dict();
+  if (dict.size() != entries_.size()) {
+    return "keys " + key_list(dict.keys()) + ", expected " + key_list(entries_);
+  }
+  for (std::size_t i = 0; i < entries_.size(); ++i) {
+    if (dict.keys()[i] != entries_[i].first) {
+      return "keys " + key_list(dict.keys()) + ", expected " + key_list(entries_);
+    }
+    std::string reason = entries_[i].second->layout_mismatch(dict.values()[i]);
+    if (!reason.empty()) return "key \"" + entries_[i].first + "\": " + reason;
+  }
+  return "";
+}
+
 std::string Dict::to_string() const {
   std::string text = "Dict(";
   for (std::size_t i = 0; i < entries_.size(); ++i) {
@@ -76,12 +104,43 @@ bool Dict::has(const std::string& key) const {
   return false;
 }
 
-const Space& Dict::at(const std::string& key) const {
-  for (const auto& entry : entries_) {
-    if (entry.first == key) return *entry.second;
+const Space& Dict::at(const std::string& key) const { return *entries_[index(key)].second; }
+
+std::size_t Dict::index(const std::string& key) const {
+  for (std::size_t i = 0; i < entries_.size(); ++i) {
+    if (entries_[i].first == key) return i;
   }
   throw std::out_of_range("spaces::Dict: no key \"" + key + "\" (keys: " + key_list(entries_) +
                           ")");
+}
+
+std::shared_ptr<const Dict> Dict::replaced(const std::string& key, SpacePtr space) const {
+  Entries entries = entries_;
+  entries[index(key)].second = std::move(space);
+  return std::make_shared<const Dict>(std::move(entries));
+}
+
+std::shared_ptr<const Dict> Dict::inserted(const std::string& key, SpacePtr space,
+                                           std::optional<std::size_t> position) const {
+  if (has(key)) {
+    throw std::invalid_argument("spaces::Dict: cannot insert \"" + key +
+                                "\": the key is present (keys: " + key_list(entries_) + ")");
+  }
+  const std::size_t at = position.value_or(entries_.size());
+  if (at > entries_.size()) {
+    throw std::invalid_argument("spaces::Dict: cannot insert \"" + key + "\" at position " +
+                                std::to_string(at) + " of " + std::to_string(entries_.size()) +
+                                " entries");
+  }
+  Entries entries = entries_;
+  entries.insert(entries.begin() + static_cast<std::ptrdiff_t>(at), {key, std::move(space)});
+  return std::make_shared<const Dict>(std::move(entries));
+}
+
+std::shared_ptr<const Dict> Dict::removed(const std::string& key) const {
+  Entries entries = entries_;
+  entries.erase(entries.begin() + static_cast<std::ptrdiff_t>(index(key)));
+  return std::make_shared<const Dict>(std::move(entries));
 }
 
 }  // namespace pixelgym::spaces

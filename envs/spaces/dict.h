@@ -1,6 +1,8 @@
 // spaces::Dict: an ordered mapping of named subspaces, as gymnasium.spaces.Dict.
 #pragma once
 
+#include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -21,6 +23,8 @@ class Dict final : public Space {
   using Space::sample;
   Value sample(Rng& rng) const override;
   std::string mismatch(const Value& value) const override;
+  Value zeros() const override;
+  std::string layout_mismatch(const Value& value) const override;
   std::optional<Shape> shape() const override { return std::nullopt; }
   std::optional<DType> dtype() const override { return std::nullopt; }
   std::string to_string() const override;
@@ -30,6 +34,17 @@ class Dict final : public Space {
   bool has(const std::string& key) const;
   /// Throws std::out_of_range naming the key and the keys present.
   const Space& at(const std::string& key) const;
+  /// The position of `key` in entries(). Throws std::out_of_range like `at`.
+  std::size_t index(const std::string& key) const;
+
+  /// Copies with one entry changed (spaces are immutable), for wrappers that change one key:
+  /// `replaced` swaps the subspace of `key` in place (std::out_of_range when absent);
+  /// `inserted` adds `key` at `position` (the end by default; std::invalid_argument when present
+  /// or past the end); `removed` drops `key` (std::out_of_range when absent).
+  std::shared_ptr<const Dict> replaced(const std::string& key, SpacePtr space) const;
+  std::shared_ptr<const Dict> inserted(const std::string& key, SpacePtr space,
+                                       std::optional<std::size_t> position = std::nullopt) const;
+  std::shared_ptr<const Dict> removed(const std::string& key) const;
 
  private:
   Entries entries_;

@@ -17,6 +17,9 @@ class MultiBinary final : public Space {
   Value sample(Rng& rng) const override;
   std::string mismatch(const Value& value) const override;
   std::optional<Shape> shape() const override { return shape_; }
+  std::string layout_mismatch(const Value& value) const override {
+    return array_layout_mismatch(value, DType::kUInt8, shape_);
+  }
   std::optional<DType> dtype() const override { return DType::kUInt8; }
   std::string to_string() const override;
   bool equals(const Space& other) const override;

@@ -33,6 +33,26 @@ std::string Tuple::mismatch(const Value& value) const {
   return "";
 }
 
+Value Tuple::zeros() const {
+  std::vector<Value> items;
+  for (const SpacePtr& space : spaces_) items.push_back(space->zeros());
+  return pixelgym::ValueTuple(std::move(items));
+}
+
+std::string Tuple::layout_mismatch(const Value& value) const {
+  if (!value.is_tuple()) return std::string("expected a Tuple, got a ") + value.kind();
+  const pixelgym::ValueTuple& tuple = value.tuple();
+  if (tuple.size() != spaces_.size()) {
+    return "length " + std::to_string(tuple.size()) + ", expected " +
+           std::to_string(spaces_.size());
+  }
+  for (std::size_t i = 0; i < spaces_.size(); ++i) {
+    std::string reason = spaces_[i]->layout_mismatch(tuple.items()[i]);
+    if (!reason.empty()) return "item " + std::to_string(i) + ": " + reason;
+  }
+  return "";
+}
+
 std::string Tuple::to_string() const {
   std::string text = "Tuple(";
   for (std::size_t i = 0; i < spaces_.size(); ++i) {

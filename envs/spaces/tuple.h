@@ -16,6 +16,8 @@ class Tuple final : public Space {
   using Space::sample;
   Value sample(Rng& rng) const override;
   std::string mismatch(const Value& value) const override;
+  Value zeros() const override;
+  std::string layout_mismatch(const Value& value) const override;
   std::optional<Shape> shape() const override { return std::nullopt; }
   std::optional<DType> dtype() const override { return std::nullopt; }
   std::string to_string() const override;

@@ -50,13 +50,11 @@ Eigen::Vector3d AcrobotTask::tip(const engine::World& world) const {
   return world.link_pose(robot_, lower_arm_) * Eigen::Vector3d(0.0, 0.0, -1.0);
 }
 
-void AcrobotTask::observe(const engine::World& world, ValueDict& state) const {
+void AcrobotTask::observe(const engine::World& world, StateSlots& state) const {
   const Eigen::VectorXd q = world.joint_positions(robot_);
   const Eigen::VectorXd qd = world.joint_velocities(robot_);
-  state.insert("joint_pos", Array::from_vector<float>({2}, {static_cast<float>(wrap_angle(q[0])),
-                                                            static_cast<float>(wrap_angle(q[1]))}));
-  state.insert("joint_vel", Array::from_vector<float>(
-                                {2}, {static_cast<float>(qd[0]), static_cast<float>(qd[1])}));
+  state.set("joint_pos", {wrap_angle(q[0]), wrap_angle(q[1])});
+  state.set("joint_vel", qd);
 }
 
 double AcrobotTask::reward(const engine::World& world) const {

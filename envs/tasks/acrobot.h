@@ -26,7 +26,7 @@ class AcrobotTask final : public Task {
   render::Camera camera(const std::string& name, const engine::World& world) const override;
   void initialize_episode(engine::World& world, Rng& rng) override;
   void before_step(const Value& action, engine::World& world) override;
-  void observe(const engine::World& world, ValueDict& state) const override;
+  void observe(const engine::World& world, StateSlots& state) const override;
   double reward(const engine::World& world) const override;
 
   /// World position of the lower arm's tip.

@@ -100,13 +100,14 @@ Eigen::Vector3d ArmPushTask::goal(const engine::World& world) const {
   return world.body_pose(goal_body_).translation();
 }
 
-void ArmPushTask::observe(const engine::World& world, ValueDict& state) const {
-  state.insert("joint_pos", float32_array(world.joint_positions(arm_)));
-  state.insert("joint_vel", float32_array(world.joint_velocities(arm_)));
-  state.insert("end_effector_pos", float32_array(end_effector(world)));
+void ArmPushTask::observe(const engine::World& world, StateSlots& state) const {
+  const Eigen::Vector3d hand = end_effector(world);
   const Eigen::Vector3d c = cube(world);
-  state.insert("to_cube", float32_array(c - end_effector(world)));
-  state.insert("cube_to_goal", float32_array((goal(world) - c).head<2>()));
+  state.set("joint_pos", world.joint_positions(arm_));
+  state.set("joint_vel", world.joint_velocities(arm_));
+  state.set("end_effector_pos", hand);
+  state.set("to_cube", c - hand);
+  state.set("cube_to_goal", (goal(world) - c).head<2>());
 }
 
 double ArmPushTask::reward(const engine::World& world) const {

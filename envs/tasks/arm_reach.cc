@@ -91,12 +91,11 @@ Eigen::Vector3d ArmReachTask::target(const engine::World& world) const {
   return world.body_pose(target_body_).translation();
 }
 
-void ArmReachTask::observe(const engine::World& world, ValueDict& state) const {
-  Eigen::VectorXd q = world.joint_positions(robot_);
-  state.insert("joint_pos", float32_array(q));
-  state.insert("joint_vel", float32_array(world.joint_velocities(robot_)));
-  state.insert("end_effector_pos", float32_array(end_effector(world)));
-  state.insert("target_pos", float32_array(target(world)));
+void ArmReachTask::observe(const engine::World& world, StateSlots& state) const {
+  state.set("joint_pos", world.joint_positions(robot_));
+  state.set("joint_vel", world.joint_velocities(robot_));
+  state.set("end_effector_pos", end_effector(world));
+  state.set("target_pos", target(world));
 }
 
 double ArmReachTask::reward(const engine::World& world) const {

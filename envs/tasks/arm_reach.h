@@ -31,7 +31,7 @@ class ArmReachTask final : public Task {
   render::Camera camera(const std::string& name, const engine::World& world) const override;
   void initialize_episode(engine::World& world, Rng& rng) override;
   void before_step(const Value& action, engine::World& world) override;
-  void observe(const engine::World& world, ValueDict& state) const override;
+  void observe(const engine::World& world, StateSlots& state) const override;
   double reward(const engine::World& world) const override;
 
   Eigen::Vector3d end_effector(const engine::World& world) const;

@@ -64,13 +64,10 @@ double CartPoleTask::pole_angular_velocity(const engine::World& world) const {
   return world.joint_velocities(robot_)[1];
 }
 
-void CartPoleTask::observe(const engine::World& world, ValueDict& state) const {
+void CartPoleTask::observe(const engine::World& world, StateSlots& state) const {
   const Eigen::VectorXd qd = world.joint_velocities(robot_);
-  state.insert("joint_pos",
-               Array::from_vector<float>({2}, {static_cast<float>(cart_position(world)),
-                                               static_cast<float>(pole_angle(world))}));
-  state.insert("joint_vel", Array::from_vector<float>(
-                                {2}, {static_cast<float>(qd[0]), static_cast<float>(qd[1])}));
+  state.set("joint_pos", {cart_position(world), pole_angle(world)});
+  state.set("joint_vel", qd);
 }
 
 double CartPoleTask::reward(const engine::World& world) const {

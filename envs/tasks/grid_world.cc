@@ -77,16 +77,17 @@ GridWorld::GridWorld(GridWorldConfig config)
   metadata_.render_fps = 4.0;
 }
 
-ResetResult GridWorld::do_reset(std::optional<std::uint64_t> /*seed*/, const Options& options) {
+void GridWorld::do_reset(std::optional<std::uint64_t> /*seed*/, const Options& options,
+                         ResetResult& out) {
   if (!options.empty()) {
     throw std::invalid_argument(name() + ": reset() takes no options, got \"" +
                                 options.begin()->first + "\"");
   }
   agent_ = kStart;
-  return {observe(), {}};
+  observe(out.obs);
 }
 
-StepResult GridWorld::do_step(const Value& action) {
+void GridWorld::do_step(const Value& action, StepResult& out) {
   Cell next = agent_;
   switch (static_cast<std::int64_t>(action.array().element_as_double(0))) {
     case kLeft:
@@ -107,22 +108,28 @@ StepResult GridWorld::do_step(const Value& action) {
   const bool on_grid = next.row >= 0 && next.row < kSize && next.col >= 0 && next.col < kSize;
   if (on_grid && !(next == kWall)) agent_ = next;
 
-  StepResult result;
-  result.obs = observe();
-  result.terminated = agent_ == kGoal;
-  result.reward = result.terminated ? kGoalReward : kStepReward;
-  return result;
+  observe(out.obs);
+  out.terminated = agent_ == kGoal;
+  out.reward = out.terminated ? kGoalReward : kStepReward;
 }
 
-Value GridWorld::observe() const {
-  if (config_.obs_mode == "pixels") return ValueDict{{"pixels", draw(config_.width, config_.height)}};
-  return Array::scalar<std::int64_t>(agent_.row * kSize + agent_.col);
+void GridWorld::observe(Value& obs) const {
+  if (config_.obs_mode == "pixels") {
+    draw(obs.dict().values()[0].array());
+  } else {
+    *obs.array().data<std::int64_t>() = agent_.row * kSize + agent_.col;
+  }
 }
 
-Array GridWorld::do_render() { return draw(config_.render_width, config_.render_height); }
+Array GridWorld::do_render() {
+  Array image(DType::kUInt8, {config_.render_height, config_.render_width, 3});
+  draw(image);
+  return image;
+}
 
-Array GridWorld::draw(int width, int height) const {
-  Array image(DType::kUInt8, {height, width, 3});
+void GridWorld::draw(Array& image) const {
+  const auto height = static_cast<int>(image.shape()[0]);
+  const auto width = static_cast<int>(image.shape()[1]);
   fill_rect(image, 0, height, 0, width, kLineColor);
   const int line = std::max(1, std::min(width, height) / 96);
   for (int row = 0; row < kSize; ++row) {
@@ -154,7 +161,6 @@ Array GridWorld::draw(int width, int height) const {
       }
     }
   }
-  return image;
 }
 
 EnvSpec GridWorld::spec_v0() {
@@ -165,6 +171,16 @@ EnvSpec GridWorld::spec_v0() {
   spec.max_episode_steps = kMaxEpisodeSteps;
   spec.factory = [](const Params& kwargs) {
     return std::make_unique<GridWorld>(GridWorldConfig::from_params(kwargs));
+  };
+  spec.describe = [](const Params& kwargs) {
+    // Building a GridWorld is cheap (no world, no GL): its spaces are the description.
+    const GridWorld env(GridWorldConfig::from_params(kwargs));
+    EnvDescription description;
+    description.observation_space = env.observation_space_;
+    description.action_space = env.action_space_;
+    description.metadata = env.metadata_;
+    description.max_episode_steps = kMaxEpisodeSteps;
+    return description;
   };
   return spec;
 }

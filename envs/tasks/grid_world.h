@@ -69,13 +69,15 @@ class GridWorld final : public Env {
 
  protected:
   std::string type_name() const override { return "GridWorld"; }
-  ResetResult do_reset(std::optional<std::uint64_t> seed, const Options& options) override;
-  StepResult do_step(const Value& action) override;
+  void do_reset(std::optional<std::uint64_t> seed, const Options& options,
+                ResetResult& out) override;
+  void do_step(const Value& action, StepResult& out) override;
   Array do_render() override;
 
  private:
-  Value observe() const;
-  Array draw(int width, int height) const;
+  void observe(Value& obs) const;
+  /// Draws the grid into an (H, W, 3) uint8 image.
+  void draw(Array& image) const;
 
   GridWorldConfig config_;
   SpacePtr observation_space_;

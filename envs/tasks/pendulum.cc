@@ -50,11 +50,9 @@ double PendulumTask::angular_velocity(const engine::World& world) const {
   return world.joint_velocities(robot_)[0];
 }
 
-void PendulumTask::observe(const engine::World& world, ValueDict& state) const {
-  state.insert("joint_pos",
-               Array::from_vector<float>({1}, {static_cast<float>(angle_from_upright(world))}));
-  state.insert("joint_vel",
-               Array::from_vector<float>({1}, {static_cast<float>(angular_velocity(world))}));
+void PendulumTask::observe(const engine::World& world, StateSlots& state) const {
+  state.set("joint_pos", {angle_from_upright(world)});
+  state.set("joint_vel", {angular_velocity(world)});
 }
 
 double PendulumTask::reward(const engine::World& world) const {

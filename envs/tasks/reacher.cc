@@ -64,16 +64,12 @@ Eigen::Vector3d ReacherTask::target(const engine::World& world) const {
   return world.body_pose(target_body_).translation();
 }
 
-void ReacherTask::observe(const engine::World& world, ValueDict& state) const {
+void ReacherTask::observe(const engine::World& world, StateSlots& state) const {
   const Eigen::VectorXd q = world.joint_positions(robot_);
   const Eigen::VectorXd qd = world.joint_velocities(robot_);
-  const Eigen::Vector3d to_target = target(world) - fingertip(world);
-  state.insert("joint_pos", Array::from_vector<float>({2}, {static_cast<float>(wrap_angle(q[0])),
-                                                            static_cast<float>(wrap_angle(q[1]))}));
-  state.insert("joint_vel", Array::from_vector<float>(
-                                {2}, {static_cast<float>(qd[0]), static_cast<float>(qd[1])}));
-  state.insert("to_target", Array::from_vector<float>({2}, {static_cast<float>(to_target.x()),
-                                                            static_cast<float>(to_target.y())}));
+  state.set("joint_pos", {wrap_angle(q[0]), wrap_angle(q[1])});
+  state.set("joint_vel", qd);
+  state.set("to_target", (target(world) - fingertip(world)).head<2>());
 }
 
 double ReacherTask::reward(const engine::World& world) const {

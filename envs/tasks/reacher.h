@@ -29,7 +29,7 @@ class ReacherTask final : public Task {
   render::Camera camera(const std::string& name, const engine::World& world) const override;
   void initialize_episode(engine::World& world, Rng& rng) override;
   void before_step(const Value& action, engine::World& world) override;
-  void observe(const engine::World& world, ValueDict& state) const override;
+  void observe(const engine::World& world, StateSlots& state) const override;
   double reward(const engine::World& world) const override;
 
   Eigen::Vector3d fingertip(const engine::World& world) const;

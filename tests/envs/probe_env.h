@@ -77,27 +77,26 @@ class ProbeEnv final : public Env {
  protected:
   std::string type_name() const override { return "ProbeEnv"; }
 
-  ResetResult do_reset(std::optional<std::uint64_t> seed, const Options& /*options*/) override {
+  void do_reset(std::optional<std::uint64_t> seed, const Options& /*options*/,
+                ResetResult& out) override {
     if (fault_ == Fault::kUnseededResetReseeds && !seed) rng() = Rng(7);
     x_ = fault_ == Fault::kResetIgnoresSeed ? os_uniform() : rng().uniform(-1.0, 1.0);
     t_ = 0;
-    Value obs = observe();
+    observe(out.obs);
+    // A broken env may put an array of its own in place of the caller's buffer.
     if (fault_ == Fault::kResetObservationWrongDtype) {
-      obs = Array::from_vector<double>({2}, {x_, 0.0});
+      out.obs = Array::from_vector<double>({2}, {x_, 0.0});
     }
-    return {obs, {}};
   }
 
-  StepResult do_step(const Value& action) override {
+  void do_step(const Value& action, StepResult& out) override {
     x_ += 0.1 * action.array().data<float>()[0];
     if (fault_ == Fault::kNondeterministicStep) x_ += 1e-3 * os_uniform();
     if (fault_ == Fault::kStepObservationOutside && t_ == 2) x_ = 100.0;
     ++t_;
-    StepResult result;
-    result.obs = observe();
-    result.reward = fault_ == Fault::kNanReward ? std::nan("") : -std::abs(x_);
-    result.terminated = t_ >= episode_length_;
-    return result;
+    observe(out.obs);
+    out.reward = fault_ == Fault::kNanReward ? std::nan("") : -std::abs(x_);
+    out.terminated = t_ >= episode_length_;
   }
 
   Array do_render() override {
@@ -117,15 +116,14 @@ class ProbeEnv final : public Env {
     return std::uniform_real_distribution<double>(-1.0, 1.0)(device);
   }
 
-  Value observe() {
+  void observe(Value& obs) {
     if (fault_ == Fault::kAliasedObservation) {
       if (shared_obs_.size() != 2) shared_obs_ = Array(DType::kFloat32, {2});
-      shared_obs_.data<float>()[0] = static_cast<float>(x_);
-      shared_obs_.data<float>()[1] = static_cast<float>(t_) / 100.0F;
-      return shared_obs_;
+      obs = shared_obs_;  // every step hands out the same memory
     }
-    return Array::from_vector<float>({2},
-                                     {static_cast<float>(x_), static_cast<float>(t_) / 100.0F});
+    float* out = obs.array().data<float>();
+    out[0] = static_cast<float>(x_);
+    out[1] = static_cast<float>(t_) / 100.0F;
   }
 
   Fault fault_;

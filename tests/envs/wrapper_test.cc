@@ -21,10 +21,8 @@ class DoubleObservation final : public ObservationWrapper {
 
  protected:
   std::string type_name() const override { return "DoubleObservation"; }
-  Value observation(const Value& obs) override {
-    Array doubled = obs.array().clone();
-    for (int i = 0; i < 2; ++i) doubled.data<float>()[i] *= 2.0F;
-    return doubled;
+  void observation(const Value& obs, Value& out) override {
+    for (int i = 0; i < 2; ++i) out.array().data<float>()[i] = 2.0F * obs.array().data<float>()[i];
   }
 };
 
@@ -36,8 +34,8 @@ class ScaleAction final : public ActionWrapper {
   }
 
  protected:
-  Value action(const Value& a) override {
-    return testing::action(a.array().data<float>()[0] / 10.0F);
+  void action(const Value& a, Value& out) override {
+    out.array().data<float>()[0] = a.array().data<float>()[0] / 10.0F;
   }
 };
 
