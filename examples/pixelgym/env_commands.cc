@@ -5,10 +5,14 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <sstream>
 
 #include "envs/checker.h"
 #include "envs/registry.h"
 #include "envs/rollout.h"
+#include "envs/spaces/box.h"
+#include "envs/spaces/dict.h"
+#include "envs/spaces/discrete.h"
 #include "examples/pixelgym/cli.h"
 
 namespace pixelgym::cli {
@@ -66,17 +70,77 @@ struct InfoArguments {
   std::vector<std::string> sets;
 };
 
+std::string number(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+// A Box's valid range: "[low, high]" when every element shares it, else each element's.
+std::string box_range(const spaces::Box& box) {
+  const auto& low = box.low();
+  const auto& high = box.high();
+  const bool uniform =
+      std::all_of(low.begin(), low.end(), [&](double v) { return v == low[0]; }) &&
+      std::all_of(high.begin(), high.end(), [&](double v) { return v == high[0]; });
+  if (uniform && !low.empty()) return "[" + number(low[0]) + ", " + number(high[0]) + "]";
+  std::string text;
+  for (std::size_t i = 0; i < low.size(); ++i) {
+    text += (i == 0 ? "" : ", ") + std::string("[") + number(low[i]) + ", " + number(high[i]) + "]";
+  }
+  return "per element " + text;
+}
+
+// One row per observation key (one for the whole observation when it is not a Dict): the key,
+// dtype, shape and valid range.
+std::vector<std::vector<std::string>> observation_rows(const Space& space) {
+  const auto row = [](const std::string& key, const Space& sub) {
+    std::string range = sub.to_string();
+    if (const auto* box = dynamic_cast<const spaces::Box*>(&sub)) range = box_range(*box);
+    if (const auto* discrete = dynamic_cast<const spaces::Discrete*>(&sub)) {
+      range = "{" + std::to_string(discrete->start()) + ", ..., " +
+              std::to_string(discrete->start() + discrete->n() - 1) + "}";
+    }
+    return std::vector<std::string>{key, sub.dtype() ? dtype_name(*sub.dtype()) : "",
+                                    sub.shape() ? shape_to_string(*sub.shape()) : "", range};
+  };
+  std::vector<std::vector<std::string>> rows = {{"key", "dtype", "shape", "valid range"}};
+  if (const auto* dict = dynamic_cast<const spaces::Dict*>(&space)) {
+    for (const auto& [key, sub] : dict->entries()) rows.push_back(row(key, *sub));
+  } else {
+    rows.push_back(row("(all)", space));
+  }
+  return rows;
+}
+
+// From the spec and Registry::describe alone: no env, Bullet world or GL context is built.
 int run_info(const InfoArguments& args) {
-  std::unique_ptr<Env> env = make_env(args.id, args.sets);  // first: an unknown id is a usage error
+  const Params kwargs = parse_sets(args.id, args.sets);
+  EnvDescription description;
+  try {
+    description = describe(args.id, kwargs);
+  } catch (const std::invalid_argument& error) {
+    throw UsageError(error.what());  // the kwargs: an unknown key, a value out of range
+  }
   const auto spec = default_registry().spec(args.id);
-  const std::string max_steps =
-      spec->max_episode_steps ? std::to_string(*spec->max_episode_steps) : "none";
+  const auto limit = [](const std::optional<std::int64_t>& steps) {
+    return steps ? std::to_string(*steps) : std::string("none");
+  };
+  std::string cameras = "none";
+  if (!description.cameras.empty()) {
+    cameras = description.cameras[0] + " (default)";
+    for (std::size_t i = 1; i < description.cameras.size(); ++i) {
+      cameras += ", " + description.cameras[i];
+    }
+  }
   std::cout << args.id << ": " << spec->description << "\n"
-            << "observation_space: " << env->observation_space().to_string() << "\n"
-            << "action_space:      " << env->action_space().to_string() << "\n"
-            << "render_modes:      " << join(env->metadata().render_modes) << "\n"
-            << "render_fps:        " << env->metadata().render_fps << "\n"
-            << "max_episode_steps: " << max_steps << "\n"
+            << "observation_space: " << description.observation_space->to_string() << "\n";
+  print_table(std::cout, observation_rows(*description.observation_space), "  ");
+  std::cout << "action_space:      " << description.action_space->to_string() << "\n"
+            << "cameras:           " << cameras << "\n"
+            << "render_modes:      " << join(description.metadata.render_modes) << "\n"
+            << "render_fps:        " << description.metadata.render_fps << "\n"
+            << "max_episode_steps: " << limit(description.max_episode_steps) << "\n"
             << "config (--set key=value):\n";
   std::vector<std::vector<std::string>> rows = {{"key", "type", "default", "description"}};
   for (const ParamSpec& param : spec->params) {
@@ -87,7 +151,6 @@ int run_info(const InfoArguments& args) {
                   spec->max_episode_steps ? std::to_string(*spec->max_episode_steps) : "0",
                   "steps before TimeLimit truncates; 0 for no limit"});
   print_table(std::cout, rows, "  ");
-  env->close();
   return 0;
 }
 

@@ -34,8 +34,9 @@ struct CliRun {
   std::string output;  // stdout and stderr
 };
 
-CliRun run(const std::string& arguments) {
-  const std::string command = std::string(PIXELGYM_CLI) + " " + arguments + " 2>&1";
+// Runs `pixelgym ARGUMENTS`, with `environment` ("NAME=value ...") set for it.
+CliRun run(const std::string& arguments, const std::string& environment = "") {
+  const std::string command = environment + " " + PIXELGYM_CLI + " " + arguments + " 2>&1";
   std::FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) return {-1, "popen failed"};
   std::string output;
@@ -95,6 +96,50 @@ TEST(PixelgymCliTest, InfoShowsSpacesAndConfigKeys) {
   EXPECT_THAT(result.output, HasSubstr("action_space:      Discrete(4)"));
   EXPECT_THAT(result.output, HasSubstr("render_width"));
   EXPECT_THAT(result.output, HasSubstr("max_episode_steps: 50"));
+}
+
+// info answers from the spec (Registry::describe): with OpenGL broken (GALLIUM_DRIVER names no
+// driver, so creating a context fails or crashes, as the snapshot shows) it still prints every
+// env's spaces, each observation key's range, the cameras and the time limit.
+TEST(PixelgymCliTest, InfoShowsRangesCamerasAndLimitsWithoutOpenGl) {
+  const std::string broken_gl = "GALLIUM_DRIVER=no-such-driver";
+  EXPECT_NE(
+      run("snapshot CartPoleSwingup-v0 --out " + fresh_output("no_gl.png"), broken_gl).exit_code,
+      0);
+  for (const std::string& id : registered_ids()) {
+    const CliRun result = run("info " + id, broken_gl);
+    ASSERT_EQ(result.exit_code, 0) << id << ": " << result.output;
+    const EnvDescription description = describe(id);
+    EXPECT_THAT(
+        result.output,
+        HasSubstr("observation_space: " + description.observation_space->to_string() + "\n"));
+    if (description.cameras.empty()) {
+      EXPECT_THAT(result.output, HasSubstr("cameras:           none\n")) << id;
+    } else {
+      EXPECT_THAT(result.output,
+                  HasSubstr("cameras:           " + description.cameras[0] + " (default)"))
+          << id;
+      for (const std::string& camera : description.cameras) {
+        EXPECT_THAT(result.output, HasSubstr(camera)) << id;
+      }
+    }
+    ASSERT_TRUE(description.max_episode_steps.has_value()) << id;
+    EXPECT_THAT(
+        result.output,
+        HasSubstr("max_episode_steps: " + std::to_string(*description.max_episode_steps) + "\n"));
+  }
+  const std::string cartpole = run("info CartPoleSwingup-v0", broken_gl).output;
+  EXPECT_THAT(cartpole,
+              ::testing::ContainsRegex("\n  pixels +uint8 +\\(84, 84, 3\\) +\\[0, 255\\]\n"));
+  EXPECT_THAT(cartpole,
+              ::testing::ContainsRegex("\n  joint_pos +float32 +\\(2,\\) +\\[-inf, inf\\]\n"));
+  EXPECT_THAT(run("info GridWorld-v0").output,
+              ::testing::ContainsRegex("\n  \\(all\\) +int64 +\\(\\) +\\{0, \\.\\.\\., 15\\}\n"));
+  // The limit follows the kwargs: 1000 control steps at action_repeat 4 are 250 env steps.
+  EXPECT_THAT(run("info CartPoleSwingup-v0 --set action_repeat=4", broken_gl).output,
+              HasSubstr("max_episode_steps: 250\n"));
+  EXPECT_THAT(run("info GridWorld-v0 --set max_episode_steps=7").output,
+              HasSubstr("max_episode_steps: 7\n"));
 }
 
 // Each config row's cells start where the header's do, after at least two spaces: a long default
