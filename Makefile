@@ -1,13 +1,15 @@
 # The two commands of the README. Both install what is missing, then configure and build
 # (Release, in build/), then run.
 #   make demo   the main job
-#   make test   every test, through ctest
+#   make test   every test, through ctest (FormatCheck among them: see format-check)
+#   make format-check   the project's C++ files against .clang-format (clang-format 14); exits 1
+#                       naming the files that differ. `make format` rewrites them.
 BUILD_DIR ?= build
 BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 PIXELGYM := $(BUILD_DIR)/examples/pixelgym
 
-.PHONY: all deps configure build demo test goldens bench clean
+.PHONY: all deps configure build demo test format-check format goldens bench clean
 
 all: build
 
@@ -27,6 +29,15 @@ demo: build
 
 test: build
 	ctest --test-dir $(BUILD_DIR) --output-on-failure --parallel $(JOBS)
+
+# CI runs `make test`, which runs this same check as the ctest test FormatCheck
+# (tests/examples/CMakeLists.txt): it then shows in ctest's summary beside the other tests, and a
+# formatting slip does not stop the real tests from running and reporting.
+format-check: deps
+	scripts/format-check.sh
+
+format: deps
+	scripts/format-check.sh --fix
 
 goldens: build
 	PIXELGYM_UPDATE_GOLDENS=1 ctest --test-dir $(BUILD_DIR) -R Golden --output-on-failure

@@ -5,6 +5,8 @@
 #include <functional>
 #include <sstream>
 
+#include "envs/rollout.h"
+
 namespace pixelgym {
 namespace {
 
@@ -31,19 +33,16 @@ struct Transition {
   bool truncated;
 };
 
-// reset(seed), then `num_steps` actions from a generator seeded with `seed`, resetting (unseeded)
-// when an episode ends. Every transition is recorded; observations are checked as they come.
+// RandomRollout over `num_steps` steps, every transition recorded: the reset's observation, each
+// step's, and the new episode's first after an episode ends.
 std::vector<Transition> rollout(Env& env, std::uint64_t seed, int num_steps) {
   std::vector<Transition> trajectory;
-  Rng action_rng(seed);
-  Value obs = env.reset(seed).obs;
-  trajectory.push_back({obs, 0.0, false, false});
+  RandomRollout random(env, seed);
+  trajectory.push_back({random.observation(), 0.0, false, false});
   for (int t = 0; t < num_steps; ++t) {
-    const Value action = env.action_space().sample(action_rng);
-    StepResult step = env.step(action);
+    const StepResult& step = random.step();
     trajectory.push_back({step.obs, step.reward, step.terminated, step.truncated});
-    if (step.terminated || step.truncated)
-      trajectory.push_back({env.reset().obs, 0.0, false, false});
+    if (random.episode_ended()) trajectory.push_back({random.observation(), 0.0, false, false});
   }
   return trajectory;
 }

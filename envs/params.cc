@@ -71,7 +71,8 @@ std::string Param::to_string() const {
 
 Param parse_param(ParamType type, const std::string& text) {
   const auto fail = [&] {
-    return std::invalid_argument("cannot read \"" + text + "\" as a " + param_type_name(type));
+    return std::invalid_argument("cannot read \"" + text + "\" as " +
+                                 (type == ParamType::kInt ? "an " : "a ") + param_type_name(type));
   };
   switch (type) {
     case ParamType::kBool: {

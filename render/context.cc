@@ -70,4 +70,11 @@ std::string Context::description() {
          (version != nullptr ? version : "?");
 }
 
+int Context::max_samples() {
+  make_current();
+  GLint samples = 0;
+  glGetIntegerv(GL_MAX_SAMPLES, &samples);
+  return samples;
+}
+
 }  // namespace pixelgym::render

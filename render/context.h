@@ -36,6 +36,9 @@ class Context {
   /// GL_RENDERER and GL_VERSION, e.g. "llvmpipe (LLVM 15.0.6, 256 bits), 4.5 (Core Profile)
   /// Mesa 22.3.6".
   std::string description();
+  /// GL_MAX_SAMPLES: the most samples per pixel a multisampled render target (and so
+  /// Camera::msaa_samples) may have in this context; 4 on llvmpipe.
+  int max_samples();
 
  private:
   struct Impl;

@@ -8,6 +8,8 @@ set -euo pipefail
 PACKAGES=(
   # toolchain
   cmake g++ make pkg-config ccache
+  # make format-check (clang-format 14 on Debian 12)
+  clang-format
   # engine: physics, URDF parsing, mesh import, linear algebra
   libbullet-dev liburdfdom-dev libconsole-bridge-dev libtinyxml-dev libassimp-dev libeigen3-dev
   # render: off-screen OpenGL (llvmpipe) and PNG files

@@ -1,12 +1,66 @@
 #include "examples/pixelgym/cli.h"
 
 #include <algorithm>
+#include <cctype>
+#include <charconv>
 #include <filesystem>
+#include <limits>
 
 #include "envs/registry.h"
 #include "render/image_io.h"
 
 namespace pixelgym::cli {
+namespace {
+
+// Whether `text` is wholly a decimal integer of type T (no sign for unsigned T, no spaces).
+template <typename T>
+bool parse_integer(const std::string& text, T& value) {
+  const char* end = text.data() + text.size();
+  const auto [stop, error] = std::from_chars(text.data(), end, value);
+  return error == std::errc() && stop == end && !text.empty();
+}
+
+}  // namespace
+
+CLI::Validator integer_in(int min, int max) {
+  const bool unbounded = max == std::numeric_limits<int>::max();
+  return CLI::Validator(
+      [min, max](std::string& text) -> std::string {
+        int value = 0;
+        if (parse_integer(text, value) && value >= min && value <= max) return "";
+        return "must be an integer from " + std::to_string(min) + " to " + std::to_string(max) +
+               ", got \"" + text + "\"";
+      },
+      unbounded ? ">= " + std::to_string(min) : std::to_string(min) + " to " + std::to_string(max));
+}
+
+void add_seed_option(CLI::App& command, std::uint64_t& seed, const std::string& description) {
+  const CLI::Validator unsigned_64(
+      [](std::string& text) -> std::string {
+        std::uint64_t value = 0;
+        if (parse_integer(text, value)) return "";
+        return "must be an integer from 0 to " +
+               std::to_string(std::numeric_limits<std::uint64_t>::max()) + ", got \"" + text + "\"";
+      },
+      "");
+  seed = 0;
+  command.add_option("--seed", seed, description)
+      ->type_name("UINT64")
+      ->capture_default_str()
+      ->check(unsigned_64);
+}
+
+CLI::Validator png_path() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        std::string extension = std::filesystem::path(text).extension().string();
+        std::transform(extension.begin(), extension.end(), extension.begin(),
+                       [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+        if (extension == ".png") return "";
+        return "pixelgym writes PNG only: the file name must end in .png, got \"" + text + "\"";
+      },
+      "");
+}
 
 void add_set_option(CLI::App& command, std::vector<std::string>& sets) {
   command
@@ -16,7 +70,12 @@ void add_set_option(CLI::App& command, std::vector<std::string>& sets) {
 }
 
 Params parse_sets(const std::string& id, const std::vector<std::string>& sets) {
-  const auto spec = default_registry().spec(id);
+  std::shared_ptr<const EnvSpec> spec;
+  try {
+    spec = default_registry().spec(id);
+  } catch (const std::invalid_argument& error) {
+    throw UsageError(error.what());  // an unknown id, with the registered ids closest to it
+  }
   Params params;
   for (const std::string& entry : sets) {
     const std::size_t equals = entry.find('=');
@@ -33,14 +92,19 @@ Params parse_sets(const std::string& id, const std::vector<std::string>& sets) {
     try {
       params.insert_or_assign(key, parse_param(type, text));
     } catch (const std::invalid_argument& error) {
-      throw std::invalid_argument(id + ": --set " + key + ": " + error.what());
+      throw UsageError(id + ": --set " + key + ": " + error.what());
     }
   }
   return params;
 }
 
 std::unique_ptr<Env> make_env(const std::string& id, const std::vector<std::string>& sets) {
-  return make(id, parse_sets(id, sets));
+  const Params kwargs = parse_sets(id, sets);
+  try {
+    return make(id, kwargs);
+  } catch (const std::invalid_argument& error) {
+    throw UsageError(error.what());  // the kwargs: an unknown key, a value out of range
+  }
 }
 
 void write_frame_png(const std::string& path, const Array& frame) {
@@ -55,7 +119,7 @@ void write_frame_png(const std::string& path, const Array& frame) {
       throw std::runtime_error("cannot create folder " + parent.string() + ": " + error.message());
   }
   render::write_png(path, {frame.data<std::uint8_t>(), static_cast<int>(frame.shape()[0]),
-                   static_cast<int>(frame.shape()[1]), 3});
+                           static_cast<int>(frame.shape()[1]), 3});
 }
 
 }  // namespace pixelgym::cli

@@ -2,8 +2,11 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -13,25 +16,39 @@
 
 namespace pixelgym::cli {
 
-/// Exit codes: 0 success, 1 the command ran and failed (an env error, a failed check), 2 usage.
+/// Exit codes: 0 success; 1 the command ran and failed (an env error, a failed check, a file that
+/// cannot be read or written); 2 a usage error (a malformed command line, an unknown subcommand,
+/// env id or kwarg, a value out of range, an env config that `make` refuses).
 constexpr int kExitFailure = 1;
 constexpr int kExitUsage = 2;
 
-/// Thrown for a malformed command line that CLI11 cannot catch itself (a --set without '=').
+/// Thrown for a command line that parses but cannot be used (an unknown env id, a --set without
+/// '=', a kwarg the env refuses): main prints it with the subcommand's usage and exits 2.
 class UsageError : public std::invalid_argument {
  public:
   using std::invalid_argument::invalid_argument;
 };
+
+/// Accepts a whole decimal integer in [min, max] (for an int option); otherwise the option fails
+/// with "must be an integer from MIN to MAX, got "TEXT"". Help shows the range.
+CLI::Validator integer_in(int min, int max = std::numeric_limits<int>::max());
+
+/// Adds `--seed N` (default 0, any unsigned 64-bit integer; "-1" is refused, not wrapped around).
+void add_seed_option(CLI::App& command, std::uint64_t& seed, const std::string& description);
+
+/// Accepts a path ending in ".png" (any case): pixelgym writes PNG only.
+CLI::Validator png_path();
 
 /// Adds the repeatable `--set key=value` option to `command`.
 void add_set_option(CLI::App& command, std::vector<std::string>& sets);
 
 /// Turns `--set key=value` strings into kwargs typed by env `id`'s declared params (a key the env
 /// does not declare is passed as a string, so that `make` reports it with the valid keys).
-/// Throws UsageError for an entry without '=' and std::invalid_argument for an unreadable value.
+/// Throws UsageError for an unknown id, an entry without '=' or an unreadable value.
 Params parse_sets(const std::string& id, const std::vector<std::string>& sets);
 
-/// `make(id, parse_sets(id, sets))`.
+/// `make(id, parse_sets(id, sets))`; a config `make` refuses (std::invalid_argument: an unknown
+/// kwarg, a value out of range) is rethrown as UsageError.
 std::unique_ptr<Env> make_env(const std::string& id, const std::vector<std::string>& sets);
 
 /// Writes an (H, W, 3) uint8 frame as PNG, creating missing parent folders.
@@ -43,8 +60,8 @@ struct Command {
   std::function<int()> run;
 };
 
-/// Adds list, info, check, snapshot and rollout to `app`. The options they parse into live as
-/// long as the returned commands.
+/// Adds list, info, check, snapshot, rollout and bench to `app`. Each subcommand parses into
+/// options of its own, which live as long as the returned commands.
 std::vector<Command> add_env_commands(CLI::App& app);
 
 /// Adds inspect to `app`.

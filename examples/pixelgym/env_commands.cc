@@ -1,7 +1,7 @@
 // pixelgym list | info | check | snapshot | rollout | bench
+#include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -9,6 +9,10 @@
 
 #include "envs/checker.h"
 #include "envs/registry.h"
+#include "envs/rollout.h"
+#include "envs/spaces/box.h"
+#include "envs/spaces/dict.h"
+#include "envs/spaces/discrete.h"
 #include "examples/pixelgym/cli.h"
 
 namespace pixelgym::cli {
@@ -20,42 +24,157 @@ std::string join(const std::vector<std::string>& items) {
   return text;
 }
 
-int run_list() {
-  for (const std::string& id : registered_ids()) {
-    std::cout << std::left << std::setw(28) << id << " " << default_registry().spec(id)->description
-              << "\n";
+// Rows printed as left-aligned columns as wide as their widest cell, two spaces apart; the last
+// column is not padded.
+void print_table(std::ostream& out, const std::vector<std::vector<std::string>>& rows,
+                 const std::string& indent) {
+  std::vector<std::size_t> widths;
+  for (const auto& row : rows) {
+    widths.resize(std::max(widths.size(), row.size()));
+    for (std::size_t i = 0; i < row.size(); ++i) widths[i] = std::max(widths[i], row[i].size());
   }
-  return 0;
+  for (const auto& row : rows) {
+    std::string line = indent;
+    for (std::size_t i = 0; i < row.size(); ++i) {
+      line += row[i];
+      if (i + 1 < row.size()) line += std::string(widths[i] - row[i].size() + 2, ' ');
+    }
+    out << line << "\n";
+  }
 }
 
-int run_info(const std::string& id, const std::vector<std::string>& sets) {
-  const auto spec = default_registry().spec(id);
-  std::unique_ptr<Env> env = make_env(id, sets);
-  std::cout << id << ": " << spec->description << "\n"
-            << "observation_space: " << env->observation_space().to_string() << "\n"
-            << "action_space:      " << env->action_space().to_string() << "\n"
-            << "render_modes:      " << join(env->metadata().render_modes) << "\n"
-            << "render_fps:        " << env->metadata().render_fps << "\n"
-            << "max_episode_steps: "
-            << (spec->max_episode_steps ? std::to_string(*spec->max_episode_steps) : "none") << "\n"
+void add_id_argument(CLI::App& command, std::string& id, const std::string& example) {
+  command.add_option("id", id, "Env id, e.g. " + example + " (`pixelgym list` shows them)")
+      ->required();
+}
+
+// --- list ---
+
+Command add_list(CLI::App& app) {
+  CLI::App* list =
+      app.add_subcommand("list", "List the registered env ids, one per line with a description");
+  return {list, [] {
+            std::vector<std::vector<std::string>> rows;
+            for (const std::string& id : registered_ids()) {
+              rows.push_back({id, default_registry().spec(id)->description});
+            }
+            print_table(std::cout, rows, "");
+            return 0;
+          }};
+}
+
+// --- info ---
+
+struct InfoArguments {
+  std::string id;
+  std::vector<std::string> sets;
+};
+
+std::string number(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+// A Box's valid range: "[low, high]" when every element shares it, else each element's.
+std::string box_range(const spaces::Box& box) {
+  const auto& low = box.low();
+  const auto& high = box.high();
+  const bool uniform =
+      std::all_of(low.begin(), low.end(), [&](double v) { return v == low[0]; }) &&
+      std::all_of(high.begin(), high.end(), [&](double v) { return v == high[0]; });
+  if (uniform && !low.empty()) return "[" + number(low[0]) + ", " + number(high[0]) + "]";
+  std::string text;
+  for (std::size_t i = 0; i < low.size(); ++i) {
+    text += (i == 0 ? "" : ", ") + std::string("[") + number(low[i]) + ", " + number(high[i]) + "]";
+  }
+  return "per element " + text;
+}
+
+// One row per observation key (one for the whole observation when it is not a Dict): the key,
+// dtype, shape and valid range.
+std::vector<std::vector<std::string>> observation_rows(const Space& space) {
+  const auto row = [](const std::string& key, const Space& sub) {
+    std::string range = sub.to_string();
+    if (const auto* box = dynamic_cast<const spaces::Box*>(&sub)) range = box_range(*box);
+    if (const auto* discrete = dynamic_cast<const spaces::Discrete*>(&sub)) {
+      range = "{" + std::to_string(discrete->start()) + ", ..., " +
+              std::to_string(discrete->start() + discrete->n() - 1) + "}";
+    }
+    return std::vector<std::string>{key, sub.dtype() ? dtype_name(*sub.dtype()) : "",
+                                    sub.shape() ? shape_to_string(*sub.shape()) : "", range};
+  };
+  std::vector<std::vector<std::string>> rows = {{"key", "dtype", "shape", "valid range"}};
+  if (const auto* dict = dynamic_cast<const spaces::Dict*>(&space)) {
+    for (const auto& [key, sub] : dict->entries()) rows.push_back(row(key, *sub));
+  } else {
+    rows.push_back(row("(all)", space));
+  }
+  return rows;
+}
+
+// From the spec and Registry::describe alone: no env, Bullet world or GL context is built.
+int run_info(const InfoArguments& args) {
+  const Params kwargs = parse_sets(args.id, args.sets);
+  EnvDescription description;
+  try {
+    description = describe(args.id, kwargs);
+  } catch (const std::invalid_argument& error) {
+    throw UsageError(error.what());  // the kwargs: an unknown key, a value out of range
+  }
+  const auto spec = default_registry().spec(args.id);
+  const auto limit = [](const std::optional<std::int64_t>& steps) {
+    return steps ? std::to_string(*steps) : std::string("none");
+  };
+  std::string cameras = "none";
+  if (!description.cameras.empty()) {
+    cameras = description.cameras[0] + " (default)";
+    for (std::size_t i = 1; i < description.cameras.size(); ++i) {
+      cameras += ", " + description.cameras[i];
+    }
+  }
+  std::cout << args.id << ": " << spec->description << "\n"
+            << "observation_space: " << description.observation_space->to_string() << "\n";
+  print_table(std::cout, observation_rows(*description.observation_space), "  ");
+  std::cout << "action_space:      " << description.action_space->to_string() << "\n"
+            << "cameras:           " << cameras << "\n"
+            << "render_modes:      " << join(description.metadata.render_modes) << "\n"
+            << "render_fps:        " << description.metadata.render_fps << "\n"
+            << "max_episode_steps: " << limit(description.max_episode_steps) << "\n"
             << "config (--set key=value):\n";
+  std::vector<std::vector<std::string>> rows = {{"key", "type", "default", "description"}};
   for (const ParamSpec& param : spec->params) {
-    std::cout << "  " << std::left << std::setw(18) << param.name << std::setw(8)
-              << param_type_name(param.type()) << "default " << std::setw(10)
-              << param.default_value.to_string() << param.doc << "\n";
+    rows.push_back(
+        {param.name, param_type_name(param.type()), param.default_value.to_string(), param.doc});
   }
-  std::cout << "  " << std::left << std::setw(18) << "max_episode_steps" << std::setw(8) << "int"
-            << "default " << std::setw(10)
-            << (spec->max_episode_steps ? std::to_string(*spec->max_episode_steps) : "0")
-            << "steps before TimeLimit truncates; 0 for no limit\n";
-  env->close();
+  rows.push_back({"max_episode_steps", "int",
+                  spec->max_episode_steps ? std::to_string(*spec->max_episode_steps) : "0",
+                  "steps before TimeLimit truncates; 0 for no limit"});
+  print_table(std::cout, rows, "  ");
   return 0;
 }
 
-int run_check(const std::string& id, std::uint64_t seed, int steps,
-              const std::vector<std::string>& sets) {
-  std::unique_ptr<Env> env = make_env(id, sets);
-  const CheckReport report = check_env(*env, {seed, steps});
+Command add_info(CLI::App& app) {
+  auto args = std::make_shared<InfoArguments>();
+  CLI::App* info = app.add_subcommand(
+      "info", "Show an env's spaces, metadata and config keys (types, defaults)");
+  add_id_argument(*info, args->id, "GridWorld-v0");
+  add_set_option(*info, args->sets);
+  return {info, [args] { return run_info(*args); }};
+}
+
+// --- check ---
+
+struct CheckArguments {
+  std::string id;
+  std::uint64_t seed = 0;
+  int steps = 100;
+  std::vector<std::string> sets;
+};
+
+int run_check(const CheckArguments& args) {
+  std::unique_ptr<Env> env = make_env(args.id, args.sets);
+  const CheckReport report = check_env(*env, {args.seed, args.steps});
   for (const CheckResult& result : report.results) {
     std::cout << (result.passed ? "ok    " : "FAIL  ") << result.name;
     if (!result.passed) std::cout << ": " << result.reason;
@@ -63,194 +182,174 @@ int run_check(const std::string& id, std::uint64_t seed, int steps,
   }
   const std::size_t failed = report.failures().size();
   if (failed == 0) {
-    std::cout << id << ": all " << report.results.size() << " checks passed\n";
+    std::cout << args.id << ": all " << report.results.size() << " checks passed\n";
     return 0;
   }
-  std::cout << id << ": " << failed << " of " << report.results.size() << " checks failed\n";
+  std::cout << args.id << ": " << failed << " of " << report.results.size() << " checks failed\n";
   return kExitFailure;
 }
 
-int run_snapshot(const std::string& id, std::uint64_t seed, int steps, const std::string& out,
-                 bool observation, const std::vector<std::string>& sets) {
-  std::unique_ptr<Env> env = make_env(id, sets);
-  Value obs = env->reset(seed).obs;
-  Rng action_rng(seed);
-  for (int t = 0; t < steps; ++t) {
-    const StepResult step = env->step(env->action_space().sample(action_rng));
-    obs = step.obs;
-    if (step.terminated || step.truncated) obs = env->reset().obs;
-  }
+Command add_check(CLI::App& app) {
+  auto args = std::make_shared<CheckArguments>();
+  CLI::App* check = app.add_subcommand(
+      "check",
+      "Run the env checker; exit 0 when every check passes, 1 otherwise (failures printed)");
+  add_id_argument(*check, args->id, "GridWorld-v0");
+  add_seed_option(*check, args->seed, "Seed for resets and random actions");
+  check->add_option("--steps", args->steps, "Random steps per checked trajectory")
+      ->capture_default_str()
+      ->check(integer_in(1));
+  add_set_option(*check, args->sets);
+  return {check, [args] { return run_check(*args); }};
+}
+
+// --- snapshot ---
+
+struct SnapshotArguments {
+  std::string id;
+  std::uint64_t seed = 0;
+  int steps = 0;
+  std::string out;
+  bool observation = false;
+  std::vector<std::string> sets;
+};
+
+int run_snapshot(const SnapshotArguments& args) {
+  std::unique_ptr<Env> env = make_env(args.id, args.sets);
+  RandomRollout random(*env, args.seed);
+  for (int t = 0; t < args.steps; ++t) random.step();
   Array frame;
-  if (observation) {
+  if (args.observation) {
+    const Value& obs = random.observation();
     if (!obs.is_dict() || !obs.dict().contains("pixels")) {
-      throw std::invalid_argument(
-          id + ": --observation needs an observation with \"pixels\" (try --set obs_mode=pixels)");
+      throw UsageError(args.id +
+                       ": --observation needs an observation with \"pixels\" (try --set "
+                       "obs_mode=pixels)");
     }
     frame = obs.dict().at("pixels").array();
   } else {
     frame = env->render();
   }
-  write_frame_png(out, frame);
-  std::cout << "wrote " << out << " (" << frame.shape()[1] << "x" << frame.shape()[0] << " "
-            << (observation ? "observation" : "render()") << ", " << id << ", seed " << seed << ", "
-            << steps << " steps)\n";
+  write_frame_png(args.out, frame);
+  std::cout << "wrote " << args.out << " (" << frame.shape()[1] << "x" << frame.shape()[0] << " "
+            << (args.observation ? "observation" : "render()") << ", " << args.id << ", seed "
+            << args.seed << ", " << args.steps << " steps)\n";
   env->close();
   return 0;
 }
 
-int run_rollout(const std::string& id, std::uint64_t seed, int episodes,
-                const std::string& snapshot, const std::vector<std::string>& sets) {
-  std::unique_ptr<Env> env = make_env(id, sets);
-  Rng action_rng(seed);
+Command add_snapshot(CLI::App& app) {
+  auto args = std::make_shared<SnapshotArguments>();
+  CLI::App* snapshot = app.add_subcommand("snapshot",
+                                          "Reset with a seed, take K seeded random actions, write "
+                                          "render() (or the observation) as a PNG");
+  add_id_argument(*snapshot, args->id, "GridWorld-v0");
+  add_seed_option(*snapshot, args->seed, "Seed for the reset and the random actions");
+  snapshot->add_option("--out", args->out, "PNG file to write (folders are created; PNG only)")
+      ->required()
+      ->check(png_path());
+  snapshot->add_option("--steps", args->steps, "Random actions before the frame is taken")
+      ->capture_default_str()
+      ->check(integer_in(0));
+  snapshot->add_flag(
+      "--observation", args->observation,
+      "Write the observation's \"pixels\" (what the agent sees) instead of render()");
+  add_set_option(*snapshot, args->sets);
+  return {snapshot, [args] { return run_snapshot(*args); }};
+}
+
+// --- rollout ---
+
+struct RolloutArguments {
+  std::string id;
+  std::uint64_t seed = 0;
+  int episodes = 5;
+  std::string snapshot;
+  std::vector<std::string> sets;
+};
+
+int run_rollout(const RolloutArguments& args) {
+  std::unique_ptr<Env> env = make_env(args.id, args.sets);
+  RandomRollout random(*env, args.seed);
   double total = 0.0;
-  for (int episode = 0; episode < episodes; ++episode) {
-    // The first reset seeds the env; later ones continue its generator.
-    env->reset(episode == 0 ? std::optional<std::uint64_t>(seed) : std::nullopt);
-    double episode_return = 0.0;
-    int length = 0;
-    StepResult step;
-    do {
-      step = env->step(env->action_space().sample(action_rng));
-      episode_return += step.reward;
-      ++length;
-    } while (!step.terminated && !step.truncated);
-    total += episode_return;
-    std::cout << "episode " << episode << ": return=" << episode_return << " length=" << length
-              << (step.terminated ? " terminated" : " truncated") << "\n";
-    if (!snapshot.empty() && episode == episodes - 1) write_frame_png(snapshot, env->render());
+  for (int episode = 0; episode < args.episodes; ++episode) {
+    // The last episode is not reset, so that the snapshot is its final frame.
+    const EpisodeSummary& summary = random.finish_episode(episode + 1 < args.episodes);
+    total += summary.episode_return;
+    std::cout << "episode " << episode << ": return=" << summary.episode_return
+              << " length=" << summary.length << (summary.terminated ? " terminated" : " truncated")
+              << "\n";
   }
-  std::cout << "mean_return=" << total / episodes << " episodes=" << episodes << "\n";
-  if (!snapshot.empty()) std::cout << "wrote " << snapshot << "\n";
+  if (!args.snapshot.empty()) write_frame_png(args.snapshot, env->render());
+  std::cout << "mean_return=" << total / args.episodes << " episodes=" << args.episodes << "\n";
+  if (!args.snapshot.empty()) std::cout << "wrote " << args.snapshot << "\n";
   env->close();
   return 0;
 }
 
-int run_bench(const std::string& id, std::uint64_t seed, int steps,
-              const std::vector<std::string>& sets) {
-  std::unique_ptr<Env> env = make_env(id, sets);
-  Rng action_rng(seed);
-  env->reset(seed);
+Command add_rollout(CLI::App& app) {
+  auto args = std::make_shared<RolloutArguments>();
+  CLI::App* rollout = app.add_subcommand(
+      "rollout", "Run a uniform random policy for some episodes and print each return");
+  add_id_argument(*rollout, args->id, "GridWorld-v0");
+  add_seed_option(*rollout, args->seed, "Seed for the first reset and the random actions");
+  rollout->add_option("--episodes", args->episodes, "Episodes to run")
+      ->capture_default_str()
+      ->check(integer_in(1));
+  rollout
+      ->add_option("--snapshot", args->snapshot,
+                   "Write the last episode's final frame to this PNG (PNG only)")
+      ->check(png_path());
+  add_set_option(*rollout, args->sets);
+  return {rollout, [args] { return run_rollout(*args); }};
+}
+
+// --- bench ---
+
+struct BenchArguments {
+  std::string id;
+  std::uint64_t seed = 0;
+  int steps = 2000;
+  std::vector<std::string> sets;
+};
+
+int run_bench(const BenchArguments& args) {
+  std::unique_ptr<Env> env = make_env(args.id, args.sets);
+  RandomRollout random(*env, args.seed);
   // Warm up (shader compilation, caches) outside the timed loop.
-  for (int t = 0; t < 20; ++t) {
-    const StepResult step = env->step(env->action_space().sample(action_rng));
-    if (step.terminated || step.truncated) env->reset();
-  }
-  int episodes = 0;
+  for (int t = 0; t < 20; ++t) random.step();
+  const std::int64_t episodes_before = random.episodes();
   const auto start = std::chrono::steady_clock::now();
-  for (int t = 0; t < steps; ++t) {
-    const StepResult step = env->step(env->action_space().sample(action_rng));
-    if (step.terminated || step.truncated) {
-      env->reset();
-      ++episodes;
-    }
-  }
+  for (int t = 0; t < args.steps; ++t) random.step();
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::cout << id << ": " << steps << " steps (" << episodes << " resets) in " << seconds
-            << " s, one thread\n";
-  std::cout << "steps_per_s=" << static_cast<long>(std::lround(steps / seconds)) << "\n";
+  std::cout << args.id << ": " << args.steps << " steps (" << random.episodes() - episodes_before
+            << " resets) in " << seconds << " s, one thread\n";
+  std::cout << "steps_per_s=" << static_cast<long>(std::lround(args.steps / seconds)) << "\n";
   env->close();
   return 0;
+}
+
+Command add_bench(CLI::App& app) {
+  auto args = std::make_shared<BenchArguments>();
+  CLI::App* bench = app.add_subcommand(
+      "bench",
+      "Step an env with seeded random actions (resetting when done) and print steps_per_s= for "
+      "physics + render + observation, one thread (--set obs_mode=state for physics alone)");
+  add_id_argument(*bench, args->id, "CartPoleSwingup-v0");
+  bench->add_option("--steps", args->steps, "Steps to time")
+      ->capture_default_str()
+      ->check(integer_in(1));
+  add_seed_option(*bench, args->seed, "Seed for the reset and the random actions");
+  add_set_option(*bench, args->sets);
+  return {bench, [args] { return run_bench(*args); }};
 }
 
 }  // namespace
 
 std::vector<Command> add_env_commands(CLI::App& app) {
-  // Options live in shared state owned by the returned callbacks. Each subcommand's `--steps` has
-  // its own variable: CLI11 writes a default into the variable when the option is declared, so
-  // a shared one would take the last subcommand's default.
-  struct Options {
-    std::string id;
-    std::uint64_t seed = 0;
-    int check_steps = 0;
-    int snapshot_steps = 0;
-    int bench_steps = 0;
-    int episodes = 5;
-    std::string out;
-    bool observation = false;
-    std::vector<std::string> sets;
-  };
-  auto options = std::make_shared<Options>();
-  std::vector<Command> commands;
-
-  CLI::App* list =
-      app.add_subcommand("list", "List the registered env ids, one per line with a description");
-  commands.push_back({list, [] { return run_list(); }});
-
-  CLI::App* info = app.add_subcommand(
-      "info", "Show an env's spaces, metadata and config keys (types, defaults)");
-  info->add_option("id", options->id, "Env id, e.g. GridWorld-v0")->required();
-  add_set_option(*info, options->sets);
-  commands.push_back({info, [options] { return run_info(options->id, options->sets); }});
-
-  CLI::App* check = app.add_subcommand(
-      "check",
-      "Run the env checker; exit 0 when every check passes, 1 otherwise (failures printed)");
-  check->add_option("id", options->id, "Env id, e.g. GridWorld-v0")->required();
-  check->add_option("--seed", options->seed, "Seed for resets and random actions")
-      ->capture_default_str();
-  check->add_option("--steps", options->check_steps, "Random steps per checked trajectory")
-      ->default_val(100)
-      ->check(CLI::PositiveNumber);
-  add_set_option(*check, options->sets);
-  commands.push_back({check, [options] {
-                        return run_check(options->id, options->seed, options->check_steps,
-                                         options->sets);
-                      }});
-
-  CLI::App* snapshot = app.add_subcommand("snapshot",
-                                          "Reset with a seed, take K seeded random actions, write "
-                                          "render() (or the observation) as a PNG");
-  snapshot->add_option("id", options->id, "Env id, e.g. GridWorld-v0")->required();
-  snapshot->add_option("--seed", options->seed, "Seed for the reset and the random actions")
-      ->required();
-  snapshot->add_option("--out", options->out, "PNG file to write (folders are created)")
-      ->required();
-  snapshot
-      ->add_option("--steps", options->snapshot_steps, "Random actions before the frame is taken")
-      ->default_val(0)
-      ->check(CLI::NonNegativeNumber);
-  snapshot->add_flag(
-      "--observation", options->observation,
-      "Write the observation's \"pixels\" (what the agent sees) instead of render()");
-  add_set_option(*snapshot, options->sets);
-  commands.push_back({snapshot, [options] {
-                        return run_snapshot(options->id, options->seed, options->snapshot_steps,
-                                            options->out, options->observation, options->sets);
-                      }});
-
-  CLI::App* rollout = app.add_subcommand(
-      "rollout", "Run a uniform random policy for some episodes and print each return");
-  rollout->add_option("id", options->id, "Env id, e.g. GridWorld-v0")->required();
-  rollout->add_option("--seed", options->seed, "Seed for the first reset and the random actions")
-      ->capture_default_str();
-  rollout->add_option("--episodes", options->episodes, "Episodes to run")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
-  rollout->add_option("--snapshot", options->out,
-                      "Write the last episode's final frame to this PNG");
-  add_set_option(*rollout, options->sets);
-  commands.push_back({rollout, [options] {
-                        return run_rollout(options->id, options->seed, options->episodes,
-                                           options->out, options->sets);
-                      }});
-  CLI::App* bench = app.add_subcommand(
-      "bench",
-      "Step an env with seeded random actions (resetting when done) and print steps_per_s= for "
-      "physics + "
-      "render + observation, one thread (--set obs_mode=state for physics alone)");
-  bench->add_option("id", options->id, "Env id, e.g. CartPoleSwingup-v0")->required();
-  bench->add_option("--steps", options->bench_steps, "Steps to time")
-      ->default_val(2000)
-      ->check(CLI::PositiveNumber);
-  bench->add_option("--seed", options->seed, "Seed for the reset and the random actions")
-      ->capture_default_str();
-  add_set_option(*bench, options->sets);
-  commands.push_back({bench, [options] {
-                        return run_bench(options->id, options->seed, options->bench_steps,
-                                         options->sets);
-                      }});
-  return commands;
+  return {add_list(app),     add_info(app),    add_check(app),
+          add_snapshot(app), add_rollout(app), add_bench(app)};
 }
 
 }  // namespace pixelgym::cli

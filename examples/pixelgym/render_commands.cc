@@ -8,6 +8,7 @@
 #include "engine/world.h"
 #include "envs/world_scene.h"
 #include "examples/pixelgym/cli.h"
+#include "render/context.h"
 #include "render/renderer.h"
 
 namespace pixelgym::cli {
@@ -71,12 +72,68 @@ int run_view(const ViewOptions& options) {
     write_frame_png(options.out, frame);
     std::cout << "wrote " << options.out << " (" << options.width << "x" << options.height
               << ", robot \"" << model->name() << "\", " << view.scene().instances.size()
-              << " visual shapes, camera " << options.camera << ", robot covers " << std::fixed
+              << (view.scene().instances.size() == 1 ? " visual shape" : " visual shapes")
+              << ", camera " << options.camera << ", robot covers " << std::fixed
               << std::setprecision(1) << 100.0 * coverage << "% of the frame)\n";
     return 0;
   }
   return 0;
 }
+
+// The sample counts this machine's OpenGL offers for --msaa: 0 (off) and the powers of two up to
+// GL_MAX_SAMPLES. A context is created to ask, once, and only when --msaa is given or help shown.
+class MsaaChoices {
+ public:
+  const std::vector<int>& values() {
+    if (values_.empty()) {
+      render::Context context;
+      description_ = context.description();
+      values_ = {0};
+      for (int samples = 2; samples <= context.max_samples(); samples *= 2) {
+        values_.push_back(samples);
+      }
+    }
+    return values_;
+  }
+  const std::string& description() {
+    values();
+    return description_;
+  }
+  std::string list() {
+    std::string text;
+    for (int samples : values()) text += (text.empty() ? "" : ", ") + std::to_string(samples);
+    return text;
+  }
+
+ private:
+  std::vector<int> values_;
+  std::string description_;
+};
+
+// Accepts what MsaaChoices offers; help lists it (CLI11 keeps a validator's description as a
+// function, called when help is printed).
+class MsaaValidator : public CLI::Validator {
+ public:
+  MsaaValidator() {
+    auto choices = std::make_shared<MsaaChoices>();
+    desc_function_ = [choices] {
+      try {
+        return "{" + choices->list() + "}";
+      } catch (const std::exception&) {  // no OpenGL: help still prints
+        return std::string("{0, 2, 4, ...}");
+      }
+    };
+    func_ = [choices](std::string& text) -> std::string {
+      const std::vector<int>& values = choices->values();
+      const auto listed = std::find_if(values.begin(), values.end(), [&](int samples) {
+        return std::to_string(samples) == text;
+      });
+      if (listed != values.end()) return "";
+      return "this OpenGL (" + choices->description() + ") offers " + choices->list() +
+             " samples, got \"" + text + "\"";
+    };
+  }
+};
 
 }  // namespace
 
@@ -86,19 +143,23 @@ std::vector<Command> add_render_commands(CLI::App& app) {
                                       "Render a URDF at its zero pose on the floor, framed "
                                       "automatically, to a PNG (no display needed)");
   view->add_option("urdf", options->path, "URDF file")->required();
-  view->add_option("--out", options->out, "PNG file to write (folders are created)")->required();
+  view->add_option("--out", options->out, "PNG file to write (folders are created; PNG only)")
+      ->required()
+      ->check(png_path());
   view->add_option("--width", options->width, "Image width in pixels")
       ->capture_default_str()
-      ->check(CLI::Range(1, 8192));
+      ->check(integer_in(1, 8192));
   view->add_option("--height", options->height, "Image height in pixels")
       ->capture_default_str()
-      ->check(CLI::Range(1, 8192));
+      ->check(integer_in(1, 8192));
   view->add_option("--camera", options->camera, "Viewpoint")
       ->capture_default_str()
       ->check(CLI::IsMember({"iso", "front", "side", "top"}));
-  view->add_option("--msaa", options->msaa, "Multisample anti-aliasing samples")
+  view->add_option("--msaa", options->msaa,
+                   "Multisample anti-aliasing samples per pixel: 0 (off) or a power of two up to "
+                   "what this machine's OpenGL offers")
       ->capture_default_str()
-      ->check(CLI::IsMember({0, 2, 4, 8}));
+      ->check(MsaaValidator());
   view->add_flag("!--no-shadows", options->shadows, "Draw without shadows");
   return {{view, [options] { return run_view(*options); }}};
 }

@@ -1,27 +1,42 @@
-// Runs the `pixelgym` binary and checks exit codes and output, as a user or a script sees them.
+// Runs the `pixelgym` binary and checks exit codes, output and written files, as a user or a
+// script sees them. Every file a command writes is deleted first, so no test passes on a file an
+// earlier run left; pictures are compared with what the library gives for the same seed.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <map>
+#include <set>
+#include <sstream>
 #include <string>
+#include <vector>
 
+#include "engine/robot_model.h"
+#include "engine/world.h"
+#include "envs/registry.h"
+#include "envs/world_scene.h"
 #include "render/image_io.h"
+#include "render/renderer.h"
 
 namespace pixelgym {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
+using ::testing::StartsWith;
 
 struct CliRun {
-  int exit_code;
+  int exit_code;       // -1 when the process did not exit normally (a crash)
   std::string output;  // stdout and stderr
 };
 
-CliRun run(const std::string& arguments) {
-  const std::string command = std::string(PIXELGYM_CLI) + " " + arguments + " 2>&1";
+// Runs `pixelgym ARGUMENTS`, with `environment` ("NAME=value ...") set for it.
+CliRun run(const std::string& arguments, const std::string& environment = "") {
+  const std::string command = environment + " " + PIXELGYM_CLI + " " + arguments + " 2>&1";
   std::FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) return {-1, "popen failed"};
   std::string output;
@@ -31,11 +46,47 @@ CliRun run(const std::string& arguments) {
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
 }
 
-TEST(PixelgymCliTest, ListShowsGridWorldWithDescription) {
+// A path under the test output folder, with no file there yet.
+std::string fresh_output(const std::string& name) {
+  const std::filesystem::path path = std::filesystem::path(PIXELGYM_TEST_OUTPUT_DIR) / "cli" / name;
+  std::filesystem::remove(path);
+  EXPECT_FALSE(std::filesystem::exists(path)) << path;
+  return path.string();
+}
+
+std::string asset(const std::string& relative) {
+  return std::string(PIXELGYM_SOURCE_DIR) + "/assets/" + relative;
+}
+
+std::vector<std::uint8_t> bytes(const Array& frame) {
+  const auto* data = frame.data<std::uint8_t>();
+  return {data, data + frame.size()};
+}
+
+// What `snapshot`, `rollout` and `bench` promise, written out with the library: reset(seed),
+// actions from Rng(seed), an unseeded reset() when an episode ends.
+struct ApiRollout {
+  ApiRollout(const std::string& id, const Params& kwargs, std::uint64_t seed)
+      : env(make(id, kwargs)), action_rng(seed), obs(env->reset(seed).obs) {}
+  StepResult step() {
+    StepResult result = env->step(env->action_space().sample(action_rng));
+    obs = result.obs;
+    return result;
+  }
+  std::unique_ptr<Env> env;
+  Rng action_rng;
+  Value obs;
+};
+
+// --- list, info ---
+
+TEST(PixelgymCliTest, ListShowsEveryRegisteredIdWithItsDescription) {
   const CliRun result = run("list");
-  EXPECT_EQ(result.exit_code, 0);
-  EXPECT_THAT(result.output, HasSubstr("GridWorld-v0"));
-  EXPECT_THAT(result.output, HasSubstr("4x4 grid"));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  for (const std::string& id : registered_ids()) {
+    EXPECT_THAT(result.output, HasSubstr(id + "  ")) << id;
+    EXPECT_THAT(result.output, HasSubstr(default_registry().spec(id)->description)) << id;
+  }
 }
 
 TEST(PixelgymCliTest, InfoShowsSpacesAndConfigKeys) {
@@ -47,84 +98,248 @@ TEST(PixelgymCliTest, InfoShowsSpacesAndConfigKeys) {
   EXPECT_THAT(result.output, HasSubstr("max_episode_steps: 50"));
 }
 
+// info answers from the spec (Registry::describe): with OpenGL broken (GALLIUM_DRIVER names no
+// driver, so creating a context fails or crashes, as the snapshot shows) it still prints every
+// env's spaces, each observation key's range, the cameras and the time limit.
+TEST(PixelgymCliTest, InfoShowsRangesCamerasAndLimitsWithoutOpenGl) {
+  const std::string broken_gl = "GALLIUM_DRIVER=no-such-driver";
+  EXPECT_NE(
+      run("snapshot CartPoleSwingup-v0 --out " + fresh_output("no_gl.png"), broken_gl).exit_code,
+      0);
+  for (const std::string& id : registered_ids()) {
+    const CliRun result = run("info " + id, broken_gl);
+    ASSERT_EQ(result.exit_code, 0) << id << ": " << result.output;
+    const EnvDescription description = describe(id);
+    EXPECT_THAT(
+        result.output,
+        HasSubstr("observation_space: " + description.observation_space->to_string() + "\n"));
+    if (description.cameras.empty()) {
+      EXPECT_THAT(result.output, HasSubstr("cameras:           none\n")) << id;
+    } else {
+      EXPECT_THAT(result.output,
+                  HasSubstr("cameras:           " + description.cameras[0] + " (default)"))
+          << id;
+      for (const std::string& camera : description.cameras) {
+        EXPECT_THAT(result.output, HasSubstr(camera)) << id;
+      }
+    }
+    ASSERT_TRUE(description.max_episode_steps.has_value()) << id;
+    EXPECT_THAT(
+        result.output,
+        HasSubstr("max_episode_steps: " + std::to_string(*description.max_episode_steps) + "\n"));
+  }
+  const std::string cartpole = run("info CartPoleSwingup-v0", broken_gl).output;
+  EXPECT_THAT(cartpole,
+              ::testing::ContainsRegex("\n  pixels +uint8 +\\(84, 84, 3\\) +\\[0, 255\\]\n"));
+  EXPECT_THAT(cartpole,
+              ::testing::ContainsRegex("\n  joint_pos +float32 +\\(2,\\) +\\[-inf, inf\\]\n"));
+  EXPECT_THAT(run("info GridWorld-v0").output,
+              ::testing::ContainsRegex("\n  \\(all\\) +int64 +\\(\\) +\\{0, \\.\\.\\., 15\\}\n"));
+  // The limit follows the kwargs: 1000 control steps at action_repeat 4 are 250 env steps.
+  EXPECT_THAT(run("info CartPoleSwingup-v0 --set action_repeat=4", broken_gl).output,
+              HasSubstr("max_episode_steps: 250\n"));
+  EXPECT_THAT(run("info GridWorld-v0 --set max_episode_steps=7").output,
+              HasSubstr("max_episode_steps: 7\n"));
+}
+
+// Each config row's cells start where the header's do, after at least two spaces: a long default
+// ("pixels+state") no longer runs into its description.
+TEST(PixelgymCliTest, InfoConfigColumnsLineUpWithoutColliding) {
+  for (const std::string id : {"CartPoleSwingup-v0", "GridWorld-v0", "ArmReach-v0"}) {
+    const CliRun result = run("info " + id);
+    ASSERT_EQ(result.exit_code, 0) << result.output;
+    std::istringstream lines(result.output.substr(result.output.find("config (--set")));
+    std::string line;
+    std::getline(lines, line);
+    std::getline(lines, line);  // the header
+    ASSERT_THAT(line, StartsWith("  key ")) << result.output;
+    std::vector<std::size_t> starts;
+    for (const char* column : {"type", "default", "description"})
+      starts.push_back(line.find(column));
+    int rows = 0;
+    while (std::getline(lines, line) && line.rfind("  ", 0) == 0) {
+      ++rows;
+      for (const std::size_t start : starts) {
+        ASSERT_GT(line.size(), start) << line;
+        EXPECT_NE(line[start], ' ') << id << ": \"" << line << "\"";
+        EXPECT_EQ(line.substr(start - 2, 2), "  ") << id << ": \"" << line << "\"";
+      }
+    }
+    EXPECT_EQ(rows, static_cast<int>(default_registry().spec(id)->params.size()) + 1) << id;
+  }
+  EXPECT_THAT(run("info CartPoleSwingup-v0").output,
+              HasSubstr("\"pixels+state\"  \"pixels+state\", \"pixels\" or \"state\""));
+}
+
+// --- check ---
+
 TEST(PixelgymCliTest, CheckGridWorldPasses) {
   const CliRun result = run("check GridWorld-v0 --seed 3");
   EXPECT_EQ(result.exit_code, 0) << result.output;
   EXPECT_THAT(result.output, HasSubstr("all 11 checks passed"));
 }
 
-TEST(PixelgymCliTest, CheckUnknownIdFailsAndSuggests) {
-  const CliRun result = run("check Nope-v0");
-  EXPECT_EQ(result.exit_code, 1);
-  EXPECT_THAT(result.output, HasSubstr("unknown env id \"Nope-v0\""));
-  EXPECT_THAT(result.output, HasSubstr("GridWorld-v0"));
-}
-
-TEST(PixelgymCliTest, UnknownSubcommandAndBadFlagsExitTwoWithUsage) {
-  for (const char* arguments :
-       {"frobnicate", "", "check", "check GridWorld-v0 --bogus",
-        "snapshot GridWorld-v0 --seed x --out a.png", "check GridWorld-v0 --set novalue"}) {
-    const CliRun result = run(std::string(arguments));
-    EXPECT_EQ(result.exit_code, 2) << arguments << ": " << result.output;
-    EXPECT_THAT(result.output, HasSubstr("Usage")) << arguments;
+TEST(PixelgymCliTest, UnknownIdIsAUsageErrorThatSuggests) {
+  for (const char* command : {"check", "info", "rollout", "bench"}) {
+    const CliRun result = run(std::string(command) + " GridWorld-v9");
+    EXPECT_EQ(result.exit_code, 2) << command << ": " << result.output;
+    EXPECT_THAT(result.output,
+                HasSubstr("unknown env id \"GridWorld-v9\"; did you mean GridWorld-v0"));
+    EXPECT_THAT(result.output, HasSubstr("Usage: pixelgym " + std::string(command)));
   }
 }
 
-TEST(PixelgymCliTest, HelpExitsZero) {
-  const CliRun result = run("snapshot --help");
-  EXPECT_EQ(result.exit_code, 0);
-  EXPECT_THAT(result.output, HasSubstr("--steps"));
+// --- usage errors: exit 2, a message naming the problem, the subcommand's usage ---
+
+struct UsageCase {
+  std::string arguments;
+  std::string message;
+};
+
+TEST(PixelgymCliTest, UsageErrorsExitTwoWithAClearMessage) {
+  const std::string out = fresh_output("usage.png");
+  const std::string arm = asset("arm/arm.urdf");
+  const std::string max_int = "2147483647";
+  const std::vector<UsageCase> cases = {
+      {"frobnicate", "unknown subcommand \"frobnicate\""},
+      {"", "A subcommand is required"},
+      {"check", "id is required"},
+      {"check GridWorld-v0 --bogus", "--bogus"},
+      {"snapshot GridWorld-v0 --seed x --out " + out,
+       "--seed: must be an integer from 0 to 18446744073709551615, got \"x\""},
+      {"rollout GridWorld-v0 --seed -1",
+       "--seed: must be an integer from 0 to 18446744073709551615, got \"-1\""},
+      {"check GridWorld-v0 --seed 18446744073709551616", "got \"18446744073709551616\""},
+      {"rollout GridWorld-v0 --episodes 0",
+       "--episodes: must be an integer from 1 to " + max_int + ", got \"0\""},
+      {"check GridWorld-v0 --steps 0", "--steps: must be an integer from 1 to " + max_int},
+      {"bench GridWorld-v0 --steps 1.5", "--steps: must be an integer from 1 to " + max_int},
+      {"snapshot GridWorld-v0 --steps -1 --out " + out, "--steps: must be an integer from 0 to"},
+      {"view " + arm + " --out " + out + " --width 0",
+       "--width: must be an integer from 1 to 8192"},
+      {"view " + arm + " --out " + out + " --height 9000",
+       "--height: must be an integer from 1 to 8192"},
+      {"view " + arm + " --out " + out + " --camera nowhere", "--camera"},
+      {"view " + arm, "--out is required"},
+      {"snapshot GridWorld-v0 --out a.jpg",
+       "writes PNG only: the file name must end in .png, got \"a.jpg\""},
+      {"rollout GridWorld-v0 --snapshot last.jpeg", "must end in .png, got \"last.jpeg\""},
+      {"view " + arm + " --out arm.bmp", "must end in .png, got \"arm.bmp\""},
+      {"check GridWorld-v0 --set novalue", "--set expects key=value, got \"novalue\""},
+      {"info GridWorld-v0 --set colour=red", "unknown kwarg \"colour\""},
+      {"info GridWorld-v0 --set render_width=wide", "cannot read \"wide\" as an int"},
+      {"snapshot GridWorld-v0 --observation --out " + out, "try --set obs_mode=pixels"},
+      {"help nope", "help: unknown subcommand \"nope\""},
+  };
+  for (const UsageCase& c : cases) {
+    const CliRun result = run(c.arguments);
+    EXPECT_EQ(result.exit_code, 2) << c.arguments << ": " << result.output;
+    EXPECT_THAT(result.output, HasSubstr(c.message)) << c.arguments;
+    EXPECT_THAT(result.output, HasSubstr("Usage: pixelgym")) << c.arguments;
+    EXPECT_THAT(result.output, Not(HasSubstr("not in range"))) << c.arguments;
+  }
+  EXPECT_FALSE(std::filesystem::exists(out));
+  EXPECT_FALSE(std::filesystem::exists("a.jpg"));
 }
 
-TEST(PixelgymCliTest, SetPassesTypedKwargsAndReportsUnknownOnes) {
-  const std::string out = std::string(PIXELGYM_TEST_OUTPUT_DIR) + "/cli/gridworld_small.png";
-  std::filesystem::remove(out);
-  const CliRun small = run("snapshot GridWorld-v0 --seed 0 --steps 3 --out " + out +
-                           " --set render_width=96 --set render_height=64");
-  ASSERT_EQ(small.exit_code, 0) << small.output;
+TEST(PixelgymCliTest, UnknownKwargListsTheValidOnes) {
+  const CliRun unknown = run("info GridWorld-v0 --set colour=red");
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_THAT(unknown.output, HasSubstr("render_width (int, default 256)"));
+}
+
+// --- --version, help ---
+
+TEST(PixelgymCliTest, VersionPrintsTheProjectVersion) {
+  const CliRun result = run("--version");
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(result.output, std::string("pixelgym ") + PIXELGYM_VERSION + "\n");
+}
+
+TEST(PixelgymCliTest, HelpListsEverySubcommandAndExplainsEach) {
+  const CliRun help = run("help");
+  ASSERT_EQ(help.exit_code, 0) << help.output;
+  EXPECT_THAT(help.output, HasSubstr("Usage: pixelgym [OPTIONS] SUBCOMMAND"));
+  const std::vector<std::string> subcommands = {"list",  "info",    "check", "snapshot", "rollout",
+                                                "bench", "inspect", "view",  "help"};
+  for (const std::string& name : subcommands) {
+    EXPECT_THAT(help.output, HasSubstr("\n  " + name + " ")) << name;
+    const CliRun one = run("help " + name);
+    EXPECT_EQ(one.exit_code, 0) << name << ": " << one.output;
+    EXPECT_THAT(one.output, HasSubstr("Usage: pixelgym " + name)) << name;
+    EXPECT_EQ(one.output, run(name + " --help").output) << name;
+  }
+  EXPECT_EQ(run("--help").output, help.output);
+}
+
+// Each subcommand keeps its own options and defaults (one shared variable once gave snapshot
+// bench's 2000 steps).
+TEST(PixelgymCliTest, EachSubcommandShowsItsOwnDefaults) {
+  EXPECT_THAT(run("check --help").output, HasSubstr("=100"));
+  EXPECT_THAT(run("snapshot --help").output, HasSubstr("=0"));
+  EXPECT_THAT(run("bench --help").output, HasSubstr("=2000"));
+  EXPECT_THAT(run("rollout --help").output, HasSubstr("--episodes INT:>= 1=5"));
+  for (const char* command : {"check", "snapshot", "rollout", "bench"}) {
+    EXPECT_THAT(run(std::string(command) + " --help").output, HasSubstr("--seed UINT64=0"))
+        << command;
+  }
+}
+
+// --- snapshot: the PNG holds what the library gives for the same seed ---
+
+TEST(PixelgymCliTest, SnapshotRenderIsTheEnvsRenderForTheSeed) {
+  const std::string out = fresh_output("gridworld_small.png");
+  const CliRun result = run("snapshot GridWorld-v0 --seed 4 --steps 7 --out " + out +
+                            " --set render_width=96 --set render_height=64");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("(96x64 render(), GridWorld-v0, seed 4, 7 steps)"));
   const render::Image image = render::read_png(out);
   EXPECT_EQ(image.width, 96);
   EXPECT_EQ(image.height, 64);
 
-  const CliRun unknown = run("info GridWorld-v0 --set colour=red");
-  EXPECT_EQ(unknown.exit_code, 1);
-  EXPECT_THAT(unknown.output, HasSubstr("unknown kwarg \"colour\""));
-  EXPECT_THAT(unknown.output, HasSubstr("render_width (int, default 256)"));
+  ApiRollout api("GridWorld-v0", {{"render_width", 96}, {"render_height", 64}}, 4);
+  for (int t = 0; t < 7; ++t) {
+    const StepResult step = api.step();
+    if (step.terminated || step.truncated) api.env->reset();
+  }
+  EXPECT_EQ(image.pixels, bytes(api.env->render()));
 
-  const CliRun bad_value = run("info GridWorld-v0 --set render_width=wide");
-  EXPECT_EQ(bad_value.exit_code, 1);
-  EXPECT_THAT(bad_value.output, HasSubstr("cannot read \"wide\" as a int"));
+  ApiRollout other("GridWorld-v0", {{"render_width", 96}, {"render_height", 64}}, 4);
+  other.step();
+  EXPECT_NE(image.pixels, bytes(other.env->render()));  // the test can tell frames apart
 }
 
-TEST(PixelgymCliTest, SnapshotIsReproducibleFromTheSeed) {
-  const std::string dir = std::string(PIXELGYM_TEST_OUTPUT_DIR) + "/cli/";
-  ASSERT_EQ(run("snapshot GridWorld-v0 --seed 4 --steps 7 --out " + dir + "a.png").exit_code, 0);
-  ASSERT_EQ(run("snapshot GridWorld-v0 --seed 4 --steps 7 --out " + dir + "b.png").exit_code, 0);
-  EXPECT_EQ(render::read_png(dir + "a.png").pixels, render::read_png(dir + "b.png").pixels);
-}
-
-// Each subcommand keeps its own defaults: snapshot's --steps is 0 (the frame after reset), not
-// bench's 2000.
-TEST(PixelgymCliTest, SnapshotDefaultsToTheFrameAfterReset) {
-  const std::string dir = std::string(PIXELGYM_TEST_OUTPUT_DIR) + "/cli/";
-  const CliRun plain = run("snapshot GridWorld-v0 --seed 2 --out " + dir + "reset_default.png");
-  ASSERT_EQ(plain.exit_code, 0) << plain.output;
-  EXPECT_THAT(plain.output, HasSubstr("seed 2, 0 steps)"));
-  ASSERT_EQ(
-      run("snapshot GridWorld-v0 --seed 2 --steps 0 --out " + dir + "reset_zero.png").exit_code, 0);
-  EXPECT_EQ(render::read_png(dir + "reset_default.png").pixels, render::read_png(dir + "reset_zero.png").pixels);
-}
-
-TEST(PixelgymCliTest, SnapshotOfTheObservationIsWhatTheAgentSees) {
-  const std::string out = std::string(PIXELGYM_TEST_OUTPUT_DIR) + "/cli/observation.png";
-  const CliRun result = run("snapshot CartPoleSwingup-v0 --seed 0 --observation --out " + out);
+TEST(PixelgymCliTest, SnapshotObservationIsWhatTheAgentSees) {
+  const std::string out = fresh_output("observation.png");
+  const CliRun result =
+      run("snapshot CartPoleSwingup-v0 --seed 3 --steps 4 --observation --out " + out);
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const render::Image image = render::read_png(out);
   EXPECT_EQ(image.width, 84);
   EXPECT_EQ(image.height, 84);
-  const CliRun index = run("snapshot GridWorld-v0 --seed 0 --observation --out " + out);
-  EXPECT_EQ(index.exit_code, 1);
-  EXPECT_THAT(index.output, HasSubstr("obs_mode=pixels"));
+
+  ApiRollout api("CartPoleSwingup-v0", {}, 3);
+  for (int t = 0; t < 4; ++t) api.step();
+  EXPECT_EQ(image.pixels, bytes(api.obs.dict().at("pixels").array()));
+  ApiRollout after_reset("CartPoleSwingup-v0", {}, 3);
+  EXPECT_NE(image.pixels, bytes(after_reset.obs.dict().at("pixels").array()));
+}
+
+// --seed is 0 unless given; snapshot's --steps is 0 (the frame after reset).
+TEST(PixelgymCliTest, SnapshotDefaultsToSeedZeroAndTheFrameAfterReset) {
+  const std::string plain = fresh_output("reset_default.png");
+  const CliRun result = run("snapshot GridWorld-v0 --out " + plain);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("seed 0, 0 steps)"));
+  ApiRollout api("GridWorld-v0", {}, 0);
+  EXPECT_EQ(render::read_png(plain).pixels, bytes(api.env->render()));
+
+  const std::string seeded = fresh_output("seed_default.png");
+  ASSERT_EQ(run("snapshot CartPoleSwingup-v0 --steps 5 --observation --out " + seeded).exit_code,
+            0);
+  ApiRollout zero("CartPoleSwingup-v0", {}, 0);
+  for (int t = 0; t < 5; ++t) zero.step();
+  EXPECT_EQ(render::read_png(seeded).pixels, bytes(zero.obs.dict().at("pixels").array()));
 }
 
 TEST(PixelgymCliTest, SnapshotToUnwritablePathFailsClearly) {
@@ -133,82 +348,211 @@ TEST(PixelgymCliTest, SnapshotToUnwritablePathFailsClearly) {
   EXPECT_THAT(result.output, HasSubstr("/proc/pixelgym"));
 }
 
-TEST(PixelgymCliTest, RolloutPrintsReturns) {
-  const CliRun result = run("rollout GridWorld-v0 --episodes 3 --seed 1");
-  EXPECT_EQ(result.exit_code, 0) << result.output;
-  EXPECT_THAT(result.output, HasSubstr("episode 2: return="));
-  EXPECT_THAT(result.output, HasSubstr("mean_return="));
+// --- rollout: the returns the library gives for the same seed ---
+
+std::string expected_rollout(const std::string& id, std::uint64_t seed, int episodes) {
+  ApiRollout api(id, {}, seed);
+  std::ostringstream out;
+  double total = 0.0;
+  for (int episode = 0; episode < episodes; ++episode) {
+    if (episode > 0) api.env->reset();
+    double episode_return = 0.0;
+    int length = 0;
+    StepResult step;
+    do {
+      step = api.step();
+      episode_return += step.reward;
+      ++length;
+    } while (!step.terminated && !step.truncated);
+    total += episode_return;
+    out << "episode " << episode << ": return=" << episode_return << " length=" << length
+        << (step.terminated ? " terminated" : " truncated") << "\n";
+  }
+  out << "mean_return=" << total / episodes << " episodes=" << episodes << "\n";
+  return out.str();
 }
 
-TEST(PixelgymCliTest, InspectWorksOnEveryAsset) {
-  int count = 0;
-  for (const auto& entry : std::filesystem::recursive_directory_iterator(
-           std::string(PIXELGYM_SOURCE_DIR) + "/assets")) {
-    if (entry.path().extension() != ".urdf") continue;
-    ++count;
-    const CliRun result = run("inspect " + entry.path().string());
-    EXPECT_EQ(result.exit_code, 0) << entry.path() << ": " << result.output;
-    EXPECT_THAT(result.output, HasSubstr("simulates:"));
+TEST(PixelgymCliTest, RolloutPrintsTheReturnsOfTheSeededRandomPolicy) {
+  const CliRun result = run("rollout GridWorld-v0 --episodes 3 --seed 1");
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(result.output, expected_rollout("GridWorld-v0", 1, 3));
+  EXPECT_NE(result.output, expected_rollout("GridWorld-v0", 2, 3));
+  EXPECT_EQ(run("rollout GridWorld-v0").output, expected_rollout("GridWorld-v0", 0, 5));
+}
+
+TEST(PixelgymCliTest, RolloutSnapshotIsTheLastEpisodesFinalFrame) {
+  const std::string out = fresh_output("rollout_last.png");
+  const CliRun result = run("rollout GridWorld-v0 --episodes 2 --seed 5 --snapshot " + out);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("wrote " + out));
+  ApiRollout api("GridWorld-v0", {}, 5);
+  for (int episode = 0; episode < 2; ++episode) {
+    if (episode > 0) api.env->reset();
+    for (StepResult step = api.step(); !step.terminated && !step.truncated;) step = api.step();
   }
-  EXPECT_EQ(count, 8);
-  const CliRun arm = run("inspect " + std::string(PIXELGYM_SOURCE_DIR) + "/assets/arm/arm.urdf");
+  EXPECT_EQ(render::read_png(out).pixels, bytes(api.env->render()));
+}
+
+TEST(PixelgymCliTest, BenchPrintsStepsPerSecondLast) {
+  const CliRun result = run("bench GridWorld-v0 --steps 50");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("GridWorld-v0: 50 steps ("));
+  const std::size_t at = result.output.rfind("steps_per_s=");
+  ASSERT_NE(at, std::string::npos) << result.output;
+  EXPECT_EQ(result.output.find('\n', at), result.output.size() - 1);
+  EXPECT_GT(std::stol(result.output.substr(at + 12)), 0);
+}
+
+// --- inspect ---
+
+const std::vector<std::string> kAssetUrdfs = {"acrobot/acrobot.urdf",   "arm/arm.urdf",
+                                              "cartpole/cartpole.urdf", "objects/cube.urdf",
+                                              "objects/table.urdf",     "objects/target.urdf",
+                                              "pendulum/pendulum.urdf", "reacher/reacher.urdf"};
+
+TEST(PixelgymCliTest, InspectWorksOnEveryAsset) {
+  std::set<std::string> found;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(asset(""))) {
+    if (entry.path().extension() == ".urdf") {
+      found.insert(std::filesystem::relative(entry.path(), asset("")).string());
+    }
+  }
+  EXPECT_EQ(found, std::set<std::string>(kAssetUrdfs.begin(), kAssetUrdfs.end()));
+  for (const std::string& urdf : kAssetUrdfs) {
+    const CliRun result = run("inspect " + asset(urdf));
+    EXPECT_EQ(result.exit_code, 0) << urdf << ": " << result.output;
+    EXPECT_THAT(result.output, HasSubstr("simulates:")) << urdf;
+  }
+  const CliRun arm = run("inspect " + asset("arm/arm.urdf"));
   EXPECT_THAT(arm.output, HasSubstr("link3.obj   1152 triangles"));
   EXPECT_THAT(arm.output, HasSubstr("limits [-2.090, 2.090] rad"));
   EXPECT_THAT(arm.output, HasSubstr("total mass 23.200 kg"));
 }
 
 TEST(PixelgymCliTest, InspectRefusesEveryBadFileNamingTheProblem) {
-  int count = 0;
-  for (const auto& entry :
-       std::filesystem::directory_iterator(std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/urdf")) {
-    if (entry.path().extension() != ".urdf" || entry.path().filename() == "minimal_valid.urdf")
-      continue;
-    ++count;
-    const CliRun result = run("inspect " + entry.path().string());
-    EXPECT_EQ(result.exit_code, 1) << entry.path() << ": " << result.output;
-    EXPECT_THAT(result.output, HasSubstr("pixelgym: error: URDF " + entry.path().string() + ": "));
+  const std::string dir = std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/urdf/";
+  const std::vector<std::string> bad = {"bad_inertia",
+                                        "detached_cycle",
+                                        "floating_joint",
+                                        "joint_cycle",
+                                        "malformed_xml",
+                                        "mesh_without_triangles",
+                                        "missing_mesh",
+                                        "negative_mass",
+                                        "no_links",
+                                        "planar_joint",
+                                        "reversed_limits",
+                                        "two_parents",
+                                        "two_roots",
+                                        "unknown_link",
+                                        "unreadable_mesh",
+                                        "unresolvable_package",
+                                        "unsupported_mesh_format",
+                                        "zero_mass"};
+  for (const std::string& name : bad) {
+    const std::string path = dir + name + ".urdf";
+    ASSERT_TRUE(std::filesystem::exists(path)) << path;
+    const CliRun result = run("inspect " + path);
+    EXPECT_EQ(result.exit_code, 1) << path << ": " << result.output;
+    EXPECT_THAT(result.output, HasSubstr("pixelgym: error: URDF " + path + ": ")) << name;
   }
-  EXPECT_EQ(count, 18);
-  EXPECT_EQ(
-      run("inspect " + std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/urdf/minimal_valid.urdf")
-          .exit_code,
-      0);
+  EXPECT_EQ(run("inspect " + dir + "minimal_valid.urdf").exit_code, 0);
+}
+
+// --- view ---
+
+// The share of pixels of `image` that differ (by more than 24 summed over R, G, B) from the empty
+// scene — floor and sky — seen through the camera `view` frames `urdf` with: measured from the
+// PNG, not taken from the tool's own figure. Mirrors run_view's placement (lifted onto the floor)
+// and its "iso" viewpoint; shadows off.
+double robot_share(const std::string& urdf, const render::Image& image) {
+  const auto model = engine::default_model_cache().load_urdf(urdf);
+  engine::RobotOptions placement;
+  Eigen::AlignedBox3f bounds;
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    engine::WorldConfig config;
+    config.ground_plane = false;
+    engine::World world(config);
+    world.add_robot(model, placement);
+    bounds = WorldScene(world).bounds();
+    placement.X_world_base.translation().z() = std::max(0.0F, -bounds.min().z());
+  }
+  engine::WorldConfig config;
+  config.ground_plane = false;
+  engine::World world(config);
+  WorldScene empty(world);
+  empty.scene().shadows = false;
+  const render::Camera camera = frame_box(bounds, -50.0F, 25.0F, image.width, image.height);
+  std::vector<std::uint8_t> background(image.pixels.size());
+  render::Renderer().render(empty.scene(), camera, {background.data()});
+  int differ = 0;
+  for (std::size_t i = 0; i < background.size(); i += 3) {
+    int distance = 0;
+    for (std::size_t c = 0; c < 3; ++c)
+      distance += std::abs(image.pixels[i + c] - background[i + c]);
+    differ += distance > 24 ? 1 : 0;
+  }
+  return static_cast<double>(differ) / static_cast<double>(background.size() / 3);
 }
 
 TEST(PixelgymCliTest, ViewRendersEveryAssetRobotVisibly) {
-  for (const char* urdf : {"cartpole/cartpole.urdf", "pendulum/pendulum.urdf",
-                           "acrobot/acrobot.urdf", "reacher/reacher.urdf", "arm/arm.urdf",
-                           "objects/table.urdf", "objects/cube.urdf", "objects/target.urdf"}) {
-    const std::string out = std::string(PIXELGYM_TEST_OUTPUT_DIR) + "/cli/view_" +
-                            std::filesystem::path(urdf).stem().string() + ".png";
-    std::filesystem::remove(out);
-    const CliRun result = run("view " + std::string(PIXELGYM_SOURCE_DIR) + "/assets/" + urdf +
-                              " --out " + out + " --width 160 --height 120");
+  for (const std::string& urdf : kAssetUrdfs) {
+    const std::string out =
+        fresh_output("view_" + std::filesystem::path(urdf).stem().string() + ".png");
+    const CliRun result = run("view " + asset(urdf) + " --out " + out +
+                              " --width 160 --height 120 --msaa 0 --no-shadows");
     ASSERT_EQ(result.exit_code, 0) << urdf << ": " << result.output;
     const render::Image image = render::read_png(out);
     EXPECT_EQ(image.width, 160);
     EXPECT_EQ(image.height, 120);
-    // Framed automatically: the robot fills a good part of the picture.
+    // Framed automatically: the robot fills a good part of the picture, as measured here and as
+    // the tool says.
+    const double measured = 100.0 * robot_share(asset(urdf), image);
+    EXPECT_GT(measured, 1.5) << urdf;
     const std::size_t at = result.output.find("robot covers ");
     ASSERT_NE(at, std::string::npos) << result.output;
-    EXPECT_GT(std::stod(result.output.substr(at + 13)), 1.5) << urdf << ": " << result.output;
+    EXPECT_NEAR(std::stod(result.output.substr(at + 13)), measured, 1.0) << urdf;
+  }
+  EXPECT_THAT(
+      run("view " + asset("objects/cube.urdf") + " --out " + fresh_output("cube.png")).output,
+      HasSubstr("1 visual shape,"));
+}
+
+// --msaa accepts exactly what the OpenGL offers (help lists it) and refuses the next step up.
+TEST(PixelgymCliTest, ViewOffersTheMsaaSamplesTheOpenGlHas) {
+  const std::string help = run("view --help").output;
+  const std::size_t open = help.find("--msaa INT:{");
+  ASSERT_NE(open, std::string::npos) << help;
+  const std::size_t close = help.find('}', open);
+  std::vector<int> offered;
+  std::istringstream list(help.substr(open + 12, close - open - 12));
+  for (std::string item; std::getline(list, item, ',');) offered.push_back(std::stoi(item));
+  ASSERT_GE(offered.size(), 2U) << help;  // 0 and at least 2
+  EXPECT_EQ(offered.front(), 0);
+  const std::string cube = asset("objects/cube.urdf");
+  for (const int samples : offered) {
+    const std::string out = fresh_output("msaa_" + std::to_string(samples) + ".png");
+    const CliRun result = run("view " + cube + " --out " + out + " --width 32 --height 32 --msaa " +
+                              std::to_string(samples));
+    EXPECT_EQ(result.exit_code, 0) << samples << ": " << result.output;
+    EXPECT_TRUE(std::filesystem::exists(out)) << samples;
+  }
+  for (const int samples : {offered.back() * 2, 3, -1}) {
+    const CliRun result = run("view " + cube + " --out x.png --msaa " + std::to_string(samples));
+    EXPECT_EQ(result.exit_code, 2) << samples << ": " << result.output;
+    EXPECT_THAT(result.output, HasSubstr("offers 0, 2")) << samples;
   }
 }
 
-TEST(PixelgymCliTest, ViewRefusesBadInput) {
-  const std::string arm = std::string(PIXELGYM_SOURCE_DIR) + "/assets/arm/arm.urdf";
-  const std::string out = std::string(PIXELGYM_TEST_OUTPUT_DIR) + "/cli/bad.png";
-  EXPECT_EQ(run("view " + arm + " --out " + out + " --width 0").exit_code, 2);
-  EXPECT_EQ(run("view " + arm + " --out " + out + " --width 9000").exit_code, 2);
-  EXPECT_EQ(run("view " + arm + " --out " + out + " --msaa 3").exit_code, 2);
-  EXPECT_EQ(run("view " + arm + " --out " + out + " --camera nowhere").exit_code, 2);
-  EXPECT_EQ(run("view " + arm).exit_code, 2);  // --out is required
+TEST(PixelgymCliTest, ViewFailuresOfTheRunExitOne) {
+  const std::string out = fresh_output("bad.png");
   const CliRun missing = run("view /nonexistent/robot.urdf --out " + out);
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_THAT(missing.output, HasSubstr("/nonexistent/robot.urdf"));
-  const CliRun unwritable = run("view " + arm + " --out /proc/pixelgym/arm.png");
+  const CliRun unwritable = run("view " + asset("arm/arm.urdf") + " --out /proc/pixelgym/arm.png");
   EXPECT_EQ(unwritable.exit_code, 1);
   EXPECT_THAT(unwritable.output, HasSubstr("/proc/pixelgym"));
+  EXPECT_FALSE(std::filesystem::exists(out));
 }
 
 }  // namespace
