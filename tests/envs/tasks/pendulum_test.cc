@@ -5,6 +5,7 @@
 #include <cmath>
 #include <iostream>
 
+#include "engine/world.h"
 #include "envs/registry.h"
 #include "tests/envs/tasks/scripted.h"
 
@@ -40,6 +41,29 @@ TEST(PendulumTest, EnergyPumpingSwingsUpAndHolds) {
             << ", random " << random << "\n";
   EXPECT_GE(scripted, 700.0);
   EXPECT_LT(random, 100.0);
+}
+
+// The reward is 1 within 30 degrees of upright and 0 beyond: sampled on both sides of the edge,
+// on both sides of upright, and far from it (a zone narrowed to 15 or widened to 90 degrees
+// fails here).
+TEST(PendulumTest, RewardZoneIsThirtyDegreesEachSide) {
+  PendulumTask task;
+  engine::World world(task.world_config());
+  task.build(world);
+  const engine::RobotId pendulum{0};  // the task's only robot
+  const double degree = 3.14159265358979 / 180.0;
+  for (const double from_upright_deg : {0.0, 10.0, 20.0, 29.0, 29.9, 30.1, 31.0, 45.0, 89.0, 91.0,
+                                        135.0, 180.0}) {
+    for (const double sign : {1.0, -1.0}) {
+      // Joint angle 0 hangs down; upright is pi.
+      const double q = 3.14159265358979 + sign * from_upright_deg * degree;
+      world.set_joint_state(pendulum, Eigen::Matrix<double, 1, 1>(q),
+                            Eigen::Matrix<double, 1, 1>(0.0));
+      ASSERT_NEAR(std::abs(task.angle_from_upright(world)), from_upright_deg * degree, 1e-9);
+      EXPECT_EQ(task.reward(world), from_upright_deg < 30.0 ? 1.0 : 0.0)
+          << sign * from_upright_deg << " degrees from upright";
+    }
+  }
 }
 
 TEST(PendulumTest, RewardOnlyNearUpright) {
