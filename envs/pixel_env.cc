@@ -147,7 +147,7 @@ Array PixelEnv::render_camera(const std::string& camera, int width, int height, 
   view.height = height;
   view.msaa_samples = msaa_samples;
   Array frame(DType::kUInt8, {height, width, 3});
-  renderer().render(scene_->scene(), view, {frame.data<std::uint8_t>()});
+  renderer().render(scene_->scene(), view, {width, height, frame.data<std::uint8_t>()});
   return frame;
 }
 
