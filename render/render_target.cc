@@ -59,10 +59,11 @@ void read_rgb(int width, int height, std::vector<std::uint8_t>& rgba, std::uint8
   const std::size_t count = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   rgba.resize(count * 4);
   glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+  const std::uint8_t* source = rgba.data();  // hoisted: stores to `rgb` may alias the vector
   for (std::size_t p = 0; p < count; ++p) {
-    rgb[p * 3] = rgba[p * 4];
-    rgb[p * 3 + 1] = rgba[p * 4 + 1];
-    rgb[p * 3 + 2] = rgba[p * 4 + 2];
+    rgb[p * 3] = source[p * 4];
+    rgb[p * 3 + 1] = source[p * 4 + 1];
+    rgb[p * 3 + 2] = source[p * 4 + 2];
   }
 }
 

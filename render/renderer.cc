@@ -213,7 +213,7 @@ struct Renderer::Impl {
     }
     const GpuMesh& floor_mesh = arena.add(floor);
     arena.sync();
-    textures.forget_binding();  // texture creation and the shadow map may have changed unit 0
+    textures.forget_binding();  // the shadow map, when (re)made below, is bound on unit 0
     const Eigen::Matrix4f view_projection = camera.projection_matrix() * camera.view_matrix();
     bounds.resize(scene.instances.size());
     for (std::size_t i = 0; i < scene.instances.size(); ++i) bounds[i] = drawn[i]->bounds;
