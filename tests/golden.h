@@ -39,6 +39,9 @@
 //    23-25 windows, from the pole; swing-up starting upright (kPi dropped): 2 windows but 48
 //    displaced; acrobot lower link +-0.1 rad: 31-34 windows; pendulum +-0.05 rad: 14-19 windows.
 //    None moves the clipped mean past 0.09: it is there for colour and light, not for motion.
+//  - Smaller mutants, for the edge of what it sees: pole +0.02 rad fails both swing-up frames (6
+//    windows) but passes the balance frames; +0.03 rad fails all four (6-8 windows); pendulum
+//    +0.02 rad fails (5 windows); acrobot lower link +0.05 rad fails (23 windows).
 //
 // On failure the actual frame and a diff image are written to build/test_output/golden/: grey is
 // |difference| x 8, red marks the 2 x 2 windows all off, blue the displaced pixels (magenta both).
