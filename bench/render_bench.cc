@@ -46,7 +46,7 @@ int main(int argc, char** argv) {
     for (int d = 0; d < dofs; ++d) q[d] = q0[d] + 0.4 * std::sin(0.01 * i + d);
     f.world->set_joint_state(pixelgym::engine::RobotId{0}, q, Eigen::VectorXd::Zero(dofs));
     f.view->update(*f.world);
-    renderer.render(f.view->scene(), f.camera, {rgb.data()});
+    renderer.render(f.view->scene(), f.camera, {width, height, rgb.data()});
     checksum += rgb[rgb.size() / 2];
   }
   const double seconds =

@@ -193,7 +193,7 @@ void PixelEnv::render_camera_into(const std::string& camera, int msaa_samples, A
   view.height = static_cast<int>(shape[0]);
   view.width = static_cast<int>(shape[1]);
   view.msaa_samples = msaa_samples;
-  renderer().render(scene_->scene(), view, {frame.data<std::uint8_t>()});
+  renderer().render(scene_->scene(), view, {view.width, view.height, frame.data<std::uint8_t>()});
   ++frames_rendered_;
 }
 

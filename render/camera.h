@@ -15,7 +15,8 @@ struct Camera {
   float far_m = 50.0F;
   int width = 84;
   int height = 84;
-  /// Multisample anti-aliasing samples: 0 (off, the default for observations), 2, 4 or 8.
+  /// Multisample anti-aliasing samples: 0 (off, the default for observations), 2, 4 or 8;
+  /// Renderer::render refuses more than its GL offers (llvmpipe: 4).
   int msaa_samples = 0;
 
   /// A camera at `eye` looking at `target`, with `up` (world) pointing up in the image. Throws

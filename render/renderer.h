@@ -11,9 +11,14 @@
 
 namespace pixelgym::render {
 
-/// Where `Renderer::render` writes; each pointer may be null to skip that output. Images are
-/// row-major with row 0 at the top and camera.width * camera.height pixels.
+/// Where `Renderer::render` writes, and the image size the buffers hold: `width` x `height`
+/// pixels, row-major with row 0 at the top; it must equal the camera's. Each pointer may be null
+/// to skip that output.
 struct RenderTargets {
+  /// Pixels per row of every buffer.
+  int width = 0;
+  /// Rows of every buffer.
+  int height = 0;
   /// 3 bytes per pixel, RGB.
   std::uint8_t* rgb = nullptr;
   /// Distance along the camera's viewing axis (-z) in metres; camera.far_m where nothing is drawn.
@@ -37,8 +42,10 @@ class Renderer {
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
-  /// Draws `scene` as seen by `camera`. Throws std::invalid_argument for an invalid camera or an
-  /// instance without a mesh, and std::runtime_error for a texture that cannot be read.
+  /// Draws `scene` as seen by `camera` into `targets`. Throws std::invalid_argument for an invalid
+  /// camera, targets whose width and height differ from the camera's (naming both), more MSAA
+  /// samples than the GL offers, or an instance without a mesh; std::runtime_error for a texture
+  /// that cannot be read.
   void render(const Scene& scene, const Camera& camera, const RenderTargets& targets);
 
   /// The GL implementation in use.

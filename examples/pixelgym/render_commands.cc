@@ -57,7 +57,9 @@ int run_view(const ViewOptions& options) {
     Array frame(DType::kUInt8, {options.height, options.width, 3});
     std::vector<std::int32_t> ids(static_cast<std::size_t>(options.width) *
                                   static_cast<std::size_t>(options.height));
-    renderer.render(view.scene(), camera, {frame.data<std::uint8_t>(), nullptr, ids.data()});
+    renderer.render(
+        view.scene(), camera,
+        {options.width, options.height, frame.data<std::uint8_t>(), nullptr, ids.data()});
     // How much of the frame the robot fills: a robot that cannot be seen is an error, not a PNG of
     // an empty floor.
     const auto covered =

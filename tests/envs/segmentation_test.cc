@@ -37,6 +37,8 @@ Images draw(render::Renderer& renderer, const render::Scene& scene, const render
       static_cast<std::size_t>(camera.width) * static_cast<std::size_t>(camera.height);
   Images images{std::vector<std::int32_t>(pixels), std::vector<float>(pixels)};
   render::RenderTargets targets;
+  targets.width = camera.width;
+  targets.height = camera.height;
   targets.segmentation = images.segmentation.data();
   targets.depth = images.depth.data();
   renderer.render(scene, camera, targets);

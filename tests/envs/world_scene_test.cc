@@ -14,7 +14,8 @@ using testing::FixtureScene;
 
 Array draw(FixtureScene& f, render::Renderer& renderer) {
   Array frame(DType::kUInt8, {f.camera.height, f.camera.width, 3});
-  renderer.render(f.view->scene(), f.camera, {frame.data<std::uint8_t>()});
+  renderer.render(f.view->scene(), f.camera,
+                  {f.camera.width, f.camera.height, frame.data<std::uint8_t>()});
   return frame;
 }
 

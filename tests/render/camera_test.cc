@@ -20,7 +20,8 @@ std::string error_of(const Camera& camera) {
 TEST(CameraTest, RejectsBadSizesFieldOfViewAndClipPlanes) {
   Camera camera;
   EXPECT_EQ(error_of(camera), "(valid)");
-  for (const auto& [w, h] : std::vector<std::pair<int, int>>{{0, 84}, {84, -1}, {9000, 84}, {84, 8193}}) {
+  for (const auto& [w, h] :
+       std::vector<std::pair<int, int>>{{0, 84}, {84, -1}, {9000, 84}, {84, 8193}}) {
     Camera c;
     c.width = w;
     c.height = h;
@@ -45,7 +46,8 @@ TEST(CameraTest, RejectsBadSizesFieldOfViewAndClipPlanes) {
 TEST(CameraTest, LookAtLooksAtTheTargetWithUpUp) {
   const Camera camera = Camera::look_at({3, 0, 1}, {0, 0, 1});
   // The target lies on the camera's -z axis, straight ahead.
-  const Eigen::Vector3f target_in_camera = camera.X_world_camera.inverse() * Eigen::Vector3f(0, 0, 1);
+  const Eigen::Vector3f target_in_camera =
+      camera.X_world_camera.inverse() * Eigen::Vector3f(0, 0, 1);
   EXPECT_TRUE(target_in_camera.isApprox(Eigen::Vector3f(0, 0, -3), 1e-6F));
   EXPECT_TRUE(camera.X_world_camera.linear().col(1).isApprox(Eigen::Vector3f::UnitZ(), 1e-6F));
   EXPECT_THROW(Camera::look_at({1, 1, 1}, {1, 1, 1}), std::invalid_argument);

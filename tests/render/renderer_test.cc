@@ -3,8 +3,11 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <thread>
+
+#include "render/gl.h"  // GL_MAX_SAMPLES, to check the MSAA limit against the GL
 
 namespace pixelgym::render {
 namespace {
@@ -18,7 +21,9 @@ struct Pixel {
 };
 
 Pixel at(const std::vector<std::uint8_t>& rgb, int width, int row, int col) {
-  const std::size_t i = (static_cast<std::size_t>(row) * static_cast<std::size_t>(width) + static_cast<std::size_t>(col)) * 3;
+  const std::size_t i = (static_cast<std::size_t>(row) * static_cast<std::size_t>(width) +
+                         static_cast<std::size_t>(col)) *
+                        3;
   return {rgb[i], rgb[i + 1], rgb[i + 2]};
 }
 
@@ -39,7 +44,8 @@ Scene flat_scene() {
   return scene;
 }
 
-Instance box(const Eigen::Vector3f& centre, const Eigen::Vector3f& size, const Eigen::Vector4f& color, int id = 0) {
+Instance box(const Eigen::Vector3f& centre, const Eigen::Vector3f& size,
+             const Eigen::Vector4f& color, int id = 0) {
   Instance instance;
   instance.mesh = make_box_mesh();
   instance.scale = size;
@@ -62,9 +68,10 @@ TEST(RendererTest, KnownColourBoxAtTheCentreAndBackgroundAtTheCorners) {
   Scene scene = flat_scene();
   scene.instances.push_back(box({0, 0, 0.5F}, {0.5F, 0.5F, 0.5F}, {0.8F, 0.25F, 0.5F, 1.0F}));
   std::vector<std::uint8_t> rgb(kSize * kSize * 3);
-  renderer.render(scene, front_camera(), {rgb.data()});
+  renderer.render(scene, front_camera(), {kSize, kSize, rgb.data()});
   expect_pixel(at(rgb, kSize, kSize / 2, kSize / 2), 204, 64, 128, "centre");
-  for (const auto& [row, col] : std::vector<std::pair<int, int>>{{0, 0}, {0, kSize - 1}, {kSize - 1, 0}, {kSize - 1, kSize - 1}}) {
+  for (const auto& [row, col] : std::vector<std::pair<int, int>>{
+           {0, 0}, {0, kSize - 1}, {kSize - 1, 0}, {kSize - 1, kSize - 1}}) {
     expect_pixel(at(rgb, kSize, row, col), 51, 102, 153, "corner");
   }
 }
@@ -75,7 +82,7 @@ TEST(RendererTest, RowZeroIsTheTopOfTheImage) {
   scene.instances.push_back(box({0, 0, 1.2F}, {0.4F, 0.4F, 0.4F}, {1, 0, 0, 1}));   // high: red
   scene.instances.push_back(box({0, 0, -0.2F}, {0.4F, 0.4F, 0.4F}, {0, 1, 0, 1}));  // low: green
   std::vector<std::uint8_t> rgb(kSize * kSize * 3);
-  renderer.render(scene, front_camera(), {rgb.data()});
+  renderer.render(scene, front_camera(), {kSize, kSize, rgb.data()});
   bool red_above_green = false;
   for (int row = 0; row < kSize / 2; ++row) {
     if (at(rgb, kSize, row, kSize / 2).r > 200) red_above_green = true;
@@ -91,11 +98,12 @@ TEST(RendererTest, DepthOfAPlaneAtAKnownDistanceWithinOneMillimetre) {
   scene.instances.push_back(box({0, 4.0F, 0.5F}, {20, 10, 20}, {1, 1, 1, 1}));  // face at y = -1
   std::vector<float> depth(kSize * kSize);
   Camera camera = front_camera();
-  renderer.render(scene, camera, {nullptr, depth.data()});
-  for (int p = 0; p < kSize * kSize; ++p) ASSERT_NEAR(depth[static_cast<std::size_t>(p)], 2.0F, 1e-3F) << p;
+  renderer.render(scene, camera, {kSize, kSize, nullptr, depth.data()});
+  for (int p = 0; p < kSize * kSize; ++p)
+    ASSERT_NEAR(depth[static_cast<std::size_t>(p)], 2.0F, 1e-3F) << p;
   // Where nothing is drawn, depth is the far plane.
   Scene empty = flat_scene();
-  renderer.render(empty, camera, {nullptr, depth.data()});
+  renderer.render(empty, camera, {kSize, kSize, nullptr, depth.data()});
   EXPECT_EQ(depth[0], camera.far_m);
 }
 
@@ -107,16 +115,19 @@ TEST(RendererTest, SegmentationIdsAreExact) {
   scene.instances.push_back(box({0.5F, 0, 0.5F}, {0.4F, 0.4F, 0.4F}, {0, 0, 1, 1}, 9));
   std::vector<std::int32_t> ids(kSize * kSize);
   std::vector<std::uint8_t> rgb(kSize * kSize * 3);
-  renderer.render(scene, front_camera(), {rgb.data(), nullptr, ids.data()});
-  const auto id_at = [&](int row, int col) { return ids[static_cast<std::size_t>(row * kSize + col)]; };
+  renderer.render(scene, front_camera(), {kSize, kSize, rgb.data(), nullptr, ids.data()});
+  const auto id_at = [&](int row, int col) {
+    return ids[static_cast<std::size_t>(row * kSize + col)];
+  };
   EXPECT_EQ(id_at(kSize / 2, kSize / 2 - 11), 5);
   EXPECT_EQ(id_at(kSize / 2, kSize / 2 + 11), 9);
-  EXPECT_EQ(id_at(0, 0), 0);            // sky
+  EXPECT_EQ(id_at(0, 0), 0);           // sky
   EXPECT_EQ(id_at(kSize - 1, 0), -1);  // floor
   for (std::int32_t id : ids) ASSERT_TRUE(id == 0 || id == -1 || id == 5 || id == 9) << id;
   // Every red pixel is id 5, every blue one id 9.
   for (int p = 0; p < kSize * kSize; ++p) {
-    const Pixel px{rgb[static_cast<std::size_t>(p) * 3], rgb[static_cast<std::size_t>(p) * 3 + 1], rgb[static_cast<std::size_t>(p) * 3 + 2]};
+    const Pixel px{rgb[static_cast<std::size_t>(p) * 3], rgb[static_cast<std::size_t>(p) * 3 + 1],
+                   rgb[static_cast<std::size_t>(p) * 3 + 2]};
     if (px.r > 250 && px.g < 5 && px.b < 5) {
       ASSERT_EQ(ids[static_cast<std::size_t>(p)], 5);
     }
@@ -135,9 +146,9 @@ TEST(RendererTest, ShadowsDarkenTheFloorUnderAnObject) {
   camera.width = camera.height = kSize;
   std::vector<std::uint8_t> with(kSize * kSize * 3);
   std::vector<std::uint8_t> without(kSize * kSize * 3);
-  renderer.render(scene, camera, {with.data()});
+  renderer.render(scene, camera, {kSize, kSize, with.data()});
   scene.shadows = false;
-  renderer.render(scene, camera, {without.data()});
+  renderer.render(scene, camera, {kSize, kSize, without.data()});
   // The floor at the origin is below the slab; it is hidden from the camera by nothing but the
   // slab's shadow. Find a floor pixel that changed and one that did not.
   int darker = 0;
@@ -171,11 +182,11 @@ TEST(RendererTest, OpenMeshesAreDrawnAndShadowedFromBehind) {
   camera.width = camera.height = kSize;
   std::vector<std::uint8_t> with(kSize * kSize * 3);
   std::vector<std::uint8_t> without(kSize * kSize * 3);
-  renderer.render(scene, camera, {with.data()});
+  renderer.render(scene, camera, {kSize, kSize, with.data()});
   const Pixel centre = at(with, kSize, kSize / 2, kSize / 2);
   EXPECT_GT(centre.r, 2 * centre.g) << "the sheet is not drawn from behind";
   scene.shadows = false;
-  renderer.render(scene, camera, {without.data()});
+  renderer.render(scene, camera, {kSize, kSize, without.data()});
   int darker = 0;
   for (std::size_t i = 0; i < with.size(); i += 3) {
     if (int{without[i]} - int{with[i]} > 20) ++darker;
@@ -194,9 +205,9 @@ TEST(RendererTest, MirroredClosedMeshesLookTheSame) {
   const Camera camera = Camera::look_at({1.5F, -2.5F, 1.8F}, {0, 0, 0.4F});
   Camera sized = camera;
   sized.width = sized.height = kSize;
-  renderer.render(scene, sized, {plain.data()});
+  renderer.render(scene, sized, {kSize, kSize, plain.data()});
   scene.instances[0].scale.x() = -scene.instances[0].scale.x();
-  renderer.render(scene, sized, {mirrored.data()});
+  renderer.render(scene, sized, {kSize, kSize, mirrored.data()});
   int differing = 0;
   for (std::size_t i = 0; i < plain.size(); ++i) {
     if (std::abs(int{plain[i]} - int{mirrored[i]}) > 8) ++differing;
@@ -208,10 +219,11 @@ TEST(RendererTest, TexturesModulateTheBaseColour) {
   Renderer renderer;
   Scene scene = flat_scene();
   Instance textured = box({0, 0, 0.5F}, {1.5F, 0.1F, 1.5F}, {1, 1, 1, 1});
-  textured.material.texture_path = std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/urdf_good/checker.png";
+  textured.material.texture_path =
+      std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/urdf_good/checker.png";
   scene.instances.push_back(textured);
   std::vector<std::uint8_t> rgb(kSize * kSize * 3);
-  renderer.render(scene, front_camera(), {rgb.data()});
+  renderer.render(scene, front_camera(), {kSize, kSize, rgb.data()});
   // The 8x8 texture's two grays (60 and 200) both appear on the face (texel centres are exact;
   // linear filtering blends between them).
   bool dark = false;
@@ -223,7 +235,7 @@ TEST(RendererTest, TexturesModulateTheBaseColour) {
   EXPECT_TRUE(dark && light);
   scene.instances[0].material.texture_path = "/nonexistent/texture.png";
   try {
-    renderer.render(scene, front_camera(), {rgb.data()});
+    renderer.render(scene, front_camera(), {kSize, kSize, rgb.data()});
     FAIL() << "no error";
   } catch (const std::runtime_error& error) {
     EXPECT_THAT(error.what(), HasSubstr("/nonexistent/texture.png"));
@@ -248,12 +260,12 @@ TEST(RendererTest, SameSceneTwiceGivesIdenticalBytes) {
   Camera camera = front_camera(96);
   std::vector<std::uint8_t> a(96 * 96 * 3);
   std::vector<std::uint8_t> b(96 * 96 * 3);
-  renderer.render(scene, camera, {a.data()});
-  renderer.render(busy_scene(0.3F), camera, {b.data()});  // something else in between
-  renderer.render(scene, camera, {b.data()});
+  renderer.render(scene, camera, {96, 96, a.data()});
+  renderer.render(busy_scene(0.3F), camera, {96, 96, b.data()});  // something else in between
+  renderer.render(scene, camera, {96, 96, b.data()});
   EXPECT_EQ(a, b);
   Renderer other;  // a fresh renderer's first frame matches too
-  other.render(scene, camera, {b.data()});
+  other.render(scene, camera, {96, 96, b.data()});
   EXPECT_EQ(a, b);
 }
 
@@ -262,15 +274,16 @@ TEST(RendererTest, TwoThreadsGiveTheBytesOfOneThread) {
   const Scene second = busy_scene(0.4F);
   Camera camera = front_camera(84);
   const std::size_t bytes = 84 * 84 * 3;
-  std::vector<std::uint8_t> seq_first(bytes), seq_second(bytes), par_first(bytes), par_second(bytes);
+  std::vector<std::uint8_t> seq_first(bytes), seq_second(bytes), par_first(bytes),
+      par_second(bytes);
   {
     Renderer renderer;
-    renderer.render(first, camera, {seq_first.data()});
-    renderer.render(second, camera, {seq_second.data()});
+    renderer.render(first, camera, {84, 84, seq_first.data()});
+    renderer.render(second, camera, {84, 84, seq_second.data()});
   }
   const auto draw = [&camera](const Scene& scene, std::vector<std::uint8_t>& out) {
     Renderer renderer;
-    for (int i = 0; i < 20; ++i) renderer.render(scene, camera, {out.data()});
+    for (int i = 0; i < 20; ++i) renderer.render(scene, camera, {84, 84, out.data()});
   };
   std::thread a(draw, std::cref(first), std::ref(par_first));
   std::thread b(draw, std::cref(second), std::ref(par_second));
@@ -294,9 +307,9 @@ TEST(RendererTest, MultisamplingSmoothsEdgesOnly) {
   Camera camera = front_camera();
   std::vector<std::uint8_t> plain(kSize * kSize * 3);
   std::vector<std::uint8_t> smooth(kSize * kSize * 3);
-  renderer.render(scene, camera, {plain.data()});
+  renderer.render(scene, camera, {kSize, kSize, plain.data()});
   camera.msaa_samples = 4;
-  renderer.render(scene, camera, {smooth.data()});
+  renderer.render(scene, camera, {kSize, kSize, smooth.data()});
   expect_pixel(at(smooth, kSize, kSize / 2, kSize / 2), 204, 64, 128, "centre with MSAA");
   // Without MSAA every pixel is the ball's or the sky's colour; with it the rim blends the two.
   const auto blended = [](const std::vector<std::uint8_t>& rgb) {
@@ -308,15 +321,26 @@ TEST(RendererTest, MultisamplingSmoothsEdgesOnly) {
   };
   EXPECT_EQ(blended(plain), 0);
   EXPECT_GT(blended(smooth), 20);
-  camera.msaa_samples = 8;  // llvmpipe offers at most 4
-  int max_samples = 0;
-  try {
-    renderer.render(scene, camera, {smooth.data()});
-    max_samples = 8;
-  } catch (const std::invalid_argument& error) {
-    EXPECT_THAT(error.what(), HasSubstr("at most"));
+  // Every sample count the GL offers is drawn (and smooths the rim); every larger one is refused
+  // naming the GL's limit. (llvmpipe offers 4: 2 and 4 draw, 8 is refused.)
+  GLint max_samples = 0;
+  glGetIntegerv(GL_MAX_SAMPLES, &max_samples);  // the renderer's context is current here
+  ASSERT_GE(max_samples, 2);
+  for (int samples : {2, 4, 8}) {
+    camera.msaa_samples = samples;
+    if (samples <= max_samples) {
+      std::fill(smooth.begin(), smooth.end(), std::uint8_t{0});
+      renderer.render(scene, camera, {kSize, kSize, smooth.data()});
+      EXPECT_GT(blended(smooth), 20) << samples << " samples";
+    } else {
+      try {
+        renderer.render(scene, camera, {kSize, kSize, smooth.data()});
+        FAIL() << samples << " samples drawn, but the GL offers at most " << max_samples;
+      } catch (const std::invalid_argument& error) {
+        EXPECT_THAT(error.what(), HasSubstr("at most " + std::to_string(max_samples)));
+      }
+    }
   }
-  EXPECT_TRUE(max_samples == 0 || max_samples == 8);
 }
 
 TEST(RendererTest, BadInputIsRejected) {
@@ -325,17 +349,37 @@ TEST(RendererTest, BadInputIsRejected) {
   std::vector<std::uint8_t> rgb(kSize * kSize * 3);
   Camera camera = front_camera();
   camera.width = 0;
-  EXPECT_THROW(renderer.render(scene, camera, {rgb.data()}), std::invalid_argument);
+  EXPECT_THROW(renderer.render(scene, camera, {kSize, kSize, rgb.data()}), std::invalid_argument);
   camera = front_camera();
   camera.far_m = camera.near_m;
-  EXPECT_THROW(renderer.render(scene, camera, {rgb.data()}), std::invalid_argument);
+  EXPECT_THROW(renderer.render(scene, camera, {kSize, kSize, rgb.data()}), std::invalid_argument);
   scene.instances.push_back(Instance{});
   try {
-    renderer.render(scene, front_camera(), {rgb.data()});
+    renderer.render(scene, front_camera(), {kSize, kSize, rgb.data()});
     FAIL() << "no error";
   } catch (const std::invalid_argument& error) {
     EXPECT_THAT(error.what(), HasSubstr("instance 0 has no mesh"));
   }
+}
+
+// The targets' size must be the camera's, on either axis: a buffer sized for another image would
+// be overrun or left partly unwritten.
+TEST(RendererTest, TargetsOfAnotherSizeAreRejected) {
+  Renderer renderer;
+  const Scene scene = flat_scene();
+  std::vector<std::uint8_t> rgb(kSize * kSize * 3);
+  const Camera camera = front_camera();
+  for (const auto& [width, height] : std::vector<std::pair<int, int>>{
+           {kSize - 1, kSize}, {kSize, kSize - 1}, {kSize, kSize / 2}, {0, 0}}) {
+    try {
+      renderer.render(scene, camera, {width, height, rgb.data()});
+      FAIL() << "no error for targets of " << width << "x" << height;
+    } catch (const std::invalid_argument& error) {
+      EXPECT_THAT(error.what(), HasSubstr(std::to_string(width) + "x" + std::to_string(height)));
+      EXPECT_THAT(error.what(), HasSubstr("64x64"));
+    }
+  }
+  EXPECT_NO_THROW(renderer.render(scene, camera, {kSize, kSize, rgb.data()}));
 }
 
 TEST(RendererTest, DescribesItsBackend) {
