@@ -64,8 +64,8 @@ void Env::step_into(const Value& action, StepResult& out) {
   }
   const std::string reason = action_space().mismatch(action);  // empty: no allocation
   if (!reason.empty()) {
-    throw std::invalid_argument(name() + ": step() action: " + action.to_string() +
-                                " is not in " + action_space().to_string() + ": " + reason);
+    throw std::invalid_argument(name() + ": step() action: " + action.to_string() + " is not in " +
+                                action_space().to_string() + ": " + reason);
   }
   require_layout(*this, observation_space(), out.obs, "step_into()");
   // Should do_step throw, the episode is in an unknown state: require a reset.

@@ -17,7 +17,8 @@ namespace pixelgym {
 //                            the action space, an unknown env id or kwarg,
 //                            a kwarg of the wrong type, a buffer of the
 //                            wrong layout, a malformed URDF, a bad config
-//   ResetNeeded              calls out of order: step/render before reset,   gymnasium.error.ResetNeeded
+//   ResetNeeded              calls out of order: step/render before reset,
+//   gymnasium.error.ResetNeeded
 //                            step after the episode ended, anything after    (RuntimeError without
 //                            close                                           gymnasium)
 //   std::runtime_error       the environment failing, not the caller: a      RuntimeError

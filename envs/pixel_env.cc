@@ -45,8 +45,8 @@ float* StateSlots::slot(const char* name, std::int64_t size) {
   }
   std::string names;
   for (const StateSpec& spec : specs_) names += (names.empty() ? "\"" : ", \"") + spec.name + "\"";
-  throw std::out_of_range("Task::observe: no state \"" + std::string(name) + "\" (states: " +
-                          names + ")");
+  throw std::out_of_range("Task::observe: no state \"" + std::string(name) +
+                          "\" (states: " + names + ")");
 }
 
 std::vector<ParamSpec> TaskConfig::params() {
@@ -184,9 +184,9 @@ Array PixelEnv::render_camera(const std::string& camera, int width, int height, 
 void PixelEnv::render_camera_into(const std::string& camera, int msaa_samples, Array& frame) {
   const Shape& shape = frame.shape();
   if (frame.dtype() != DType::kUInt8 || shape.size() != 3 || shape[2] != 3) {
-    throw std::invalid_argument(name() + ": a frame must be a uint8 (height, width, 3) array, got " +
-                                std::string(dtype_name(frame.dtype())) + " " +
-                                shape_to_string(shape));
+    throw std::invalid_argument(
+        name() + ": a frame must be a uint8 (height, width, 3) array, got " +
+        std::string(dtype_name(frame.dtype())) + " " + shape_to_string(shape));
   }
   scene_->update(*world_);
   render::Camera view = task_->camera(camera, *world_);

@@ -58,8 +58,8 @@ class Registry {
 
   /// Builds env `id` with `kwargs`, wrapped in TimeLimit when the spec (or the reserved kwarg
   /// "max_episode_steps") sets a limit. Throws std::invalid_argument for an unknown id (naming
-  /// the closest registered ids, or all of them when none is close), an unknown kwarg (listing the valid ones with types and
-  /// defaults) or a kwarg of the wrong type.
+  /// the closest registered ids, or all of them when none is close), an unknown kwarg (listing the
+  /// valid ones with types and defaults) or a kwarg of the wrong type.
   std::unique_ptr<Env> make(const std::string& id, const Params& kwargs = {}) const;
 
   /// What `make(id, kwargs)` would return — spaces, time limit, cameras, metadata — computed

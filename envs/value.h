@@ -61,8 +61,8 @@ class ValueTuple {
 /// One of Array, Dict or Tuple. Copies are shallow for the arrays inside (they share memory).
 class Value {
  public:
-  Value();             // an empty Array
-  Value(Array array);  // NOLINT(google-explicit-constructor): arrays are values
+  Value();                  // an empty Array
+  Value(Array array);       // NOLINT(google-explicit-constructor): arrays are values
   Value(ValueDict dict);    // NOLINT(google-explicit-constructor)
   Value(ValueTuple tuple);  // NOLINT(google-explicit-constructor)
 

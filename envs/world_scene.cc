@@ -22,7 +22,7 @@ struct ConvertedMesh {
 };
 
 std::shared_ptr<const render::MeshData> convert(const std::shared_ptr<const engine::Mesh>& mesh,
-                                        bool keep_part_colors) {
+                                                bool keep_part_colors) {
   static std::mutex mutex;
   static std::map<const engine::Mesh*, ConvertedMesh> converted;
   std::lock_guard<std::mutex> lock(mutex);
@@ -52,8 +52,8 @@ std::shared_ptr<const render::MeshData> convert(const std::shared_ptr<const engi
     const float half_diagonal = 0.5F * bounds.diagonal().norm();
     if (data->triangle_count() > kMeshLowDetailMinTriangles && half_diagonal > 0.0F) {
       // Two levels: the coarse copy has its own coarser copy, which shadows use (see Renderer).
-      auto coarse =
-          std::make_shared<render::MeshData>(*render::simplify_by_clustering(*data, half_diagonal / 3.0F));
+      auto coarse = std::make_shared<render::MeshData>(
+          *render::simplify_by_clustering(*data, half_diagonal / 3.0F));
       coarse->low_detail = render::simplify_by_clustering(*data, half_diagonal / 1.5F);
       coarse->low_detail_radius = half_diagonal;
       coarse->low_detail_below_px = 0.0F;  // never chosen for the camera, only for shadows
@@ -73,10 +73,10 @@ constexpr float kLowDetailBelowPx = 6.0F;
 // Unit primitives shared by every scene.
 std::shared_ptr<const render::MeshData> shared_primitive(engine::GeometryType type) {
   static const auto box = render::make_box_mesh();
-  static const auto sphere =
-      render::with_low_detail(*render::make_sphere_mesh(24), render::make_sphere_mesh(10), kLowDetailBelowPx);
-  static const auto cylinder =
-      render::with_low_detail(*render::make_cylinder_mesh(24), render::make_cylinder_mesh(10), kLowDetailBelowPx);
+  static const auto sphere = render::with_low_detail(
+      *render::make_sphere_mesh(24), render::make_sphere_mesh(10), kLowDetailBelowPx);
+  static const auto cylinder = render::with_low_detail(
+      *render::make_cylinder_mesh(24), render::make_cylinder_mesh(10), kLowDetailBelowPx);
   switch (type) {
     case engine::GeometryType::kBox:
       return box;
@@ -89,14 +89,15 @@ std::shared_ptr<const render::MeshData> shared_primitive(engine::GeometryType ty
 
 std::shared_ptr<const render::MeshData> shared_capsule(double length_over_radius) {
   static std::mutex mutex;
-  static std::map<long, std::shared_ptr<const render::MeshData>> capsules;  // by ratio in thousandths
+  static std::map<long, std::shared_ptr<const render::MeshData>>
+      capsules;  // by ratio in thousandths
   const long key = std::lround(length_over_radius * 1000.0);
   std::lock_guard<std::mutex> lock(mutex);
   auto& slot = capsules[key];
   if (slot == nullptr) {
     const double ratio = static_cast<double>(key) / 1000.0;
-    slot = render::with_low_detail(*render::make_capsule_mesh(ratio, 24), render::make_capsule_mesh(ratio, 10),
-                           kLowDetailBelowPx);
+    slot = render::with_low_detail(*render::make_capsule_mesh(ratio, 24),
+                                   render::make_capsule_mesh(ratio, 10), kLowDetailBelowPx);
   }
   return slot;
 }
@@ -162,8 +163,8 @@ Eigen::AlignedBox3f WorldScene::bounds() const {
   return box;
 }
 
-render::Camera frame_box(const Eigen::AlignedBox3f& box, float azimuth_deg, float elevation_deg, int width,
-                 int height, float fov_y_deg) {
+render::Camera frame_box(const Eigen::AlignedBox3f& box, float azimuth_deg, float elevation_deg,
+                         int width, int height, float fov_y_deg) {
   if (box.isEmpty()) throw std::invalid_argument("frame_box: nothing to frame (the box is empty)");
   const Eigen::Vector3f centre = box.center();
   const float radius = std::max(0.5F * box.diagonal().norm(), 1e-3F);

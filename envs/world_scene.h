@@ -35,7 +35,7 @@ class WorldScene {
 /// A camera that frames `box` whole, looking from the direction given by azimuth (degrees,
 /// counter-clockwise from +x) and elevation (degrees above the horizon). Throws
 /// std::invalid_argument for an empty box.
-render::Camera frame_box(const Eigen::AlignedBox3f& box, float azimuth_deg, float elevation_deg, int width,
-                 int height, float fov_y_deg = 40.0F);
+render::Camera frame_box(const Eigen::AlignedBox3f& box, float azimuth_deg, float elevation_deg,
+                         int width, int height, float fov_y_deg = 40.0F);
 
 }  // namespace pixelgym

@@ -64,7 +64,7 @@ class ObservationWrapper : public Wrapper {
   void do_step(const Value& action, StepResult& out) override;
 
  private:
-  SpacePtr observation_space_;  // null: the inner env's
+  SpacePtr observation_space_;      // null: the inner env's
   std::optional<Value> inner_obs_;  // the inner env's observation, allocated on the first reset
 };
 
@@ -83,7 +83,7 @@ class ActionWrapper : public Wrapper {
   void do_step(const Value& action, StepResult& out) override;
 
  private:
-  SpacePtr action_space_;  // null: the inner env's
+  SpacePtr action_space_;              // null: the inner env's
   std::optional<Value> inner_action_;  // allocated on the first step
 };
 

@@ -28,8 +28,9 @@ void AcrobotTask::build(engine::World& world) {
 }
 
 render::Camera AcrobotTask::camera(const std::string& name, const engine::World& /*world*/) const {
-  render::Camera camera = name == "wide" ? render::Camera::look_at({3.0F, -6.5F, 3.0F}, {0.0F, 0.0F, 2.1F})
-                                 : render::Camera::look_at({0.0F, -5.8F, 2.2F}, {0.0F, 0.0F, 2.2F});
+  render::Camera camera = name == "wide"
+                              ? render::Camera::look_at({3.0F, -6.5F, 3.0F}, {0.0F, 0.0F, 2.1F})
+                              : render::Camera::look_at({0.0F, -5.8F, 2.2F}, {0.0F, 0.0F, 2.2F});
   camera.fov_y_deg = 45.0F;
   return camera;
 }

@@ -55,9 +55,10 @@ void ArmPushTask::build(engine::World& world) {
 }
 
 render::Camera ArmPushTask::camera(const std::string& name, const engine::World& /*world*/) const {
-  render::Camera camera = name == "top" ? render::Camera::look_at({0.55F, 0.0F, 2.3F}, {0.55F, 0.0F, 0.72F},
-                                                  Eigen::Vector3f::UnitX())
-                                : render::Camera::look_at({1.4F, -1.3F, 1.6F}, {0.45F, 0.0F, 0.8F});
+  render::Camera camera = name == "top"
+                              ? render::Camera::look_at({0.55F, 0.0F, 2.3F}, {0.55F, 0.0F, 0.72F},
+                                                        Eigen::Vector3f::UnitX())
+                              : render::Camera::look_at({1.4F, -1.3F, 1.6F}, {0.45F, 0.0F, 0.8F});
   camera.fov_y_deg = 45.0F;
   return camera;
 }

@@ -46,9 +46,10 @@ void ArmReachTask::build(engine::World& world) {
 }
 
 render::Camera ArmReachTask::camera(const std::string& name, const engine::World& /*world*/) const {
-  render::Camera camera = name == "top" ? render::Camera::look_at({0.35F, 0.0F, 2.4F}, {0.35F, 0.0F, 0.3F},
-                                                  Eigen::Vector3f::UnitX())
-                                : render::Camera::look_at({1.5F, -1.7F, 1.3F}, {0.25F, 0.0F, 0.45F});
+  render::Camera camera = name == "top"
+                              ? render::Camera::look_at({0.35F, 0.0F, 2.4F}, {0.35F, 0.0F, 0.3F},
+                                                        Eigen::Vector3f::UnitX())
+                              : render::Camera::look_at({1.5F, -1.7F, 1.3F}, {0.25F, 0.0F, 0.45F});
   camera.fov_y_deg = 45.0F;
   return camera;
 }

@@ -26,8 +26,9 @@ void PendulumTask::build(engine::World& world) {
 }
 
 render::Camera PendulumTask::camera(const std::string& name, const engine::World& /*world*/) const {
-  render::Camera camera = name == "wide" ? render::Camera::look_at({1.2F, -3.2F, 1.6F}, {0.0F, 0.0F, 1.0F})
-                                 : render::Camera::look_at({0.0F, -2.2F, 1.2F}, {0.0F, 0.0F, 1.15F});
+  render::Camera camera = name == "wide"
+                              ? render::Camera::look_at({1.2F, -3.2F, 1.6F}, {0.0F, 0.0F, 1.0F})
+                              : render::Camera::look_at({0.0F, -2.2F, 1.2F}, {0.0F, 0.0F, 1.15F});
   camera.fov_y_deg = 45.0F;
   return camera;
 }

@@ -31,9 +31,10 @@ void ReacherTask::build(engine::World& world) {
 }
 
 render::Camera ReacherTask::camera(const std::string& name, const engine::World& /*world*/) const {
-  render::Camera camera = name == "angled" ? render::Camera::look_at({0.0F, -0.55F, 0.45F}, {0.0F, 0.0F, 0.0F})
-                                   : render::Camera::look_at({0.0F, 0.0F, 0.75F}, {0.0F, 0.0F, 0.0F},
-                                                     Eigen::Vector3f::UnitY());
+  render::Camera camera = name == "angled"
+                              ? render::Camera::look_at({0.0F, -0.55F, 0.45F}, {0.0F, 0.0F, 0.0F})
+                              : render::Camera::look_at({0.0F, 0.0F, 0.75F}, {0.0F, 0.0F, 0.0F},
+                                                        Eigen::Vector3f::UnitY());
   camera.fov_y_deg = 45.0F;
   return camera;
 }

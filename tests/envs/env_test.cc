@@ -53,7 +53,7 @@ TEST(EnvTest, ActionsOutsideTheSpaceAreRejectedNamingSpaceAndValue) {
       Array::from_vector<float>({2}, {0.0F, 0.0F}),  // wrong shape
       Array::from_vector<float>({1}, {NAN}),         // NaN
       Array::from_vector<float>({1}, {1.5F}),        // out of bounds
-      Value(ValueDict{{"a", Array::scalar(1.0F)}}),       // wrong structure
+      Value(ValueDict{{"a", Array::scalar(1.0F)}}),  // wrong structure
   };
   for (const Value& value : bad) {
     try {

@@ -20,8 +20,10 @@ struct FixtureScene {
 inline FixtureScene cartpole_scene(int width, int height) {
   FixtureScene f;
   f.world = std::make_unique<engine::World>();
-  const engine::RobotId robot = f.world->add_robot(engine::default_model_cache().load_urdf(engine::asset_path("cartpole/cartpole.urdf")));
-  f.world->set_joint_state(robot, (Eigen::VectorXd(2) << 0.3, 0.4).finished(), Eigen::VectorXd::Zero(2));
+  const engine::RobotId robot = f.world->add_robot(
+      engine::default_model_cache().load_urdf(engine::asset_path("cartpole/cartpole.urdf")));
+  f.world->set_joint_state(robot, (Eigen::VectorXd(2) << 0.3, 0.4).finished(),
+                           Eigen::VectorXd::Zero(2));
   f.view = std::make_unique<WorldScene>(*f.world);
   f.camera = render::Camera::look_at({0, -4.0F, 0.9F}, {0, 0, 1.3F});
   f.camera.fov_y_deg = 50.0F;
@@ -36,7 +38,8 @@ inline FixtureScene arm_scene(int width, int height) {
   FixtureScene f;
   f.world = std::make_unique<engine::World>();
   engine::ModelCache& cache = engine::default_model_cache();
-  const engine::RobotId arm = f.world->add_robot(cache.load_urdf(engine::asset_path("arm/arm.urdf")));
+  const engine::RobotId arm =
+      f.world->add_robot(cache.load_urdf(engine::asset_path("arm/arm.urdf")));
   engine::RobotOptions table;
   table.X_world_base.translation() = Eigen::Vector3f(0.75F, 0, 0).cast<double>();
   f.world->add_robot(cache.load_urdf(engine::asset_path("objects/table.urdf")), table);

@@ -18,10 +18,9 @@
 // Every other malloc is pixelgym's own (with the C++ library and Eigen, which are inlined into
 // it), and operator new is counted on its own: both must be zero. Mesa's and Bullet's counts are
 // printed.
-#include <gtest/gtest.h>
-
 #include <dlfcn.h>
 #include <execinfo.h>
+#include <gtest/gtest.h>
 
 #include <atomic>
 #include <cerrno>
@@ -54,7 +53,8 @@ Owner owner_of(void* const* frames, int depth) {
         std::strstr(name, "libgallium") != nullptr || std::strstr(name, "libglapi") != nullptr) {
       return Owner::kMesa;
     }
-    if (std::strstr(name, "libBullet") != nullptr || std::strstr(name, "libLinearMath") != nullptr) {
+    if (std::strstr(name, "libBullet") != nullptr ||
+        std::strstr(name, "libLinearMath") != nullptr) {
       owner = Owner::kBullet;
     }
   }
@@ -184,7 +184,7 @@ TEST(StepAllocationsTest, TheCounterSeesAllocations) {
   g_counting = false;
   std::free(raw);
   delete vector;
-  EXPECT_GE(g_news.load(), 2);    // the vector object and its elements
+  EXPECT_GE(g_news.load(), 2);     // the vector object and its elements
   EXPECT_GE(g_mallocs.load(), 3);  // those two through operator new, and the malloc
   EXPECT_EQ(g_mesa_mallocs.load(), 0);
   EXPECT_EQ(g_bullet_mallocs.load(), 0);
@@ -197,8 +197,8 @@ TEST_P(StepAllocationsTest, StepIntoAllocatesNothingAfterWarmUp) {
   const Counts counts = count_step_allocations(*env, /*warmup_steps=*/20, /*steps=*/100);
   EXPECT_EQ(counts.news, 0) << GetParam() << ": operator new calls in 100 steps";
   EXPECT_EQ(counts.mallocs, 0) << GetParam() << ": pixelgym's malloc calls in 100 steps";
-  std::printf("%s: in 100 steps, %ld mallocs inside Mesa, %ld inside Bullet\n",
-              GetParam().c_str(), counts.mesa_mallocs, counts.bullet_mallocs);
+  std::printf("%s: in 100 steps, %ld mallocs inside Mesa, %ld inside Bullet\n", GetParam().c_str(),
+              counts.mesa_mallocs, counts.bullet_mallocs);
 }
 
 TEST_P(StepAllocationsTest, StateModeAllocatesNothingOutsideBullet) {
@@ -208,8 +208,8 @@ TEST_P(StepAllocationsTest, StateModeAllocatesNothingOutsideBullet) {
   const Counts counts = count_step_allocations(*env, 20, 100);
   EXPECT_EQ(counts.news, 0) << GetParam();
   EXPECT_EQ(counts.mallocs + counts.mesa_mallocs, 0) << GetParam();
-  std::printf("%s, obs_mode=state: in 100 steps, %ld mallocs inside Bullet\n",
-              GetParam().c_str(), counts.bullet_mallocs);
+  std::printf("%s, obs_mode=state: in 100 steps, %ld mallocs inside Bullet\n", GetParam().c_str(),
+              counts.bullet_mallocs);
 }
 
 TEST_P(StepAllocationsTest, StepIntoWritesIntoTheCallersBuffer) {

@@ -33,7 +33,7 @@ TEST(ValueTest, WrongAlternativeThrows) {
 
 TEST(ValueTest, CloneIsDeepAndEqual) {
   Value value = ValueDict{{"x", Array::from_vector<float>({2}, {1, 2})},
-                     {"t", ValueTuple{Array::scalar<std::int64_t>(3)}}};
+                          {"t", ValueTuple{Array::scalar<std::int64_t>(3)}}};
   Value copy = value.clone();
   EXPECT_TRUE(copy.equals(value));
   EXPECT_FALSE(copy.shares_memory(value));
@@ -53,8 +53,8 @@ TEST(ValueTest, EqualsComparesStructure) {
 }
 
 TEST(ValueTest, LeavesAreDepthFirst) {
-  Value value =
-      ValueDict{{"a", Array::scalar(1.0)}, {"b", ValueTuple{Array::scalar(2.0), Array::scalar(3.0)}}};
+  Value value = ValueDict{{"a", Array::scalar(1.0)},
+                          {"b", ValueTuple{Array::scalar(2.0), Array::scalar(3.0)}}};
   const std::vector<Array> leaves = value.leaves();
   ASSERT_EQ(leaves.size(), 3U);
   EXPECT_EQ(leaves[2].item<double>(), 3.0);

@@ -68,8 +68,8 @@ TEST(WorldSceneTest, UrdfColoursOverrideTheMeshsOwnColours) {
   EXPECT_TRUE(instances[1].material.base_color.isApprox(Eigen::Vector4f(0.8F, 0.1F, 0.1F, 1.0F)));
   for (const render::MeshData::Part& part : instances[2].mesh->parts) EXPECT_TRUE(part.has_color);
 
-  f.camera = render::Camera::look_at({0.0F, 0.0F, 1.5F}, {0.0F, 0.0F, 0.0F},
-                                     Eigen::Vector3f::UnitY());
+  f.camera =
+      render::Camera::look_at({0.0F, 0.0F, 1.5F}, {0.0F, 0.0F, 0.0F}, Eigen::Vector3f::UnitY());
   f.camera.width = 84;
   f.camera.height = 84;
   render::Renderer renderer;

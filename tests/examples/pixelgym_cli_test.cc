@@ -484,7 +484,8 @@ double robot_share(const std::string& urdf, const render::Image& image) {
   empty.scene().shadows = false;
   const render::Camera camera = frame_box(bounds, -50.0F, 25.0F, image.width, image.height);
   std::vector<std::uint8_t> background(image.pixels.size());
-  render::Renderer().render(empty.scene(), camera, {camera.width, camera.height, background.data()});
+  render::Renderer().render(empty.scene(), camera,
+                            {camera.width, camera.height, background.data()});
   int differ = 0;
   for (std::size_t i = 0; i < background.size(); i += 3) {
     int distance = 0;

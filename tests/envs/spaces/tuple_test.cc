@@ -26,14 +26,14 @@ TEST(TupleSpaceTest, SamplesAreContainedAcrossSeeds) {
 TEST(TupleSpaceTest, ContainsRejectsWrongLengthAndItems) {
   const Tuple space = make_space();
   EXPECT_FALSE(space.contains(pixelgym::ValueTuple{Array::scalar<std::int64_t>(1)}));
-  EXPECT_FALSE(space.contains(
-      pixelgym::ValueTuple{Array::scalar<std::int64_t>(3), Array::from_vector<float>({2}, {0, 0})}));
-  EXPECT_FALSE(space.contains(
-      pixelgym::ValueTuple{Array::scalar<std::int64_t>(1), Array::from_vector<double>({2}, {0, 0})}));
-  EXPECT_FALSE(space.contains(
-      pixelgym::ValueTuple{Array::scalar<std::int64_t>(1), Array::from_vector<float>({2}, {NAN, 0})}));
-  EXPECT_TRUE(space.contains(
-      pixelgym::ValueTuple{Array::scalar<std::int64_t>(1), Array::from_vector<float>({2}, {0, 0})}));
+  EXPECT_FALSE(space.contains(pixelgym::ValueTuple{Array::scalar<std::int64_t>(3),
+                                                   Array::from_vector<float>({2}, {0, 0})}));
+  EXPECT_FALSE(space.contains(pixelgym::ValueTuple{Array::scalar<std::int64_t>(1),
+                                                   Array::from_vector<double>({2}, {0, 0})}));
+  EXPECT_FALSE(space.contains(pixelgym::ValueTuple{Array::scalar<std::int64_t>(1),
+                                                   Array::from_vector<float>({2}, {NAN, 0})}));
+  EXPECT_TRUE(space.contains(pixelgym::ValueTuple{Array::scalar<std::int64_t>(1),
+                                                  Array::from_vector<float>({2}, {0, 0})}));
   EXPECT_FALSE(space.contains(Value(pixelgym::ValueDict{})));
 }
 

@@ -19,11 +19,13 @@ Eigen::Vector3d vec3(const Value& obs, const std::string& key) {
 }
 
 // Cube and goal positions from the observation's relative vectors.
-Eigen::Vector3d cube_of(const Value& obs) { return vec3(obs, "end_effector_pos") + vec3(obs, "to_cube"); }
+Eigen::Vector3d cube_of(const Value& obs) {
+  return vec3(obs, "end_effector_pos") + vec3(obs, "to_cube");
+}
 Eigen::Vector3d goal_of(const Value& obs) {
   const Eigen::Vector3d cube = cube_of(obs);
-  return {cube.x() + testing::state(obs, "cube_to_goal", 0), cube.y() + testing::state(obs, "cube_to_goal", 1),
-          ArmPushTask::kTableTop};
+  return {cube.x() + testing::state(obs, "cube_to_goal", 0),
+          cube.y() + testing::state(obs, "cube_to_goal", 1), ArmPushTask::kTableTop};
 }
 
 // A scripted push: hover behind the cube (seen from the goal), descend to the cube's height and

@@ -52,8 +52,8 @@ TEST(PendulumTest, RewardZoneIsThirtyDegreesEachSide) {
   task.build(world);
   const engine::RobotId pendulum{0};  // the task's only robot
   const double degree = 3.14159265358979 / 180.0;
-  for (const double from_upright_deg : {0.0, 10.0, 20.0, 29.0, 29.9, 30.1, 31.0, 45.0, 89.0, 91.0,
-                                        135.0, 180.0}) {
+  for (const double from_upright_deg :
+       {0.0, 10.0, 20.0, 29.0, 29.9, 30.1, 31.0, 45.0, 89.0, 91.0, 135.0, 180.0}) {
     for (const double sign : {1.0, -1.0}) {
       // Joint angle 0 hangs down; upright is pi.
       const double q = 3.14159265358979 + sign * from_upright_deg * degree;
