@@ -10,8 +10,13 @@
 namespace pixelgym {
 namespace {
 
+// "an int", "a float": the type's name with its article, for messages.
+std::string with_article(ParamType type) {
+  return (type == ParamType::kInt ? "an " : "a ") + std::string(param_type_name(type));
+}
+
 std::invalid_argument wrong_type(ParamType wanted, const Param& got) {
-  return std::invalid_argument(std::string("expected a ") + param_type_name(wanted) + ", got " +
+  return std::invalid_argument(std::string("expected ") + with_article(wanted) + ", got " +
                                param_type_name(got.type()) + " " + got.to_string());
 }
 
@@ -71,8 +76,7 @@ std::string Param::to_string() const {
 
 Param parse_param(ParamType type, const std::string& text) {
   const auto fail = [&] {
-    return std::invalid_argument("cannot read \"" + text + "\" as " +
-                                 (type == ParamType::kInt ? "an " : "a ") + param_type_name(type));
+    return std::invalid_argument("cannot read \"" + text + "\" as " + with_article(type));
   };
   switch (type) {
     case ParamType::kBool: {
@@ -131,8 +135,8 @@ Params resolve_params(const std::vector<ParamSpec>& specs, const Params& given,
     } else if (spec->type() == ParamType::kFloat && value.type() == ParamType::kInt) {
       resolved.at(key) = value.as_float();
     } else {
-      throw std::invalid_argument(context + ": kwarg \"" + key + "\" must be a " +
-                                  param_type_name(spec->type()) + ", got " +
+      throw std::invalid_argument(context + ": kwarg \"" + key + "\" must be " +
+                                  with_article(spec->type()) + ", got " +
                                   param_type_name(value.type()) + " " + value.to_string());
     }
   }

@@ -49,7 +49,7 @@ TEST(ParamsTest, WrongTypeNamesExpectedAndGiven) {
     FAIL();
   } catch (const std::invalid_argument& error) {
     const std::string message = error.what();
-    EXPECT_NE(message.find("must be a int"), std::string::npos);
+    EXPECT_NE(message.find("must be an int"), std::string::npos);
     EXPECT_NE(message.find("string \"wide\""), std::string::npos);
   }
   EXPECT_THROW(resolve_params(kSpecs, {{"width", 1.5}}, "T-v0"), std::invalid_argument);

@@ -90,7 +90,7 @@ TEST(RegistryTest, WrongKwargTypeIsRejected) {
   EXPECT_THAT(error_of([&] {
                 registry.make("Probe-v0", {{"episode_length", "long"}});
               }),
-              HasSubstr("kwarg \"episode_length\" must be a int, got string \"long\""));
+              HasSubstr("kwarg \"episode_length\" must be an int, got string \"long\""));
   EXPECT_NO_THROW(registry.make("Probe-v0", {{"gain", 1}}));  // int accepted for float
 }
 

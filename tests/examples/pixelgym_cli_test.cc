@@ -429,6 +429,19 @@ TEST(PixelgymCliTest, InspectWorksOnEveryAsset) {
   EXPECT_THAT(arm.output, HasSubstr("total mass 23.200 kg"));
 }
 
+TEST(PixelgymCliTest, InspectCountsAFloatingBasesSixDegreesAndSaysOneInTheSingular) {
+  const CliRun cube = run("inspect --floating-base " + asset("objects/cube.urdf"));
+  EXPECT_EQ(cube.exit_code, 0) << cube.output;
+  EXPECT_THAT(cube.output,
+              HasSubstr("simulates: 6 degrees of freedom (0 joints + 6 of the floating base), "
+                        "floating base"));
+  const CliRun fixed = run("inspect " + asset("objects/cube.urdf"));
+  EXPECT_THAT(fixed.output, HasSubstr("simulates: 0 degrees of freedom"));
+  const CliRun pendulum = run("inspect " + asset("pendulum/pendulum.urdf"));
+  EXPECT_THAT(pendulum.output, HasSubstr("simulates: 1 degree of freedom (1 joint), fixed base"));
+  EXPECT_THAT(pendulum.output, ::testing::Not(HasSubstr("1 degrees")));
+}
+
 TEST(PixelgymCliTest, InspectRefusesEveryBadFileNamingTheProblem) {
   const std::string dir = std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/urdf/";
   const std::vector<std::string> bad = {"bad_inertia",
