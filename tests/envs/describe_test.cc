@@ -18,6 +18,7 @@
 #include "envs/registry.h"
 #include "envs/spaces/box.h"
 #include "envs/spaces/dict.h"
+#include "tests/envs/env_ids.h"
 
 namespace {
 
@@ -79,13 +80,7 @@ TEST_P(DescribeTest, MatchesTheEnvMakeBuilds) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllEnvs, DescribeTest, ::testing::ValuesIn(registered_ids()),
-                         [](const ::testing::TestParamInfo<std::string>& param_info) {
-                           std::string name = param_info.param;
-                           for (char& c : name) {
-                             if (c == '-') c = '_';
-                           }
-                           return name;
-                         });
+                         testing::env_id_test_name);
 
 TEST(DescribeTest, TheCountersSeeAWorldAndAContext) {
   const int contexts = g_gl_contexts;

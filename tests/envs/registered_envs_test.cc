@@ -9,6 +9,7 @@
 #include "envs/checker.h"
 #include "envs/pixel_env.h"
 #include "envs/registry.h"
+#include "tests/envs/env_ids.h"
 #include "tests/golden.h"
 
 namespace pixelgym {
@@ -137,13 +138,7 @@ TEST_P(RegisteredEnvTest, FirstObservationMatchesItsGolden) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllEnvs, RegisteredEnvTest, ::testing::ValuesIn(registered_ids()),
-                         [](const ::testing::TestParamInfo<std::string>& param_info) {
-                           std::string name = param_info.param;
-                           for (char& c : name) {
-                             if (c == '-') c = '_';
-                           }
-                           return name;
-                         });
+                         testing::env_id_test_name);
 
 }  // namespace
 }  // namespace pixelgym

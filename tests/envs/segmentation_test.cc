@@ -23,6 +23,7 @@
 #include "envs/registry.h"
 #include "envs/rng.h"
 #include "render/renderer.h"
+#include "tests/envs/env_ids.h"
 
 namespace pixelgym {
 namespace {
@@ -160,13 +161,7 @@ TEST_P(SegmentationTest, EachVisibleOwnersIdIsDrawnWhereItIsAndNowhereElse) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllEnvs, SegmentationTest, ::testing::ValuesIn(registered_ids()),
-                         [](const ::testing::TestParamInfo<std::string>& param_info) {
-                           std::string name = param_info.param;
-                           for (char& c : name) {
-                             if (c == '-') c = '_';
-                           }
-                           return name;
-                         });
+                         testing::env_id_test_name);
 
 }  // namespace
 }  // namespace pixelgym

@@ -31,6 +31,7 @@
 
 #include "envs/pixel_env.h"
 #include "envs/registry.h"
+#include "tests/envs/env_ids.h"
 
 namespace {
 
@@ -237,13 +238,7 @@ TEST_P(StepAllocationsTest, StepIntoRefusesABufferOfAnotherLayout) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllEnvs, StepAllocationsTest, ::testing::ValuesIn(registered_ids()),
-                         [](const ::testing::TestParamInfo<std::string>& param_info) {
-                           std::string name = param_info.param;
-                           for (char& c : name) {
-                             if (c == '-') c = '_';
-                           }
-                           return name;
-                         });
+                         testing::env_id_test_name);
 
 TEST(StepAllocationsTest, GridWorldPixelsAllocatesNothing) {
   std::unique_ptr<Env> env = make("GridWorld-v0", {{"obs_mode", "pixels"}});
