@@ -100,7 +100,8 @@ struct VisualShape {
 /// worlds except immutable models and meshes, so worlds in different threads are independent. A
 /// World is used by one thread at a time (its const queries included: some keep scratch space).
 /// Robots and bodies are named by the RobotId / BodyId that `add_robot` / `add_body` returned;
-/// an id of another world, or a default one, throws std::out_of_range.
+/// an id out of range (a default one, or one from a world with more robots or bodies) throws
+/// std::out_of_range.
 ///
 /// Segmentation ids: every owner of visual shapes, i.e. every link of every robot (with or
 /// without visuals) and every body, has its own id, handed out 1, 2, 3, ... in the order things

@@ -155,6 +155,57 @@ CheckReport check_env(Env& env, const CheckOptions& options) {
     }
   });
 
+  run("buffer_path", [&] {
+    // reset_into / step_into write into the caller's arrays and give what reset / step give.
+    const auto same_arrays = [](const std::vector<Array>& a, const std::vector<Array>& b) {
+      if (a.size() != b.size()) return false;
+      for (std::size_t i = 0; i < a.size(); ++i) {
+        if (a[i].raw_data() != b[i].raw_data()) return false;
+      }
+      return true;
+    };
+    ResetResult reset;
+    reset.obs = env.observation_space().zeros();
+    const std::vector<Array> reset_arrays = reset.obs.leaves();
+    env.reset_into(reset, seed);
+    expect(same_arrays(reset_arrays, reset.obs.leaves()),
+           "reset_into() put arrays of its own in the caller's observation instead of writing "
+           "into them");
+    expect(reset.obs.equals(env.reset(seed).obs),
+           "reset_into(seed) and reset(seed) gave different observations");
+
+    Rng actions_rng(seed);
+    std::vector<Value> actions;
+    for (int i = 0; i < std::min(options.num_steps, 10); ++i) {
+      actions.push_back(env.action_space().sample(actions_rng));
+    }
+    std::vector<StepResult> expected;
+    env.reset(seed);
+    for (const Value& action : actions) {
+      expected.push_back(env.step(action));
+      if (expected.back().terminated || expected.back().truncated) break;
+    }
+    env.reset(seed);
+    StepResult step;
+    step.obs = env.observation_space().zeros();
+    const std::vector<Array> step_arrays = step.obs.leaves();
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+      env.step_into(actions[i], step);
+      const std::string where = " at step " + std::to_string(i);
+      expect(same_arrays(step_arrays, step.obs.leaves()),
+             "step_into() put arrays of its own in the caller's observation instead of writing "
+             "into them" +
+                 where);
+      expect(step.obs.equals(expected[i].obs),
+             "step_into() and step() observations differ" + where);
+      expect(step.reward == expected[i].reward ||
+                 (std::isnan(step.reward) && std::isnan(expected[i].reward)),
+             "step_into() and step() rewards differ" + where);
+      expect(step.terminated == expected[i].terminated && step.truncated == expected[i].truncated,
+             "step_into() and step() flags differ" + where);
+    }
+  });
+
   run("render", [&] {
     env.reset(seed);
     const Array frame = env.render();

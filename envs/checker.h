@@ -42,6 +42,8 @@ struct CheckOptions {
 ///  - step: random steps return observations inside the space and finite rewards.
 ///  - step_determinism: the same seed and actions give identical observations, rewards and flags.
 ///  - observation_aliasing: consecutive observations do not share memory.
+///  - buffer_path: `reset_into` / `step_into` write into the caller's arrays (no array of the
+///    env's own swapped in) and give what `reset` / `step` give for the same seed and actions.
 ///  - render: `render()` returns an (H, W, 3) uint8 array.
 ///  - metadata: render_modes holds "rgb_array" and render_fps > 0.
 ///  - close: `close()` twice raises nothing. The env is closed afterwards.

@@ -9,22 +9,18 @@ namespace pixelgym {
 // names the component, what it expected and what it was given. A binding maps them by type,
 // without reading messages:
 //
-//   C++ type                 meaning                                         Python
-//   std::out_of_range        a missing key or index: a ValueDict or          KeyError (IndexError
-//                            spaces::Dict key, an Array index or slice,      for Array/Tuple
-//                            a Task's state name                             positions)
-//   std::invalid_argument    a bad value from the caller: an action not in   ValueError
-//                            the action space, an unknown env id or kwarg,
-//                            a kwarg of the wrong type, a buffer of the
-//                            wrong layout, a malformed URDF, a bad config
-//   ResetNeeded              calls out of order: step/render before reset,
-//   gymnasium.error.ResetNeeded
-//                            step after the episode ended, anything after    (RuntimeError without
-//                            close                                           gymnasium)
-//   std::runtime_error       the environment failing, not the caller: a      RuntimeError
-//                            file that cannot be read or written, a GL
-//                            context that cannot be made, a simulation that
-//                            went non-finite
+// - std::out_of_range: a missing key or position (a ValueDict or spaces::Dict key, an Array
+//   index or slice, a Dict-space insert position, a Task's state name, a World robot or body
+//   id). Python: KeyError for keys, IndexError for positions.
+// - std::invalid_argument: a bad value from the caller (an action not in the action space, an
+//   unknown env id or kwarg, a kwarg of the wrong type, a buffer of the wrong layout, a
+//   malformed URDF, a bad config). Python: ValueError.
+// - ResetNeeded: calls out of order (step or render before reset, step after the episode
+//   ended, anything but close after close). Python: gymnasium.error.ResetNeeded, or
+//   RuntimeError without gymnasium.
+// - std::runtime_error: the environment failing, not the caller (a file that cannot be read or
+//   written, a GL context that cannot be made, a simulation that went non-finite).
+//   Python: RuntimeError.
 //
 // std::out_of_range and std::invalid_argument both derive from std::logic_error, and so does
 // ResetNeeded: catch ResetNeeded before std::logic_error when the difference matters.

@@ -45,7 +45,7 @@ const Value& ValueDict::at(const std::string& key) const {
   if (i < 0) {
     std::string present;
     for (const auto& k : keys_) present += (present.empty() ? "\"" : ", \"") + k + "\"";
-    throw std::out_of_range("Dict: no key \"" + key +
+    throw std::out_of_range("ValueDict: no key \"" + key +
                             "\" (keys: " + (present.empty() ? "none" : present) + ")");
   }
   return values_[static_cast<std::size_t>(i)];
@@ -60,7 +60,7 @@ ValueTuple::ValueTuple(std::vector<Value> items) : items_(std::move(items)) {}
 
 const Value& ValueTuple::at(std::size_t i) const {
   if (i >= items_.size()) {
-    throw std::out_of_range("Tuple: index " + std::to_string(i) + " out of range for size " +
+    throw std::out_of_range("ValueTuple: index " + std::to_string(i) + " out of range for size " +
                             std::to_string(items_.size()));
   }
   return items_[i];

@@ -58,7 +58,8 @@ class ValueTuple {
   std::vector<Value> items_;
 };
 
-/// One of Array, Dict or Tuple. Copies are shallow for the arrays inside (they share memory).
+/// One of Array, ValueDict or ValueTuple. Copies are shallow for the arrays inside (they share
+/// memory).
 class Value {
  public:
   Value();                  // an empty Array

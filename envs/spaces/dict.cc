@@ -128,9 +128,9 @@ std::shared_ptr<const Dict> Dict::inserted(const std::string& key, SpacePtr spac
   }
   const std::size_t at = position.value_or(entries_.size());
   if (at > entries_.size()) {
-    throw std::invalid_argument("spaces::Dict: cannot insert \"" + key + "\" at position " +
-                                std::to_string(at) + " of " + std::to_string(entries_.size()) +
-                                " entries");
+    throw std::out_of_range("spaces::Dict: cannot insert \"" + key + "\" at position " +
+                            std::to_string(at) + " of " + std::to_string(entries_.size()) +
+                            " entries");
   }
   Entries entries = entries_;
   entries.insert(entries.begin() + static_cast<std::ptrdiff_t>(at), {key, std::move(space)});

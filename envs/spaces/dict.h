@@ -39,8 +39,8 @@ class Dict final : public Space {
 
   /// Copies with one entry changed (spaces are immutable), for wrappers that change one key:
   /// `replaced` swaps the subspace of `key` in place (std::out_of_range when absent);
-  /// `inserted` adds `key` at `position` (the end by default; std::invalid_argument when present
-  /// or past the end); `removed` drops `key` (std::out_of_range when absent).
+  /// `inserted` adds `key` at `position` (the end by default; std::invalid_argument when present,
+  /// std::out_of_range past the end); `removed` drops `key` (std::out_of_range when absent).
   std::shared_ptr<const Dict> replaced(const std::string& key, SpacePtr space) const;
   std::shared_ptr<const Dict> inserted(const std::string& key, SpacePtr space,
                                        std::optional<std::size_t> position = std::nullopt) const;

@@ -147,9 +147,11 @@ int run_info(const InfoArguments& args) {
     rows.push_back(
         {param.name, param_type_name(param.type()), param.default_value.to_string(), param.doc});
   }
-  rows.push_back({"max_episode_steps", "int",
-                  spec->max_episode_steps ? std::to_string(*spec->max_episode_steps) : "0",
-                  "steps before TimeLimit truncates; 0 for no limit"});
+  // Its default follows the other kwargs (a pixel task's action_repeat), as describe gives it.
+  rows.push_back(
+      {"max_episode_steps", "int",
+       description.max_episode_steps ? std::to_string(*description.max_episode_steps) : "0",
+       "steps before TimeLimit truncates; 0 for no limit"});
   print_table(std::cout, rows, "  ");
   return 0;
 }

@@ -21,7 +21,7 @@ TEST(CheckerTest, HealthyEnvPassesEveryCheck) {
   ProbeEnv env;
   const CheckReport report = check_env(env);
   EXPECT_TRUE(report.passed()) << ::testing::PrintToString(failed_names(report));
-  EXPECT_EQ(report.results.size(), 11U);
+  EXPECT_EQ(report.results.size(), 12U);
   EXPECT_TRUE(env.closed());
 }
 
@@ -62,6 +62,7 @@ INSTANTIATE_TEST_SUITE_P(
         FaultCase{Fault::kStepObservationOutside, "step", "is outside [-10.0, 10.0]"},
         FaultCase{Fault::kNondeterministicStep, "step_determinism", "observations differ"},
         FaultCase{Fault::kAliasedObservation, "observation_aliasing", "share memory"},
+        FaultCase{Fault::kReplacesBuffer, "buffer_path", "instead of writing into them"},
         FaultCase{Fault::kBadRender, "render", "(8, 8, 4)"},
         FaultCase{Fault::kZeroRenderFps, "metadata", "render_fps must be > 0, got 0"},
         FaultCase{Fault::kCloseThrows, "close", "close failed"}),

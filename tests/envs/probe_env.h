@@ -23,6 +23,7 @@ enum class Fault {
   kStepObservationOutside,  // steps leave the observation space
   kNondeterministicStep,    // steps add OS noise
   kAliasedObservation,      // one buffer is returned (and overwritten) every step
+  kReplacesBuffer,          // steps put a new array in place of the caller's instead of writing
   kBadRender,               // RGBA frames
   kZeroRenderFps,
   kCloseThrows,
@@ -94,6 +95,7 @@ class ProbeEnv final : public Env {
     if (fault_ == Fault::kNondeterministicStep) x_ += 1e-3 * os_uniform();
     if (fault_ == Fault::kStepObservationOutside && t_ == 2) x_ = 100.0;
     ++t_;
+    if (fault_ == Fault::kReplacesBuffer) out.obs = Array(DType::kFloat32, {2});
     observe(out.obs);
     out.reward = fault_ == Fault::kNanReward ? std::nan("") : -std::abs(x_);
     out.terminated = t_ >= episode_length_;

@@ -14,7 +14,8 @@
 // - Bullet mallocs when a pair of compound collision shapes starts to overlap (its dispatcher
 //   creates a btCompoundCollisionAlgorithm, freed when the pair separates, so this never settles
 //   in a task whose contacts come and go) and when its solver arrays grow for constraint rows
-//   not seen before: a stack with a frame in libBullet* or libLinearMath is Bullet's.
+//   not seen before: a stack with a frame in libBullet* (collision, dynamics) is Bullet's; one
+//   that reaches Bullet's allocator (libLinearMath) only from pixelgym's code is pixelgym's.
 // Every other malloc is pixelgym's own (with the C++ library and Eigen, which are inlined into
 // it), and operator new is counted on its own: both must be zero. Mesa's and Bullet's counts are
 // printed.
@@ -54,10 +55,9 @@ Owner owner_of(void* const* frames, int depth) {
         std::strstr(name, "libgallium") != nullptr || std::strstr(name, "libglapi") != nullptr) {
       return Owner::kMesa;
     }
-    if (std::strstr(name, "libBullet") != nullptr ||
-        std::strstr(name, "libLinearMath") != nullptr) {
-      owner = Owner::kBullet;
-    }
+    // Bullet's collision and dynamics code, not LinearMath: btAlignedObjectArray growth called
+    // from pixelgym's own code passes through libLinearMath too, and that is pixelgym's.
+    if (std::strstr(name, "libBullet") != nullptr) owner = Owner::kBullet;
   }
   return owner;
 }

@@ -105,5 +105,49 @@ TEST(WrapperTest, OrderIsEnforcedAtTheWrapperAndCloseReachesInner) {
 
 TEST(WrapperTest, NullEnvIsRejected) { EXPECT_THROW(NegateReward(nullptr), std::invalid_argument); }
 
+TEST(WrapperTest, ObservationWrapperWritesIntoTheCallersBufferThroughItsOwn) {
+  DoubleObservation env(std::make_unique<ProbeEnv>());
+  ResetResult reset;
+  reset.obs = env.observation_space().zeros();
+  const void* reset_memory = reset.obs.array().raw_data();
+  env.reset_into(reset, 3);
+  EXPECT_EQ(reset.obs.array().raw_data(), reset_memory);
+  EXPECT_TRUE(reset.obs.equals(env.reset(3).obs));
+
+  env.reset(3);
+  StepResult step;
+  step.obs = env.observation_space().zeros();
+  const void* step_memory = step.obs.array().raw_data();
+  env.step_into(action(0.5F), step);
+  EXPECT_EQ(step.obs.array().raw_data(), step_memory);
+  const double x = static_cast<ProbeEnv&>(env.unwrapped()).x();
+  EXPECT_FLOAT_EQ(step.obs.array().data<float>()[0], static_cast<float>(2.0 * x));
+}
+
+TEST(WrapperTest, TheCallerKeepsItsBufferWhenTheInnerEnvThrows) {
+  DoubleObservation env(std::make_unique<ProbeEnv>());
+  env.reset(0);
+  StepResult step;
+  step.obs = env.observation_space().zeros();
+  const void* memory = step.obs.array().raw_data();
+  env.env().close();  // the inner env now refuses to step; the wrapper still accepts the call
+  EXPECT_THROW(env.step_into(action(0.0F), step), ResetNeeded);
+  ASSERT_TRUE(step.obs.is_array());
+  EXPECT_EQ(step.obs.array().raw_data(), memory);
+  EXPECT_EQ(step.obs.array().shape(), (Shape{2}));
+}
+
+TEST(WrapperTest, ActionWrapperStepsTheInnerEnvThroughItsOwnActionBuffer) {
+  ScaleAction env(std::make_unique<ProbeEnv>());
+  env.reset(0);
+  const double x0 = static_cast<ProbeEnv&>(env.unwrapped()).x();
+  StepResult step;
+  step.obs = env.observation_space().zeros();
+  env.step_into(action(5.0F), step);
+  env.step_into(action(-5.0F), step);
+  env.step_into(action(5.0F), step);
+  EXPECT_NEAR(static_cast<ProbeEnv&>(env.unwrapped()).x(), x0 + 0.05, 1e-6);
+}
+
 }  // namespace
 }  // namespace pixelgym

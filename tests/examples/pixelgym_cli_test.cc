@@ -176,7 +176,7 @@ TEST(PixelgymCliTest, InfoConfigColumnsLineUpWithoutColliding) {
 TEST(PixelgymCliTest, CheckGridWorldPasses) {
   const CliRun result = run("check GridWorld-v0 --seed 3");
   EXPECT_EQ(result.exit_code, 0) << result.output;
-  EXPECT_THAT(result.output, HasSubstr("all 11 checks passed"));
+  EXPECT_THAT(result.output, HasSubstr("all 12 checks passed"));
 }
 
 TEST(PixelgymCliTest, UnknownIdIsAUsageErrorThatSuggests) {

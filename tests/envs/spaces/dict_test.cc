@@ -91,7 +91,7 @@ TEST(DictSpaceTest, ReplacedInsertedRemovedChangeOneEntry) {
   EXPECT_THROW(space.replaced("depth", small), std::out_of_range);
   EXPECT_THROW(space.removed("depth"), std::out_of_range);
   EXPECT_THROW(space.inserted("pixels", small), std::invalid_argument);
-  EXPECT_THROW(space.inserted("depth", small, 3), std::invalid_argument);
+  EXPECT_THROW(space.inserted("depth", small, 3), std::out_of_range);
   EXPECT_THROW(space.replaced("pixels", nullptr), std::invalid_argument);
 }
 
