@@ -1,0 +1,49 @@
+// ResizeObservation: resizes an image observation (a bare image or one key of a Dict) with
+// OpenCV, as gymnasium.wrappers.ResizeObservation, but also on a Dict key.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "envs/wrapper.h"
+#include "wrappers/image_key.h"
+
+namespace pixelgym::wrappers {
+
+/// An image's size in pixels.
+struct ImageSize {
+  std::int64_t height = 0;
+  std::int64_t width = 0;
+};
+
+/// Resizes the uint8 image under `key` (or the bare image observation) to `size`, keeping its
+/// channels: (H, W, C) -> (height, width, C), (H, W) -> (height, width); C = 1 or 3. The output
+/// space is a uint8 Box with bounds [0, 255]; the Dict's other keys pass through untouched.
+///
+/// Interpolation is OpenCV's cv::resize with INTER_AREA when neither side grows (the
+/// anti-aliased choice for shrinking) and INTER_LINEAR when either side grows. The image is read
+/// and written through cv::Mat views of the observation's memory: no copy, no allocation per
+/// step beyond what cv::resize does inside.
+class ResizeObservation final : public ObservationWrapper {
+ public:
+  /// The largest height or width accepted.
+  static constexpr std::int64_t kMaxSide = 8192;
+
+  /// Throws std::invalid_argument when `size` has a side < 1 or > kMaxSide, and as find_image
+  /// when `key` does not name a uint8 (H, W), (H, W, 1) or (H, W, 3) image.
+  ResizeObservation(std::unique_ptr<Env> env, ImageSize size, const std::string& key = "pixels");
+
+  ImageSize size() const { return size_; }
+
+ protected:
+  std::string type_name() const override { return "ResizeObservation"; }
+  void observation(const Value& in, Value& out) override;
+
+ private:
+  ImageSize size_;
+  ImageKey image_;
+  int interpolation_;  // cv::InterpolationFlags
+};
+
+}  // namespace pixelgym::wrappers
