@@ -27,7 +27,7 @@ void GrayscaleObservation::observation(const Value& in, Value& out) {
   const void* const memory = target.data;
   cv::cvtColor(source, target, cv::COLOR_RGB2GRAY);
   if (target.data != memory) {
-    throw std::logic_error("GrayscaleObservation: cv::cvtColor reallocated");
+    throw std::runtime_error("GrayscaleObservation: cv::cvtColor reallocated its target");
   }
   copy_other_entries(in, out, image_);
 }

@@ -80,9 +80,10 @@ ImageKey find_image(const Space& space, const std::string& key, const std::strin
                                 key + "\", got " + space.to_string() + "; image keys: none");
   }
   if (!key.empty() && key != kDefaultKey) {
-    throw std::invalid_argument(
-        wrapper + ": key \"" + key + "\" given, but the observation space is a bare Box (" +
-        space.to_string() + "), not a Dict; use key \"" + kDefaultKey + "\" or \"\"");
+    throw std::invalid_argument(wrapper + ": key \"" + key +
+                                "\" given, but the observation space is a bare Box (" +
+                                space.to_string() + "), not a Dict; use key \"" + kDefaultKey +
+                                "\" or \"\"; image keys: none (a bare Box has no keys)");
   }
   if (!is_image(space, requirement)) {
     throw std::invalid_argument(wrapper + ": the observation space (key \"" + key + "\") must be " +

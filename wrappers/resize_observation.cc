@@ -41,7 +41,8 @@ void ResizeObservation::observation(const Value& in, Value& out) {
   const void* const memory = target.data;
   cv::resize(source, target, target.size(), 0.0, 0.0, interpolation_);
   // The target has the size and type asked for, so cv::resize writes into it in place.
-  if (target.data != memory) throw std::logic_error("ResizeObservation: cv::resize reallocated");
+  if (target.data != memory)
+    throw std::runtime_error("ResizeObservation: cv::resize reallocated its target");
   copy_other_entries(in, out, image_);
 }
 

@@ -24,7 +24,10 @@ struct ImageSize {
 /// Interpolation is OpenCV's cv::resize with INTER_AREA when neither side grows (the
 /// anti-aliased choice for shrinking) and INTER_LINEAR when either side grows. The image is read
 /// and written through cv::Mat views of the observation's memory: no copy, no allocation per
-/// step beyond what cv::resize does inside.
+/// step in this wrapper. cv::resize itself allocates scratch buffers for its interpolation tables
+/// on each call (one for INTER_AREA, two for INTER_LINEAR; none for an integer-factor shrink),
+/// which OpenCV gives no way to preallocate. Throws std::runtime_error should OpenCV ever
+/// reallocate the target view.
 class ResizeObservation final : public ObservationWrapper {
  public:
   /// The largest height or width accepted.

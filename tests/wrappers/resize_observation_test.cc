@@ -198,7 +198,7 @@ TEST(ResizeObservationTest, RefusesAnotherKeyOnABareBox) {
       [] {
         ResizeObservation(std::make_unique<ImageEnv>(image_box(8, 8, 3)), {4, 4}, "rgb");
       },
-      {"ResizeObservation", "\"rgb\"", "bare Box"});
+      {"ResizeObservation", "\"rgb\"", "bare Box", "image keys: none"});
   EXPECT_NO_THROW(ResizeObservation(std::make_unique<ImageEnv>(image_box(8, 8, 3)), {4, 4}, ""));
 }
 
