@@ -1,121 +1,19 @@
 // World::step, set_joint_commands and the per-step queries allocate no heap memory once warm.
 //
-// What this binary sees: it replaces the global operator new / delete (every form), which counts
-// every allocation made through `new` in any C++ code of the process (pixelgym's, the standard
-// library's, gtest's). Bullet and Eigen do not allocate through operator new: Bullet's
-// btAlignedAlloc and Eigen's aligned_malloc call malloc. So the binary also replaces malloc,
-// calloc, realloc, memalign, aligned_alloc and posix_memalign (glibc lets an executable define
-// them; these forward to glibc's __libc_* entry points), and the shared Bullet libraries resolve
-// to these definitions too. The malloc count therefore includes operator new's allocations and
-// every allocation of Bullet, Eigen and libstdc++ on this thread. What it does not see: memory
-// obtained with mmap or sbrk directly (neither Bullet nor Eigen does that per step), and stack
-// growth.
+// tests/alloc_counter.h counts every heap allocation of the process while the code under test
+// runs: operator new (pixelgym's, the C++ library's) and the C allocator, which Bullet
+// (btAlignedAlloc) and Eigen (aligned_malloc) use. What it does not see: memory obtained with mmap
+// or sbrk directly (neither Bullet nor Eigen does that per step), and stack growth.
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
-#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <new>
+#include <utility>
 
 #include "engine/world.h"
-
-extern "C" {
-void* __libc_malloc(std::size_t size);
-void __libc_free(void* pointer);
-void* __libc_calloc(std::size_t count, std::size_t size);
-void* __libc_realloc(void* pointer, std::size_t size);
-void* __libc_memalign(std::size_t alignment, std::size_t size);
-}
-
-namespace {
-
-// Process-wide counters: a test instrument, read as differences around the code under test.
-std::atomic<long> g_new_calls{0};
-std::atomic<long> g_malloc_calls{0};
-
-void* counted_new(std::size_t size) {
-  g_new_calls.fetch_add(1, std::memory_order_relaxed);
-  if (void* pointer = std::malloc(size == 0 ? 1 : size)) return pointer;
-  throw std::bad_alloc();
-}
-
-void* counted_aligned_new(std::size_t size, std::align_val_t alignment) {
-  g_new_calls.fetch_add(1, std::memory_order_relaxed);
-  const auto align = static_cast<std::size_t>(alignment);
-  if (void* pointer = std::aligned_alloc(align, (size + align - 1) / align * align)) return pointer;
-  throw std::bad_alloc();
-}
-
-}  // namespace
-
-// The C allocator, counted.
-extern "C" {
-void* malloc(std::size_t size) noexcept {
-  g_malloc_calls.fetch_add(1, std::memory_order_relaxed);
-  return __libc_malloc(size);
-}
-void free(void* pointer) noexcept { __libc_free(pointer); }
-void* calloc(std::size_t count, std::size_t size) noexcept {
-  g_malloc_calls.fetch_add(1, std::memory_order_relaxed);
-  return __libc_calloc(count, size);
-}
-void* realloc(void* pointer, std::size_t size) noexcept {
-  g_malloc_calls.fetch_add(1, std::memory_order_relaxed);
-  return __libc_realloc(pointer, size);
-}
-void* memalign(std::size_t alignment, std::size_t size) noexcept {
-  g_malloc_calls.fetch_add(1, std::memory_order_relaxed);
-  return __libc_memalign(alignment, size);
-}
-void* aligned_alloc(std::size_t alignment, std::size_t size) noexcept {
-  g_malloc_calls.fetch_add(1, std::memory_order_relaxed);
-  return __libc_memalign(alignment, size);
-}
-int posix_memalign(void** out, std::size_t alignment, std::size_t size) noexcept {
-  g_malloc_calls.fetch_add(1, std::memory_order_relaxed);
-  void* pointer = __libc_memalign(alignment, size);
-  if (pointer == nullptr) return ENOMEM;
-  *out = pointer;
-  return 0;
-}
-}
-
-// The C++ allocator, counted (and forwarded to the counted malloc).
-void* operator new(std::size_t size) { return counted_new(size); }
-void* operator new[](std::size_t size) { return counted_new(size); }
-void* operator new(std::size_t size, const std::nothrow_t& /*tag*/) noexcept {
-  try {
-    return counted_new(size);
-  } catch (const std::bad_alloc&) {
-    return nullptr;
-  }
-}
-void* operator new[](std::size_t size, const std::nothrow_t& tag) noexcept {
-  return operator new(size, tag);
-}
-void* operator new(std::size_t size, std::align_val_t alignment) {
-  return counted_aligned_new(size, alignment);
-}
-void* operator new[](std::size_t size, std::align_val_t alignment) {
-  return counted_aligned_new(size, alignment);
-}
-void operator delete(void* pointer) noexcept { std::free(pointer); }
-void operator delete[](void* pointer) noexcept { std::free(pointer); }
-void operator delete(void* pointer, std::size_t /*size*/) noexcept { std::free(pointer); }
-void operator delete[](void* pointer, std::size_t /*size*/) noexcept { std::free(pointer); }
-void operator delete(void* pointer, std::align_val_t /*alignment*/) noexcept { std::free(pointer); }
-void operator delete[](void* pointer, std::align_val_t /*alignment*/) noexcept {
-  std::free(pointer);
-}
-void operator delete(void* pointer, std::size_t /*size*/, std::align_val_t /*alignment*/) noexcept {
-  std::free(pointer);
-}
-void operator delete[](void* pointer, std::size_t /*size*/,
-                       std::align_val_t /*alignment*/) noexcept {
-  std::free(pointer);
-}
+#include "tests/alloc_counter.h"
 
 namespace pixelgym::engine {
 namespace {
@@ -125,13 +23,12 @@ struct Allocations {
   long malloc = 0;  // operator new's included
 };
 
-// Allocations made while `body` runs.
+// Allocations made while `body` runs, whoever made them.
 template <typename Body>
 Allocations count_allocations(Body&& body) {
-  const long new_before = g_new_calls.load();
-  const long malloc_before = g_malloc_calls.load();
-  body();
-  return {g_new_calls.load() - new_before, g_malloc_calls.load() - malloc_before};
+  const pixelgym::testing::AllocCounts counts =
+      pixelgym::testing::count_allocations(std::forward<Body>(body));
+  return {counts.news_total(), counts.mallocs_total()};
 }
 
 TEST(AllocationCounterTest, SeesOperatorNewAndMalloc) {
