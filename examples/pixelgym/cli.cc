@@ -8,6 +8,7 @@
 
 #include "envs/registry.h"
 #include "render/image_io.h"
+#include "wrappers/wrapper_spec.h"
 
 namespace pixelgym::cli {
 namespace {
@@ -98,12 +99,27 @@ Params parse_sets(const std::string& id, const std::vector<std::string>& sets) {
   return params;
 }
 
-std::unique_ptr<Env> make_env(const std::string& id, const std::vector<std::string>& sets) {
+void add_wrap_option(CLI::App& command, std::vector<std::string>& wraps) {
+  command
+      .add_option("--wrap", wraps,
+                  "Wrapper as NAME or NAME=ARGS, e.g. resize=64x64 (repeatable, applied in order, "
+                  "the first innermost); `pixelgym wrappers` lists them")
+      ->type_name("SPEC");
+}
+
+std::unique_ptr<Env> make_env(const std::string& id, const std::vector<std::string>& sets,
+                              const std::vector<std::string>& wraps) {
   const Params kwargs = parse_sets(id, sets);
+  std::unique_ptr<Env> env;
   try {
-    return make(id, kwargs);
+    env = make(id, kwargs);
   } catch (const std::invalid_argument& error) {
     throw UsageError(error.what());  // the kwargs: an unknown key, a value out of range
+  }
+  try {
+    return wrappers::apply_wrappers(std::move(env), wraps);
+  } catch (const std::invalid_argument& error) {
+    throw UsageError(error.what());  // names the spec, the wrapper and the argument
   }
 }
 

@@ -47,9 +47,16 @@ void add_set_option(CLI::App& command, std::vector<std::string>& sets);
 /// Throws UsageError for an unknown id, an entry without '=' or an unreadable value.
 Params parse_sets(const std::string& id, const std::vector<std::string>& sets);
 
-/// `make(id, parse_sets(id, sets))`; a config `make` refuses (std::invalid_argument: an unknown
-/// kwarg, a value out of range) is rethrown as UsageError.
-std::unique_ptr<Env> make_env(const std::string& id, const std::vector<std::string>& sets);
+/// Adds the repeatable `--wrap NAME[=ARGS]` option to `command` (wrapper specs, applied in order;
+/// `pixelgym wrappers` lists them).
+void add_wrap_option(CLI::App& command, std::vector<std::string>& wraps);
+
+/// `make(id, parse_sets(id, sets))` wrapped by each of `wraps` in order (the first innermost); a
+/// config `make` refuses or a wrapper spec that does not apply (std::invalid_argument: an unknown
+/// kwarg, a value out of range, a wrapper argument that does not parse, a key that is not an
+/// image) is rethrown as UsageError.
+std::unique_ptr<Env> make_env(const std::string& id, const std::vector<std::string>& sets,
+                              const std::vector<std::string>& wraps = {});
 
 /// Writes an (H, W, 3) uint8 frame as PNG, creating missing parent folders.
 void write_frame_png(const std::string& path, const Array& frame);
@@ -60,8 +67,8 @@ struct Command {
   std::function<int()> run;
 };
 
-/// Adds list, info, check, snapshot, rollout and bench to `app`. Each subcommand parses into
-/// options of its own, which live as long as the returned commands.
+/// Adds list, wrappers, info, check, snapshot, rollout and bench to `app`. Each subcommand parses
+/// into options of its own, which live as long as the returned commands.
 std::vector<Command> add_env_commands(CLI::App& app);
 
 /// Adds inspect to `app`.

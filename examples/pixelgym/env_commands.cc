@@ -14,6 +14,7 @@
 #include "envs/spaces/dict.h"
 #include "envs/spaces/discrete.h"
 #include "examples/pixelgym/cli.h"
+#include "wrappers/wrapper_spec.h"
 
 namespace pixelgym::cli {
 namespace {
@@ -63,11 +64,31 @@ Command add_list(CLI::App& app) {
           }};
 }
 
+// --- wrappers ---
+
+Command add_wrappers(CLI::App& app) {
+  CLI::App* command = app.add_subcommand(
+      "wrappers", "List the wrappers that --wrap accepts, with their arguments and defaults");
+  command->footer(
+      "A spec is NAME or NAME=ARGS; ARGS are comma-separated, each a value (taken by the "
+      "parameters in the order shown) or param=value. Examples: --wrap resize=64x64 --wrap "
+      "grayscale --wrap time_limit=500");
+  return {command, [] {
+            std::vector<std::vector<std::string>> rows;
+            for (const wrappers::WrapperSpecHelp& help : wrappers::wrapper_spec_help()) {
+              rows.push_back({help.usage, help.summary});
+            }
+            print_table(std::cout, rows, "");
+            return 0;
+          }};
+}
+
 // --- info ---
 
 struct InfoArguments {
   std::string id;
   std::vector<std::string> sets;
+  std::vector<std::string> wraps;
 };
 
 std::string number(double value) {
@@ -122,6 +143,12 @@ int run_info(const InfoArguments& args) {
   } catch (const std::invalid_argument& error) {
     throw UsageError(error.what());  // the kwargs: an unknown key, a value out of range
   }
+  const std::optional<std::int64_t> kwarg_limit = description.max_episode_steps;
+  try {
+    description = wrappers::describe_wrapped(std::move(description), args.wraps);
+  } catch (const std::invalid_argument& error) {
+    throw UsageError(error.what());  // names the spec, the wrapper and the argument
+  }
   const auto spec = default_registry().spec(args.id);
   const auto limit = [](const std::optional<std::int64_t>& steps) {
     return steps ? std::to_string(*steps) : std::string("none");
@@ -133,8 +160,9 @@ int run_info(const InfoArguments& args) {
       cameras += ", " + description.cameras[i];
     }
   }
-  std::cout << args.id << ": " << spec->description << "\n"
-            << "observation_space: " << description.observation_space->to_string() << "\n";
+  std::cout << args.id << ": " << spec->description << "\n";
+  for (const std::string& wrap : args.wraps) std::cout << "wrapped:           " << wrap << "\n";
+  std::cout << "observation_space: " << description.observation_space->to_string() << "\n";
   print_table(std::cout, observation_rows(*description.observation_space), "  ");
   std::cout << "action_space:      " << description.action_space->to_string() << "\n"
             << "cameras:           " << cameras << "\n"
@@ -148,10 +176,8 @@ int run_info(const InfoArguments& args) {
         {param.name, param_type_name(param.type()), param.default_value.to_string(), param.doc});
   }
   // Its default follows the other kwargs (a pixel task's action_repeat), as describe gives it.
-  rows.push_back(
-      {"max_episode_steps", "int",
-       description.max_episode_steps ? std::to_string(*description.max_episode_steps) : "0",
-       "steps before TimeLimit truncates; 0 for no limit"});
+  rows.push_back({"max_episode_steps", "int", kwarg_limit ? std::to_string(*kwarg_limit) : "0",
+                  "steps before TimeLimit truncates; 0 for no limit"});
   print_table(std::cout, rows, "  ");
   return 0;
 }
@@ -159,9 +185,12 @@ int run_info(const InfoArguments& args) {
 Command add_info(CLI::App& app) {
   auto args = std::make_shared<InfoArguments>();
   CLI::App* info = app.add_subcommand(
-      "info", "Show an env's spaces, metadata and config keys (types, defaults)");
+      "info",
+      "Show an env's spaces (under the --wrap wrappers, if any), metadata and config keys "
+      "(types, defaults), without making the env");
   add_id_argument(*info, args->id, "GridWorld-v0");
   add_set_option(*info, args->sets);
+  add_wrap_option(*info, args->wraps);
   return {info, [args] { return run_info(*args); }};
 }
 
@@ -172,10 +201,11 @@ struct CheckArguments {
   std::uint64_t seed = 0;
   int steps = 100;
   std::vector<std::string> sets;
+  std::vector<std::string> wraps;
 };
 
 int run_check(const CheckArguments& args) {
-  std::unique_ptr<Env> env = make_env(args.id, args.sets);
+  std::unique_ptr<Env> env = make_env(args.id, args.sets, args.wraps);
   const CheckReport report = check_env(*env, {args.seed, args.steps});
   for (const CheckResult& result : report.results) {
     std::cout << (result.passed ? "ok    " : "FAIL  ") << result.name;
@@ -202,6 +232,7 @@ Command add_check(CLI::App& app) {
       ->capture_default_str()
       ->check(integer_in(1));
   add_set_option(*check, args->sets);
+  add_wrap_option(*check, args->wraps);
   return {check, [args] { return run_check(*args); }};
 }
 
@@ -268,10 +299,11 @@ struct RolloutArguments {
   int episodes = 5;
   std::string snapshot;
   std::vector<std::string> sets;
+  std::vector<std::string> wraps;
 };
 
 int run_rollout(const RolloutArguments& args) {
-  std::unique_ptr<Env> env = make_env(args.id, args.sets);
+  std::unique_ptr<Env> env = make_env(args.id, args.sets, args.wraps);
   RandomRollout random(*env, args.seed);
   double total = 0.0;
   for (int episode = 0; episode < args.episodes; ++episode) {
@@ -303,6 +335,7 @@ Command add_rollout(CLI::App& app) {
                    "Write the last episode's final frame to this PNG (PNG only)")
       ->check(png_path());
   add_set_option(*rollout, args->sets);
+  add_wrap_option(*rollout, args->wraps);
   return {rollout, [args] { return run_rollout(*args); }};
 }
 
@@ -313,10 +346,11 @@ struct BenchArguments {
   std::uint64_t seed = 0;
   int steps = 2000;
   std::vector<std::string> sets;
+  std::vector<std::string> wraps;
 };
 
 int run_bench(const BenchArguments& args) {
-  std::unique_ptr<Env> env = make_env(args.id, args.sets);
+  std::unique_ptr<Env> env = make_env(args.id, args.sets, args.wraps);
   RandomRollout random(*env, args.seed);
   // Warm up (shader compilation, caches) outside the timed loop.
   for (int t = 0; t < 20; ++t) random.step();
@@ -344,14 +378,15 @@ Command add_bench(CLI::App& app) {
       ->check(integer_in(1));
   add_seed_option(*bench, args->seed, "Seed for the reset and the random actions");
   add_set_option(*bench, args->sets);
+  add_wrap_option(*bench, args->wraps);
   return {bench, [args] { return run_bench(*args); }};
 }
 
 }  // namespace
 
 std::vector<Command> add_env_commands(CLI::App& app) {
-  return {add_list(app),     add_info(app),    add_check(app),
-          add_snapshot(app), add_rollout(app), add_bench(app)};
+  return {add_list(app),     add_wrappers(app), add_info(app), add_check(app),
+          add_snapshot(app), add_rollout(app),  add_bench(app)};
 }
 
 }  // namespace pixelgym::cli

@@ -260,8 +260,9 @@ TEST(PixelgymCliTest, HelpListsEverySubcommandAndExplainsEach) {
   const CliRun help = run("help");
   ASSERT_EQ(help.exit_code, 0) << help.output;
   EXPECT_THAT(help.output, HasSubstr("Usage: pixelgym [OPTIONS] SUBCOMMAND"));
-  const std::vector<std::string> subcommands = {"list",  "info",    "check", "snapshot", "rollout",
-                                                "bench", "inspect", "view",  "help"};
+  const std::vector<std::string> subcommands = {"list",     "wrappers", "info",  "check",
+                                                "snapshot", "rollout",  "bench", "inspect",
+                                                "view",     "help"};
   for (const std::string& name : subcommands) {
     EXPECT_THAT(help.output, HasSubstr("\n  " + name + " ")) << name;
     const CliRun one = run("help " + name);
@@ -401,6 +402,73 @@ TEST(PixelgymCliTest, BenchPrintsStepsPerSecondLast) {
   ASSERT_NE(at, std::string::npos) << result.output;
   EXPECT_EQ(result.output.find('\n', at), result.output.size() - 1);
   EXPECT_GT(std::stol(result.output.substr(at + 12)), 0);
+}
+
+// --- --wrap: wrapper stacks from text ---
+
+TEST(PixelgymCliTest, WrappersListsEverySpecForm) {
+  const CliRun result = run("wrappers");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  for (const char* form : {"resize=HxW[,key=pixels]", "grayscale[=keep_dim=false][,key=pixels]",
+                           "channel_first[=key=pixels]", "time_limit=<max_episode_steps>"}) {
+    EXPECT_THAT(result.output, HasSubstr(form)) << form;
+  }
+}
+
+TEST(PixelgymCliTest, EverySubcommandThatMakesAnEnvTakesWrap) {
+  for (const char* command : {"info", "check", "rollout", "bench"}) {
+    EXPECT_THAT(run(std::string(command) + " --help").output, HasSubstr("--wrap SPEC")) << command;
+  }
+}
+
+TEST(PixelgymCliTest, InfoWrapPrintsTheWrappedSpaces) {
+  const CliRun result = run(
+      "info CartPoleSwingup-v0 --set obs_mode=pixels+state --wrap resize=64x48 --wrap grayscale "
+      "--wrap time_limit=50");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("wrapped:           resize=64x48\n"
+                                       "wrapped:           grayscale\n"));
+  EXPECT_THAT(result.output, HasSubstr("'pixels': Box(0.0, 255.0, (64, 48), uint8)"));
+  EXPECT_THAT(result.output, HasSubstr("  pixels     uint8    (64, 48)  [0, 255]"));
+  EXPECT_THAT(result.output, HasSubstr("max_episode_steps: 50\n"));
+  // The kwarg's default stays the env's own.
+  EXPECT_THAT(result.output, HasSubstr("max_episode_steps  int"));
+  EXPECT_THAT(result.output, Not(HasSubstr("max_episode_steps  int     50")));
+}
+
+TEST(PixelgymCliTest, RolloutAppliesTheWrappersInOrder) {
+  const CliRun result =
+      run("rollout CartPoleSwingup-v0 --episodes 2 --wrap time_limit=7 --wrap resize=16");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("episode 0: return="));
+  EXPECT_THAT(result.output, HasSubstr(" length=7 truncated\nepisode 1:"));
+}
+
+TEST(PixelgymCliTest, CheckAndBenchRunWrapped) {
+  const CliRun check =
+      run("check CartPoleSwingup-v0 --steps 10 --wrap resize=32x32 --wrap grayscale");
+  EXPECT_EQ(check.exit_code, 0) << check.output;
+  EXPECT_THAT(check.output, HasSubstr("checks passed"));
+  const CliRun bench =
+      run("bench CartPoleSwingup-v0 --steps 20 --wrap resize=64x64 --wrap grayscale");
+  EXPECT_EQ(bench.exit_code, 0) << bench.output;
+  EXPECT_THAT(bench.output, HasSubstr("steps_per_s="));
+}
+
+TEST(PixelgymCliTest, BadWrapSpecIsAUsageErrorNamingWrapperArgumentAndExpectation) {
+  const CliRun syntax = run("bench CartPoleSwingup-v0 --wrap resize=64y64");
+  EXPECT_EQ(syntax.exit_code, 2) << syntax.output;
+  EXPECT_THAT(syntax.output,
+              HasSubstr("wrapper spec \"resize=64y64\": resize's size: expected HEIGHTxWIDTH"));
+  const CliRun unknown = run("info CartPoleSwingup-v0 --wrap blur=3");
+  EXPECT_EQ(unknown.exit_code, 2) << unknown.output;
+  EXPECT_THAT(unknown.output, HasSubstr("unknown wrapper \"blur\"; the wrappers are: resize"));
+  const CliRun not_an_image = run("check GridWorld-v0 --wrap grayscale");
+  EXPECT_EQ(not_an_image.exit_code, 2) << not_an_image.output;
+  EXPECT_THAT(not_an_image.output, HasSubstr("GrayscaleObservation"));
+  const CliRun range = run("rollout CartPoleSwingup-v0 --wrap resize=0x8");
+  EXPECT_EQ(range.exit_code, 2) << range.output;
+  EXPECT_THAT(range.output, HasSubstr("wrapper spec \"resize=0x8\": ResizeObservation"));
 }
 
 // --- inspect ---

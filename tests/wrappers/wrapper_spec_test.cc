@@ -1,0 +1,205 @@
+// The text form of wrapper stacks (`--wrap resize=64x64`): parsing, applying, and its errors.
+#include "wrappers/wrapper_spec.h"
+
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "envs/registry.h"
+#include "envs/spaces/box.h"
+#include "envs/spaces/dict.h"
+#include "envs/time_limit.h"
+#include "tests/wrappers/image_env.h"
+#include "wrappers/resize_observation.h"
+
+namespace pixelgym::wrappers {
+namespace {
+
+using Arguments = std::vector<std::pair<std::string, std::string>>;
+
+std::unique_ptr<Env> image_env() {
+  auto pixels = std::make_shared<spaces::Box>(0.0, 255.0, Shape{48, 40, 3}, DType::kUInt8);
+  auto state = std::make_shared<spaces::Box>(-1.0, 1.0, Shape{2}, DType::kFloat32);
+  return std::make_unique<testing::ImageEnv>(
+      std::make_shared<spaces::Dict>(spaces::Dict::Entries{{"pixels", pixels}, {"state", state}}));
+}
+
+Shape pixels_shape(const Env& env) {
+  return dynamic_cast<const spaces::Dict&>(env.observation_space()).at("pixels").shape().value();
+}
+
+// The message of the std::invalid_argument that `body` throws ("" when it throws none).
+template <typename Body>
+std::string error_of(Body body) {
+  try {
+    body();
+  } catch (const std::invalid_argument& error) {
+    return error.what();
+  }
+  return "";
+}
+
+TEST(WrapperSpecTest, ParsesNameAlone) {
+  const WrapperSpec spec = parse_wrapper_spec("grayscale");
+  EXPECT_EQ(spec.name, "grayscale");
+  EXPECT_TRUE(spec.arguments.empty());
+}
+
+TEST(WrapperSpecTest, BareValuesFillParametersInOrder) {
+  EXPECT_EQ(parse_wrapper_spec("resize=64x32,state").arguments,
+            (Arguments{{"size", "64x32"}, {"key", "state"}}));
+}
+
+TEST(WrapperSpecTest, NamedAndBareValuesMix) {
+  EXPECT_EQ(parse_wrapper_spec("resize=key=img,size=8").arguments,
+            (Arguments{{"key", "img"}, {"size", "8"}}));
+  EXPECT_EQ(parse_wrapper_spec("grayscale=keep_dim,key=img").arguments,
+            (Arguments{{"keep_dim", "true"}, {"key", "img"}}));
+  EXPECT_EQ(parse_wrapper_spec("grayscale=false,img").arguments,
+            (Arguments{{"keep_dim", "false"}, {"key", "img"}}));
+}
+
+TEST(WrapperSpecTest, AppliesInOrderFirstInnermost) {
+  const auto env = apply_wrappers(image_env(), {"resize=24x20", "grayscale=keep_dim"});
+  EXPECT_EQ(env->name(), "GrayscaleObservation<ResizeObservation<ImageEnv>>");
+  EXPECT_EQ(pixels_shape(*env), (Shape{24, 20, 1}));
+}
+
+TEST(WrapperSpecTest, SquareSizeFromOneNumber) {
+  const auto env = apply_wrappers(image_env(), {"resize=16"});
+  EXPECT_EQ(pixels_shape(*env), (Shape{16, 16, 3}));
+}
+
+TEST(WrapperSpecTest, ChannelFirstAndTimeLimit) {
+  auto env = apply_wrappers(image_env(), {"channel_first=pixels", "time_limit=3"});
+  EXPECT_EQ(pixels_shape(*env), (Shape{3, 48, 40}));
+  ASSERT_NE(dynamic_cast<TimeLimit*>(env.get()), nullptr);
+  EXPECT_EQ(dynamic_cast<TimeLimit&>(*env).max_episode_steps(), 3);
+}
+
+TEST(WrapperSpecTest, SpecValuesReachTheWrapperAndItSteps) {
+  auto env = apply_wrappers(image_env(), {"resize=12x10", "time_limit=2"});
+  env->reset(7);
+  env->step(env->action_space().sample());
+  const StepResult result = env->step(env->action_space().sample());
+  EXPECT_TRUE(result.truncated);
+  EXPECT_EQ(result.obs.dict().at("pixels").array().shape(), (Shape{12, 10, 3}));
+}
+
+TEST(WrapperSpecTest, EveryHelpUsageIsItselfAValidSpec) {
+  for (const WrapperSpecHelp& help : wrapper_spec_help()) {
+    // "resize=HxW[,key=pixels]" -> "resize=8x8"; the optional parts as their defaults.
+    std::string text = help.usage;
+    std::string plain;
+    for (char c : text) {
+      if (c != '[' && c != ']') plain += c;
+    }
+    for (const auto& [placeholder, value] : std::vector<std::pair<std::string, std::string>>{
+             {"HxW", "8x8"}, {"<max_episode_steps>", "5"}}) {
+      const std::size_t at = plain.find(placeholder);
+      if (at != std::string::npos) plain.replace(at, placeholder.size(), value);
+    }
+    EXPECT_NO_THROW(apply_wrapper(image_env(), parse_wrapper_spec(plain))) << plain;
+    EXPECT_FALSE(help.summary.empty());
+  }
+}
+
+TEST(WrapperSpecTest, UnknownWrapperListsTheKnownOnes) {
+  const std::string message = error_of([] { parse_wrapper_spec("resise=64"); });
+  EXPECT_NE(message.find("\"resise=64\""), std::string::npos) << message;
+  EXPECT_NE(message.find("unknown wrapper \"resise\""), std::string::npos) << message;
+  EXPECT_NE(message.find("resize, grayscale"), std::string::npos) << message;
+}
+
+TEST(WrapperSpecTest, SyntaxErrorsNameWhatIsWrong) {
+  EXPECT_NE(error_of([] { parse_wrapper_spec("=64"); }).find("got no name"), std::string::npos);
+  EXPECT_NE(error_of([] { parse_wrapper_spec("resize=64x64,,key=a"); }).find("an empty one"),
+            std::string::npos);
+  EXPECT_NE(error_of([] {
+              parse_wrapper_spec("resize=64x64,colour=rgb");
+            }).find("unknown parameter \"colour\"; resize's parameters are: size, key"),
+            std::string::npos);
+  EXPECT_NE(error_of([] { parse_wrapper_spec("resize=8,key=a,b"); }).find("too many values"),
+            std::string::npos);
+  EXPECT_NE(error_of([] { parse_wrapper_spec("resize=8,size=9"); }).find("\"size\" given twice"),
+            std::string::npos);
+  EXPECT_NE(error_of([] { parse_wrapper_spec("channel_first=a,b"); }).find("too many values"),
+            std::string::npos);
+}
+
+TEST(WrapperSpecTest, MissingRequiredArgumentShowsTheForm) {
+  const std::string message = error_of([] { parse_wrapper_spec("resize"); });
+  EXPECT_NE(message.find("resize needs its size (HEIGHTxWIDTH"), std::string::npos) << message;
+  EXPECT_NE(message.find("resize=HxW[,key=pixels]"), std::string::npos) << message;
+}
+
+TEST(WrapperSpecTest, BadValuesNameWrapperArgumentAndExpectation) {
+  const auto apply = [](const std::string& text) {
+    return error_of([&] { apply_wrapper(image_env(), parse_wrapper_spec(text)); });
+  };
+  EXPECT_EQ(apply("resize=64y64"),
+            "wrapper spec \"resize=64y64\": resize's size: expected HEIGHTxWIDTH (e.g. 64x64) or "
+            "N for NxN, got \"64y64\"");
+  EXPECT_NE(apply("resize=64x").find("got \"64x\""), std::string::npos);
+  EXPECT_NE(apply("resize=x64").find("got \"x64\""), std::string::npos);
+  EXPECT_NE(apply("grayscale=maybe")
+                .find("grayscale's keep_dim: expected true or false, got "
+                      "\"maybe\""),
+            std::string::npos);
+  EXPECT_NE(apply("time_limit=ten").find("time_limit's max_episode_steps: expected a whole number"),
+            std::string::npos);
+  EXPECT_NE(apply("resize=8,key=").find("resize's key: expected a non-empty word"),
+            std::string::npos);
+}
+
+TEST(WrapperSpecTest, WrapperConstructorErrorsArePrefixedWithTheSpec) {
+  const auto apply = [](const std::string& text) {
+    return error_of([&] { apply_wrapper(image_env(), parse_wrapper_spec(text)); });
+  };
+  const std::string zero = apply("resize=0x64");
+  EXPECT_EQ(zero.rfind("wrapper spec \"resize=0x64\": ResizeObservation", 0), 0u) << zero;
+  const std::string key = apply("grayscale=key=state");
+  EXPECT_NE(key.find("wrapper spec \"grayscale=key=state\""), std::string::npos) << key;
+  EXPECT_NE(key.find("pixels"), std::string::npos) << key;  // lists the image keys
+  EXPECT_NE(apply("time_limit=0").find("wrapper spec \"time_limit=0\""), std::string::npos);
+}
+
+TEST(WrapperSpecTest, ArgumentsNeedAnEqualsSignAfterTheName) {
+  EXPECT_EQ(error_of([] { parse_wrapper_spec("grayscale,key=state"); }),
+            "wrapper spec \"grayscale,key=state\": expected NAME=ARGS with '=' after the name "
+            "(e.g. grayscale=key=state), got a ',' in the name \"grayscale,key\"");
+}
+
+TEST(WrapperSpecTest, DescribeWrappedGivesTheSpacesOfTheWrappedEnv) {
+  EnvDescription description = describe("CartPoleSwingup-v0", {{"obs_mode", "pixels+state"}});
+  const std::optional<std::int64_t> limit = description.max_episode_steps;
+  ASSERT_TRUE(limit.has_value());
+  const EnvDescription wrapped =
+      describe_wrapped(description, {"resize=32x24", "grayscale", "time_limit=7"});
+  const auto& dict = dynamic_cast<const spaces::Dict&>(*wrapped.observation_space);
+  EXPECT_EQ(dict.at("pixels").shape().value(), (Shape{32, 24}));
+  EXPECT_TRUE(
+      dict.at("joint_pos")
+          .equals(
+              dynamic_cast<const spaces::Dict&>(*description.observation_space).at("joint_pos")));
+  EXPECT_EQ(wrapped.max_episode_steps, 7);
+  EXPECT_EQ(describe_wrapped(description, {"time_limit=100000"}).max_episode_steps, limit);
+
+  // The same spaces as the wrappers over the env itself.
+  const auto env = apply_wrappers(make("CartPoleSwingup-v0", {{"obs_mode", "pixels+state"}}),
+                                  {"resize=32x24", "grayscale"});
+  EXPECT_TRUE(env->observation_space().equals(*wrapped.observation_space));
+  EXPECT_TRUE(env->action_space().equals(*wrapped.action_space));
+}
+
+TEST(WrapperSpecTest, DescribeWrappedReportsBadSpecs) {
+  const EnvDescription description = describe("CartPoleSwingup-v0", {{"obs_mode", "state"}});
+  const std::string message = error_of([&] { describe_wrapped(description, {"grayscale"}); });
+  EXPECT_NE(message.find("wrapper spec \"grayscale\": GrayscaleObservation"), std::string::npos)
+      << message;
+}
+
+}  // namespace
+}  // namespace pixelgym::wrappers

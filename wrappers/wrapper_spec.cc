@@ -1,0 +1,394 @@
+#include "wrappers/wrapper_spec.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <functional>
+#include <optional>
+#include <stdexcept>
+
+#include "envs/time_limit.h"
+#include "wrappers/channel_first_observation.h"
+#include "wrappers/grayscale_observation.h"
+#include "wrappers/resize_observation.h"
+
+namespace pixelgym::wrappers {
+namespace {
+
+// What a parameter's value must look like; `expected()` says it in messages.
+enum class Kind { kInteger, kNumber, kBool, kText, kSize, kKeys };
+
+struct Param {
+  std::string name;
+  Kind kind;
+  /// What it means when absent ("pixels", "false"); empty for a required parameter.
+  std::string default_text;
+  bool required() const { return default_text.empty(); }
+};
+
+std::string expected(Kind kind) {
+  switch (kind) {
+    case Kind::kInteger:
+      return "a whole number";
+    case Kind::kNumber:
+      return "a finite number";
+    case Kind::kBool:
+      return "true or false";
+    case Kind::kText:
+      return "a non-empty word";
+    case Kind::kSize:
+      return "HEIGHTxWIDTH (e.g. 64x64) or N for NxN";
+    case Kind::kKeys:
+      return "observation keys joined by '+' (e.g. pixels+joint_pos)";
+  }
+  return "";
+}
+
+class Arguments;
+using Builder = std::function<std::unique_ptr<Env>(std::unique_ptr<Env>, const Arguments&)>;
+
+struct Entry {
+  std::string name;
+  std::string summary;
+  std::vector<Param> params;
+  Builder build;
+};
+
+std::string quoted(const std::string& text) { return "\"" + text + "\""; }
+
+std::string prefix(const WrapperSpec& spec) { return "wrapper spec " + quoted(spec.text) + ": "; }
+
+// The arguments of one spec, typed on demand; each accessor throws std::invalid_argument naming
+// the spec, the wrapper, the parameter, what it expected and what it got.
+class Arguments {
+ public:
+  Arguments(const WrapperSpec& spec, const Entry& entry) : spec_(spec), entry_(entry) {}
+
+  std::optional<std::string> text(const std::string& name) const {
+    for (const auto& [key, value] : spec_.arguments) {
+      if (key == name) return value;
+    }
+    return std::nullopt;
+  }
+
+  std::string word(const std::string& name, const std::string& fallback) const {
+    const auto value = text(name);
+    if (!value) return fallback;
+    if (value->empty()) fail(name, Kind::kText, *value);
+    return *value;
+  }
+
+  std::int64_t integer(const std::string& name, std::int64_t fallback) const {
+    const auto value = text(name);
+    if (!value) return fallback;
+    std::int64_t result = 0;
+    if (!parse_integer(*value, result)) fail(name, Kind::kInteger, *value);
+    return result;
+  }
+
+  double number(const std::string& name, double fallback) const {
+    const auto value = text(name);
+    if (!value) return fallback;
+    double result = 0.0;
+    if (!parse_number(*value, result)) fail(name, Kind::kNumber, *value);
+    return result;
+  }
+
+  bool boolean(const std::string& name, bool fallback) const {
+    const auto value = text(name);
+    if (!value) return fallback;
+    if (*value == "true" || *value == "1" || *value == "yes") return true;
+    if (*value == "false" || *value == "0" || *value == "no") return false;
+    fail(name, Kind::kBool, *value);
+  }
+
+  ImageSize size(const std::string& name) const {
+    const std::string value = text(name).value_or("");
+    const std::size_t x = value.find('x');
+    ImageSize size;
+    const bool ok = x == std::string::npos
+                        ? parse_integer(value, size.height) && (size.width = size.height, true)
+                        : parse_integer(value.substr(0, x), size.height) &&
+                              parse_integer(value.substr(x + 1), size.width);
+    if (!ok) fail(name, Kind::kSize, value);
+    return size;
+  }
+
+  std::vector<std::string> keys(const std::string& name) const {
+    const std::string value = text(name).value_or("");
+    std::vector<std::string> keys;
+    std::size_t begin = 0;
+    while (true) {
+      const std::size_t end = value.find('+', begin);
+      keys.push_back(value.substr(begin, end - begin));
+      if (keys.back().empty()) fail(name, Kind::kKeys, value);
+      if (end == std::string::npos) break;
+      begin = end + 1;
+    }
+    return keys;
+  }
+
+  /// One of `choices`, or `fallback` when absent.
+  std::string choice(const std::string& name, const std::vector<std::string>& choices,
+                     const std::string& fallback) const {
+    const auto value = text(name);
+    if (!value) return fallback;
+    if (std::find(choices.begin(), choices.end(), *value) != choices.end()) return *value;
+    std::string list;
+    for (const std::string& option : choices) list += (list.empty() ? "" : " | ") + option;
+    throw std::invalid_argument(prefix(spec_) + entry_.name + "'s " + name + ": expected " + list +
+                                ", got " + quoted(*value));
+  }
+
+ private:
+  template <typename T>
+  static bool parse_integer(const std::string& text, T& value) {
+    const char* end = text.data() + text.size();
+    const auto [stop, error] = std::from_chars(text.data(), end, value);
+    return !text.empty() && error == std::errc() && stop == end;
+  }
+
+  static bool parse_number(const std::string& text, double& value) {
+    if (text.empty() || std::isspace(static_cast<unsigned char>(text[0]))) return false;
+    char* end = nullptr;
+    errno = 0;
+    value = std::strtod(text.c_str(), &end);
+    return errno == 0 && end == text.c_str() + text.size() && std::isfinite(value);
+  }
+
+  [[noreturn]] void fail(const std::string& name, Kind kind, const std::string& value) const {
+    throw std::invalid_argument(prefix(spec_) + entry_.name + "'s " + name + ": expected " +
+                                expected(kind) + ", got " + quoted(value));
+  }
+
+  const WrapperSpec& spec_;
+  const Entry& entry_;
+};
+
+const Param key_param{"key", Kind::kText, "pixels"};
+
+const std::vector<Entry>& entries() {
+  static const std::vector<Entry> table = {
+      {"resize",
+       "ResizeObservation: resize the image (OpenCV INTER_AREA down, linear up)",
+       {{"size", Kind::kSize, ""}, key_param},
+       [](std::unique_ptr<Env> env, const Arguments& args) -> std::unique_ptr<Env> {
+         return std::make_unique<ResizeObservation>(std::move(env), args.size("size"),
+                                                    args.word("key", "pixels"));
+       }},
+      {"grayscale",
+       "GrayscaleObservation: RGB to gray (ITU-R 601), (H, W) or with keep_dim (H, W, 1)",
+       {{"keep_dim", Kind::kBool, "false"}, key_param},
+       [](std::unique_ptr<Env> env, const Arguments& args) -> std::unique_ptr<Env> {
+         return std::make_unique<GrayscaleObservation>(
+             std::move(env), args.boolean("keep_dim", false), args.word("key", "pixels"));
+       }},
+      {"channel_first",
+       "ChannelFirstObservation: (H, W, C) to (C, H, W) for CNNs",
+       {key_param},
+       [](std::unique_ptr<Env> env, const Arguments& args) -> std::unique_ptr<Env> {
+         return std::make_unique<ChannelFirstObservation>(std::move(env),
+                                                          args.word("key", "pixels"));
+       }},
+      {"time_limit",
+       "TimeLimit: truncate episodes after N steps",
+       {{"max_episode_steps", Kind::kInteger, ""}},
+       [](std::unique_ptr<Env> env, const Arguments& args) -> std::unique_ptr<Env> {
+         return std::make_unique<TimeLimit>(std::move(env), args.integer("max_episode_steps", 0));
+       }},
+  };
+  return table;
+}
+
+const Entry& find_entry(const std::string& name, const std::string& text) {
+  const auto& table = entries();
+  const auto found =
+      std::find_if(table.begin(), table.end(), [&](const Entry& e) { return e.name == name; });
+  if (found != table.end()) return *found;
+  std::string names;
+  for (const Entry& entry : table) names += (names.empty() ? "" : ", ") + entry.name;
+  throw std::invalid_argument("wrapper spec " + quoted(text) + ": unknown wrapper " + quoted(name) +
+                              "; the wrappers are: " + names);
+}
+
+std::string param_names(const Entry& entry) {
+  if (entry.params.empty()) return entry.name + " takes no arguments";
+  std::string names;
+  for (const Param& param : entry.params) names += (names.empty() ? "" : ", ") + param.name;
+  return entry.name + "'s parameters are: " + names;
+}
+
+// An env with described spaces and metadata only, for describe_wrapped: wrappers read the
+// spaces and metadata of the env they wrap in their constructors, and nothing else.
+class DescribedEnv final : public Env {
+ public:
+  explicit DescribedEnv(const EnvDescription& description) : description_(description) {}
+  const Space& observation_space() const override { return *description_.observation_space; }
+  const Space& action_space() const override { return *description_.action_space; }
+  const Metadata& metadata() const override { return description_.metadata; }
+
+ protected:
+  std::string type_name() const override { return "DescribedEnv"; }
+  void do_reset(std::optional<std::uint64_t> /*seed*/, const Options& /*options*/,
+                ResetResult& /*out*/) override {
+    refuse();
+  }
+  void do_step(const Value& /*action*/, StepResult& /*out*/) override { refuse(); }
+  Array do_render() override { refuse(); }
+
+ private:
+  [[noreturn]] static void refuse() {
+    throw std::logic_error("describe_wrapped: the stand-in env only describes spaces");
+  }
+  const EnvDescription description_;
+};
+
+// "resize=HxW[,key=pixels]": the form of a spec, for messages and help.
+std::string usage(const Entry& entry) {
+  std::string usage = entry.name;
+  bool first = true;
+  for (const Param& param : entry.params) {
+    const std::string separator = first ? "=" : ",";
+    if (param.required()) {
+      usage += separator + (param.kind == Kind::kSize ? "HxW" : "<" + param.name + ">");
+    } else {
+      usage += "[" + separator + param.name + "=" + param.default_text + "]";
+    }
+    first = false;
+  }
+  return usage;
+}
+
+}  // namespace
+
+WrapperSpec parse_wrapper_spec(const std::string& text) {
+  WrapperSpec spec;
+  spec.text = text;
+  const std::size_t equals = text.find('=');
+  spec.name = text.substr(0, equals);
+  if (spec.name.empty()) {
+    throw std::invalid_argument("wrapper spec " + quoted(text) +
+                                ": expected NAME or NAME=ARGS (e.g. resize=64x64), got no name");
+  }
+  if (const std::size_t comma = spec.name.find(','); comma != std::string::npos) {
+    throw std::invalid_argument(prefix(spec) + "expected NAME=ARGS with '=' after the name (e.g. " +
+                                spec.name.substr(0, comma) + "=" + text.substr(comma + 1) +
+                                "), got a ',' in the name " + quoted(spec.name));
+  }
+  const Entry& entry = find_entry(spec.name, text);
+  if (equals == std::string::npos) {
+    // No arguments: fine unless a parameter is required (checked below).
+  } else {
+    const std::string rest = text.substr(equals + 1);
+    std::size_t next_positional = 0;
+    std::size_t begin = 0;
+    while (true) {
+      const std::size_t end = rest.find(',', begin);
+      const std::string item = rest.substr(begin, end - begin);
+      if (item.empty()) {
+        throw std::invalid_argument(prefix(spec) + "expected comma-separated arguments (" +
+                                    param_names(entry) + "), got an empty one");
+      }
+      std::string name;
+      std::string value;
+      const std::size_t item_equals = item.find('=');
+      const auto param_named = [&](const std::string& n) {
+        return std::find_if(entry.params.begin(), entry.params.end(),
+                            [&](const Param& p) { return p.name == n; });
+      };
+      if (item_equals != std::string::npos) {
+        name = item.substr(0, item_equals);
+        value = item.substr(item_equals + 1);
+        if (param_named(name) == entry.params.end()) {
+          throw std::invalid_argument(prefix(spec) + "unknown parameter " + quoted(name) + "; " +
+                                      param_names(entry));
+        }
+      } else if (const auto flag = param_named(item);
+                 flag != entry.params.end() && flag->kind == Kind::kBool) {
+        name = item;
+        value = "true";
+      } else {
+        if (next_positional >= entry.params.size()) {
+          throw std::invalid_argument(prefix(spec) + "too many values: " + param_names(entry) +
+                                      ", got " + quoted(item) + " after them");
+        }
+        name = entry.params[next_positional].name;
+        value = item;
+      }
+      const bool repeated = std::any_of(
+          spec.arguments.begin(), spec.arguments.end(),
+          [&](const std::pair<std::string, std::string>& a) { return a.first == name; });
+      if (repeated) {
+        throw std::invalid_argument(prefix(spec) + "parameter " + quoted(name) + " given twice");
+      }
+      spec.arguments.emplace_back(name, value);
+      // Bare values fill the parameters after the last one named or filled.
+      const auto position = param_named(name) - entry.params.begin();
+      next_positional = std::max(next_positional, static_cast<std::size_t>(position) + 1);
+      if (end == std::string::npos) break;
+      begin = end + 1;
+    }
+  }
+  for (const Param& param : entry.params) {
+    const bool given = std::any_of(
+        spec.arguments.begin(), spec.arguments.end(),
+        [&](const std::pair<std::string, std::string>& a) { return a.first == param.name; });
+    if (param.required() && !given) {
+      throw std::invalid_argument(prefix(spec) + entry.name + " needs its " + param.name + " (" +
+                                  expected(param.kind) + "): " + usage(entry));
+    }
+  }
+  return spec;
+}
+
+std::unique_ptr<Env> apply_wrapper(std::unique_ptr<Env> env, const WrapperSpec& spec) {
+  const Entry& entry = find_entry(spec.name, spec.text);
+  const Arguments arguments(spec, entry);
+  try {
+    return entry.build(std::move(env), arguments);
+  } catch (const std::invalid_argument& error) {
+    const std::string message = error.what();
+    if (message.rfind("wrapper spec ", 0) == 0) throw;  // already names the spec
+    throw std::invalid_argument(prefix(spec) + message);
+  }
+}
+
+std::unique_ptr<Env> apply_wrappers(std::unique_ptr<Env> env,
+                                    const std::vector<std::string>& specs) {
+  for (const std::string& text : specs)
+    env = apply_wrapper(std::move(env), parse_wrapper_spec(text));
+  return env;
+}
+
+EnvDescription describe_wrapped(EnvDescription description, const std::vector<std::string>& specs) {
+  std::unique_ptr<Env> env = std::make_unique<DescribedEnv>(description);
+  for (const std::string& text : specs) {
+    const WrapperSpec spec = parse_wrapper_spec(text);
+    env = apply_wrapper(std::move(env), spec);
+    if (spec.name == "time_limit") {
+      const auto* limit = dynamic_cast<const TimeLimit*>(env.get());
+      if (limit != nullptr && (!description.max_episode_steps ||
+                               limit->max_episode_steps() < *description.max_episode_steps)) {
+        description.max_episode_steps = limit->max_episode_steps();
+      }
+    }
+  }
+  // Spaces are shared pointers owned by the wrappers: copy the outermost ones out by aliasing
+  // the wrapper stack, which stays alive as long as the description's spaces do.
+  const std::shared_ptr<Env> stack(std::move(env));
+  description.observation_space = SpacePtr(stack, &stack->observation_space());
+  description.action_space = SpacePtr(stack, &stack->action_space());
+  description.metadata = stack->metadata();
+  return description;
+}
+
+std::vector<WrapperSpecHelp> wrapper_spec_help() {
+  std::vector<WrapperSpecHelp> help;
+  for (const Entry& entry : entries()) help.push_back({entry.name, usage(entry), entry.summary});
+  return help;
+}
+
+}  // namespace pixelgym::wrappers
