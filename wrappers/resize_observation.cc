@@ -1,5 +1,6 @@
 #include "wrappers/resize_observation.h"
 
+#include <algorithm>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
@@ -30,12 +31,24 @@ ResizeObservation::ResizeObservation(std::unique_ptr<Env> env, ImageSize size,
   image_ = find_image(inner, key, "ResizeObservation", ImageRequirement{{0, 1, 3}});
   const bool grows = size.height > image_.height() || size.width > image_.width();
   interpolation_ = grows ? cv::INTER_LINEAR : cv::INTER_AREA;
+  const bool integer_factors =
+      image_.height() % size.height == 0 && image_.width() % size.width == 0;
+  if (!grows && !integer_factors) {
+    area_.emplace(static_cast<int>(image_.height()), static_cast<int>(image_.width()),
+                  static_cast<int>(size.height), static_cast<int>(size.width),
+                  static_cast<int>(std::max<std::int64_t>(image_.channels(), 1)));
+  }
   Shape shape = {size.height, size.width};
   if (image_.channels() != 0) shape.push_back(image_.channels());
   set_observation_space(replace_image(inner, image_, uint8_image_space(std::move(shape))));
 }
 
 void ResizeObservation::observation(const Value& in, Value& out) {
+  if (area_) {
+    (*area_)(image_of(in, image_).data<std::uint8_t>(), image_of(out, image_).data<std::uint8_t>());
+    copy_other_entries(in, out, image_);
+    return;
+  }
   const cv::Mat source = mat_view(image_of(in, image_));
   cv::Mat target = mat_view(image_of(out, image_));
   const void* const memory = target.data;

@@ -4,9 +4,11 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "envs/wrapper.h"
+#include "wrappers/area_resize.h"
 #include "wrappers/image_key.h"
 
 namespace pixelgym::wrappers {
@@ -21,13 +23,18 @@ struct ImageSize {
 /// channels: (H, W, C) -> (height, width, C), (H, W) -> (height, width); C = 1 or 3. The output
 /// space is a uint8 Box with bounds [0, 255]; the Dict's other keys pass through untouched.
 ///
-/// Interpolation is OpenCV's cv::resize with INTER_AREA when neither side grows (the
-/// anti-aliased choice for shrinking) and INTER_LINEAR when either side grows. The image is read
-/// and written through cv::Mat views of the observation's memory: no copy, no allocation per
-/// step in this wrapper. cv::resize itself allocates scratch buffers for its interpolation tables
-/// on each call (one for INTER_AREA, two for INTER_LINEAR; none for an integer-factor shrink),
-/// which OpenCV gives no way to preallocate. Throws std::runtime_error should OpenCV ever
-/// reallocate the target view.
+/// Interpolation is OpenCV's INTER_AREA when neither side grows (the anti-aliased choice for
+/// shrinking) and INTER_LINEAR when either side grows:
+///  - a shrink by integer factors (84 -> 42) and any enlargement: cv::resize, reading and writing
+///    through cv::Mat views of the observation's memory. For an enlargement cv::resize allocates
+///    two scratch buffers for its tables on each call, which OpenCV gives no way to preallocate;
+///    the integer shrink allocates nothing. Throws std::runtime_error should OpenCV ever
+///    reallocate the target view.
+///  - a shrink by a non-integer factor (84 -> 64): AreaResize, the same area weights with tables
+///    and buffers built once (no allocation per step) and rows blended before columns, which
+///    makes it 2-3x faster than cv::resize here (whose INTER_AREA path for such factors costs
+///    more than a third of a whole pixel step at 84x84); a value may differ from cv::resize's by
+///    one level (float sums in another order).
 class ResizeObservation final : public ObservationWrapper {
  public:
   /// The largest height or width accepted.
@@ -46,7 +53,8 @@ class ResizeObservation final : public ObservationWrapper {
  private:
   ImageSize size_;
   ImageKey image_;
-  int interpolation_;  // cv::InterpolationFlags
+  int interpolation_;               // cv::InterpolationFlags
+  std::optional<AreaResize> area_;  // a shrink by a non-integer factor
 };
 
 }  // namespace pixelgym::wrappers
