@@ -14,6 +14,7 @@
 #include "envs/spaces/dict.h"
 #include "envs/spaces/discrete.h"
 #include "examples/pixelgym/cli.h"
+#include "testing/snapshot.h"
 
 namespace pixelgym::cli {
 namespace {
@@ -212,11 +213,34 @@ struct SnapshotArguments {
   std::uint64_t seed = 0;
   int steps = 0;
   std::string out;
+  std::string compare;
   bool observation = false;
   std::vector<std::string> sets;
 };
 
+// `snapshot --compare GOLDEN`: the frame against the golden under the default tolerance of
+// testing/snapshot.h; 0 on a match, 1 with the figures and the diff image's path otherwise.
+int compare_snapshot(const SnapshotArguments& args, const Array& frame,
+                     const std::string& description) {
+  const testing::SnapshotResult result = testing::compare_to_golden(frame, args.compare);
+  if (result.status == testing::SnapshotResult::Status::kUpdated) {
+    std::cout << result.message() << " (PIXELGYM_UPDATE_GOLDENS=1; " << description << ")\n";
+    return 0;
+  }
+  if (result.matched()) {
+    std::cout << "match: " << result.message() << " (" << description << ")\n";
+    return 0;
+  }
+  std::cerr << "mismatch: " << result.message() << " (" << description << ")\n";
+  return kExitFailure;
+}
+
 int run_snapshot(const SnapshotArguments& args) {
+  if (args.out.empty() && args.compare.empty()) {
+    throw UsageError(
+        "snapshot: give --out FILE.png (write the frame), --compare GOLDEN.png "
+        "(compare it with a golden), or both");
+  }
   std::unique_ptr<Env> env = make_env(args.id, args.sets);
   RandomRollout random(*env, args.seed);
   for (int t = 0; t < args.steps; ++t) random.step();
@@ -232,23 +256,35 @@ int run_snapshot(const SnapshotArguments& args) {
   } else {
     frame = env->render();
   }
-  write_frame_png(args.out, frame);
-  std::cout << "wrote " << args.out << " (" << frame.shape()[1] << "x" << frame.shape()[0] << " "
-            << (args.observation ? "observation" : "render()") << ", " << args.id << ", seed "
-            << args.seed << ", " << args.steps << " steps)\n";
+  std::ostringstream description;
+  description << frame.shape()[1] << "x" << frame.shape()[0] << " "
+              << (args.observation ? "observation" : "render()") << ", " << args.id << ", seed "
+              << args.seed << ", " << args.steps << " steps";
+  if (!args.out.empty()) {
+    write_frame_png(args.out, frame);  // throws naming the path and the OS error
+    std::cout << "wrote " << args.out << " (" << description.str() << ")\n";
+  }
+  const int status = args.compare.empty() ? 0 : compare_snapshot(args, frame, description.str());
   env->close();
-  return 0;
+  return status;
 }
 
 Command add_snapshot(CLI::App& app) {
   auto args = std::make_shared<SnapshotArguments>();
-  CLI::App* snapshot = app.add_subcommand("snapshot",
-                                          "Reset with a seed, take K seeded random actions, write "
-                                          "render() (or the observation) as a PNG");
+  CLI::App* snapshot = app.add_subcommand(
+      "snapshot",
+      "Reset with a seed, take K seeded random actions, write render() (or the observation) as a "
+      "PNG, or compare it with a golden PNG");
   add_id_argument(*snapshot, args->id, "GridWorld-v0");
   add_seed_option(*snapshot, args->seed, "Seed for the reset and the random actions");
   snapshot->add_option("--out", args->out, "PNG file to write (folders are created; PNG only)")
-      ->required()
+      ->check(png_path());
+  snapshot
+      ->add_option("--compare", args->compare,
+                   "Golden PNG to compare the frame with (the default tolerance of "
+                   "testing/snapshot.h): exit 0 on a match, 1 with the figures and a diff image "
+                   "(in $PIXELGYM_SNAPSHOT_OUTPUT_DIR, else ./snapshot_output) otherwise; "
+                   "PIXELGYM_UPDATE_GOLDENS=1 writes the golden instead")
       ->check(png_path());
   snapshot->add_option("--steps", args->steps, "Random actions before the frame is taken")
       ->capture_default_str()
