@@ -1,13 +1,18 @@
 #include "render/image_io.h"
 
+#include <fcntl.h>
 #include <png.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
+#include <climits>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
-#include <memory>
 #include <stdexcept>
+#include <vector>
 
 namespace pixelgym::render {
 namespace {
@@ -25,9 +30,70 @@ png_uint_32 png_format(int channels) {
   }
 }
 
-struct FileCloser {
-  void operator()(std::FILE* file) const { std::fclose(file); }
-};
+// A name beside `path` that no other writer uses: the process id and a per-process counter.
+std::string temporary_name(const std::string& path) {
+  static std::atomic<unsigned> counter{0};
+  return path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
+}
+
+[[noreturn]] void fail(const std::string& path, const std::string& reason) {
+  throw std::runtime_error("write_png: cannot write " + path + ": " + reason);
+}
+
+const char* file_kind(mode_t mode) {
+  if (S_ISDIR(mode)) return "a folder";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISFIFO(mode)) return "a pipe";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
+}
+
+// Writes `bytes` to a new file beside `path` and renames it to `path`, checking every write, the
+// fsync and the close: the file under `path` is the whole of `bytes` or what was there before.
+void write_file_atomically(const std::string& path, const std::vector<std::uint8_t>& bytes) {
+  std::string target = path;
+  struct stat status {};
+  if (::stat(path.c_str(), &status) == 0) {
+    // A rename replaces the name, not what it names: a device (/dev/full), a folder or a pipe
+    // would be replaced by a regular file, or the rename would fail after the work is done.
+    if (!S_ISREG(status.st_mode)) {
+      fail(path, std::string("it is ") + file_kind(status.st_mode) +
+                     ", not a regular file (images are written to a temporary file in the "
+                     "same folder, then renamed to the path)");
+    }
+    // A symbolic link to a file: replace the file it points to, keep the link.
+    char resolved[PATH_MAX];
+    if (::realpath(path.c_str(), resolved) != nullptr) target = resolved;
+  }
+  std::string temporary;
+  int fd = -1;
+  for (int attempt = 0; attempt < 100 && fd < 0; ++attempt) {
+    temporary = temporary_name(target);
+    fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd < 0 && errno != EEXIST) fail(path, std::strerror(errno));
+  }
+  if (fd < 0) fail(path, "no free temporary name beside it");
+  const auto give_up = [&](const char* step, int error) {
+    if (fd >= 0) ::close(fd);
+    ::unlink(temporary.c_str());
+    fail(path, std::string(step) + std::strerror(error));
+  };
+  std::size_t written = 0;
+  while (written < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) give_up("", n < 0 ? errno : ENOSPC);
+    written += static_cast<std::size_t>(n);
+  }
+  if (::fsync(fd) != 0 && errno != EINVAL) give_up("", errno);
+  const int closed = ::close(fd);
+  fd = -1;
+  if (closed != 0) give_up("", errno);
+  if (std::rename(temporary.c_str(), target.c_str()) != 0) {
+    give_up("cannot rename the finished temporary file into place: ", errno);
+  }
+}
 
 }  // namespace
 
@@ -40,34 +106,24 @@ void write_png(const std::string& path, const ImageView& image) {
                                 std::to_string(image.height) + "x" + std::to_string(image.width) +
                                 "x" + std::to_string(image.channels));
   }
-  const std::string temporary = path + ".tmp." + std::to_string(::getpid());
-  std::unique_ptr<std::FILE, FileCloser> file(std::fopen(temporary.c_str(), "wb"));
-  if (file == nullptr) {
-    throw std::runtime_error("write_png: cannot write " + path + ": " + std::strerror(errno));
-  }
+  // Encoded in memory first, so that nothing is created when encoding fails.
   png_image png;
   std::memset(&png, 0, sizeof png);
   png.version = PNG_IMAGE_VERSION;
   png.width = static_cast<png_uint_32>(image.width);
   png.height = static_cast<png_uint_32>(image.height);
   png.format = png_format(image.channels);
-  const bool written = png_image_write_to_stdio(&png, file.get(), 0, image.pixels,
-                                                image.width * image.channels, nullptr) != 0;
-  const bool flushed =
-      written && std::fflush(file.get()) == 0 && ::fsync(::fileno(file.get())) == 0;
-  const int saved_errno = errno;
-  const bool closed = std::fclose(file.release()) == 0;
-  if (!written || !flushed || !closed) {
-    std::remove(temporary.c_str());
-    throw std::runtime_error("write_png: cannot write " + path + ": " +
-                             (written ? std::strerror(saved_errno) : png.message));
+  const png_int_32 stride = image.width * image.channels;
+  png_alloc_size_t size = 0;
+  if (png_image_write_to_memory(&png, nullptr, &size, 0, image.pixels, stride, nullptr) == 0) {
+    fail(path, std::string("cannot encode the PNG: ") + png.message);
   }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    const int rename_errno = errno;
-    std::remove(temporary.c_str());
-    throw std::runtime_error("write_png: cannot move the finished file to " + path + ": " +
-                             std::strerror(rename_errno));
+  std::vector<std::uint8_t> bytes(size);
+  if (png_image_write_to_memory(&png, bytes.data(), &size, 0, image.pixels, stride, nullptr) == 0) {
+    fail(path, std::string("cannot encode the PNG: ") + png.message);
   }
+  bytes.resize(size);
+  write_file_atomically(path, bytes);
 }
 
 Image read_png(const std::string& path) {

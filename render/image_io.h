@@ -24,9 +24,13 @@ struct Image {
   ImageView view() const { return {pixels.data(), height, width, channels}; }
 };
 
-/// Writes `image` as a PNG. The file is complete or absent: it is written beside `path` under a
-/// temporary name and renamed into place. Throws std::invalid_argument for a malformed view and
-/// std::runtime_error naming the path and the reason when it cannot be written.
+/// Writes `image` as a PNG. The file is complete or absent: the PNG is encoded in memory, written
+/// beside `path` under a temporary name (every write, the fsync and the close checked) and renamed
+/// into place, so a failure leaves whatever was under `path` before, and no temporary file. `path`
+/// must be a regular file or absent (a symbolic link to a file: the file is replaced); a device
+/// such as /dev/full, a folder or a pipe is refused. Throws std::invalid_argument for a malformed
+/// view and std::runtime_error naming the path and the reason (the OS error: "No space left on
+/// device", "Read-only file system", ...) when it cannot be written.
 void write_png(const std::string& path, const ImageView& image);
 
 /// Reads a PNG as 8-bit gray, RGB or RGBA (palette and 16-bit files are converted). Throws

@@ -14,6 +14,7 @@
 #include "envs/spaces/dict.h"
 #include "envs/spaces/discrete.h"
 #include "examples/pixelgym/cli.h"
+#include "testing/snapshot.h"
 #include "wrappers/wrapper_spec.h"
 
 namespace pixelgym::cli {
@@ -243,51 +244,128 @@ struct SnapshotArguments {
   std::uint64_t seed = 0;
   int steps = 0;
   std::string out;
+  std::string compare;
   bool observation = false;
   std::vector<std::string> sets;
+  std::vector<std::string> wraps;
 };
 
+// The observation's image as an (H, W, 3) picture: the "pixels" entry of a Dict observation, or
+// a bare uint8 observation. A gray image ((H, W) or (H, W, 1)) becomes grey RGB; planes on a
+// leading axis ((k, H, W): stacked gray frames or channel-first planes; (k, H, W, C): stacked
+// frames) are laid side by side, the first leftmost. Throws UsageError for anything else.
+Array observation_picture(const std::string& id, const Value& obs) {
+  const Array* image = nullptr;
+  if (obs.is_dict() && obs.dict().contains("pixels") && obs.dict().at("pixels").is_array()) {
+    image = &obs.dict().at("pixels").array();
+  } else if (obs.is_array()) {
+    image = &obs.array();
+  }
+  if (image == nullptr || image->dtype() != DType::kUInt8 || image->ndim() < 2 ||
+      image->ndim() > 4) {
+    throw UsageError(id +
+                     ": --observation needs a uint8 image observation or a \"pixels\" entry "
+                     "(try --set obs_mode=pixels), got " +
+                     obs.to_string());
+  }
+  const Shape& shape = image->shape();
+  const std::size_t rank = shape.size();
+  const bool has_channels = rank >= 3 && (shape[rank - 1] == 1 || shape[rank - 1] == 3);
+  // Planes side by side: (planes, height, width, channels).
+  const std::int64_t planes = rank == 4 || (rank == 3 && !has_channels) ? shape[0] : 1;
+  const std::int64_t height = shape[planes > 1 || rank == 4 ? 1 : 0];
+  const std::int64_t width = shape[planes > 1 || rank == 4 ? 2 : 1];
+  const std::int64_t channels = rank == 4 || (rank == 3 && has_channels) ? shape[rank - 1] : 1;
+  if (rank == 4 && !has_channels) {
+    throw UsageError(id + ": --observation cannot show an image of shape " +
+                     shape_to_string(shape) + " (the last axis must be 1 or 3 channels)");
+  }
+  Array picture(DType::kUInt8, {height, width * planes, 3});
+  const std::uint8_t* from = image->data<std::uint8_t>();
+  std::uint8_t* to = picture.data<std::uint8_t>();
+  for (std::int64_t p = 0; p < planes; ++p) {
+    for (std::int64_t y = 0; y < height; ++y) {
+      for (std::int64_t x = 0; x < width; ++x) {
+        const std::uint8_t* pixel = from + ((p * height + y) * width + x) * channels;
+        std::uint8_t* out = to + (y * width * planes + p * width + x) * 3;
+        for (int c = 0; c < 3; ++c) out[c] = pixel[channels == 3 ? c : 0];
+      }
+    }
+  }
+  return picture;
+}
+
+// `snapshot --compare GOLDEN`: the frame against the golden under the default tolerance of
+// testing/snapshot.h; 0 on a match, 1 with the figures and the diff image's path otherwise.
+int compare_snapshot(const SnapshotArguments& args, const Array& frame,
+                     const std::string& description) {
+  const testing::SnapshotResult result = testing::compare_to_golden(frame, args.compare);
+  if (result.status == testing::SnapshotResult::Status::kUpdated) {
+    std::cout << result.message() << " (PIXELGYM_UPDATE_GOLDENS=1; " << description << ")\n";
+    return 0;
+  }
+  if (result.matched()) {
+    std::cout << "match: " << result.message() << " (" << description << ")\n";
+    return 0;
+  }
+  std::cerr << "mismatch: " << result.message() << " (" << description << ")\n";
+  return kExitFailure;
+}
+
 int run_snapshot(const SnapshotArguments& args) {
-  std::unique_ptr<Env> env = make_env(args.id, args.sets);
+  if (args.out.empty() && args.compare.empty()) {
+    throw UsageError(
+        "snapshot: give --out FILE.png (write the frame), --compare GOLDEN.png "
+        "(compare it with a golden), or both");
+  }
+  std::unique_ptr<Env> env = make_env(args.id, args.sets, args.wraps);
   RandomRollout random(*env, args.seed);
   for (int t = 0; t < args.steps; ++t) random.step();
   Array frame;
   if (args.observation) {
-    const Value& obs = random.observation();
-    if (!obs.is_dict() || !obs.dict().contains("pixels")) {
-      throw UsageError(args.id +
-                       ": --observation needs an observation with \"pixels\" (try --set "
-                       "obs_mode=pixels)");
-    }
-    frame = obs.dict().at("pixels").array();
+    frame = observation_picture(args.id, random.observation());
   } else {
     frame = env->render();
   }
-  write_frame_png(args.out, frame);
-  std::cout << "wrote " << args.out << " (" << frame.shape()[1] << "x" << frame.shape()[0] << " "
-            << (args.observation ? "observation" : "render()") << ", " << args.id << ", seed "
-            << args.seed << ", " << args.steps << " steps)\n";
+  std::ostringstream description;
+  description << frame.shape()[1] << "x" << frame.shape()[0] << " "
+              << (args.observation ? "observation" : "render()") << ", " << args.id << ", seed "
+              << args.seed << ", " << args.steps << " steps";
+  if (!args.out.empty()) {
+    write_frame_png(args.out, frame);  // throws naming the path and the OS error
+    std::cout << "wrote " << args.out << " (" << description.str() << ")\n";
+  }
+  const int status = args.compare.empty() ? 0 : compare_snapshot(args, frame, description.str());
   env->close();
-  return 0;
+  return status;
 }
 
 Command add_snapshot(CLI::App& app) {
   auto args = std::make_shared<SnapshotArguments>();
-  CLI::App* snapshot = app.add_subcommand("snapshot",
-                                          "Reset with a seed, take K seeded random actions, write "
-                                          "render() (or the observation) as a PNG");
+  CLI::App* snapshot = app.add_subcommand(
+      "snapshot",
+      "Reset with a seed, take K seeded random actions, write render() (or the observation) as a "
+      "PNG, or compare it with a golden PNG");
   add_id_argument(*snapshot, args->id, "GridWorld-v0");
   add_seed_option(*snapshot, args->seed, "Seed for the reset and the random actions");
   snapshot->add_option("--out", args->out, "PNG file to write (folders are created; PNG only)")
-      ->required()
+      ->check(png_path());
+  snapshot
+      ->add_option("--compare", args->compare,
+                   "Golden PNG to compare the frame with (the default tolerance of "
+                   "testing/snapshot.h): exit 0 on a match, 1 with the figures and a diff image "
+                   "(in $PIXELGYM_SNAPSHOT_OUTPUT_DIR, else ./snapshot_output) otherwise; "
+                   "PIXELGYM_UPDATE_GOLDENS=1 writes the golden instead")
       ->check(png_path());
   snapshot->add_option("--steps", args->steps, "Random actions before the frame is taken")
       ->capture_default_str()
       ->check(integer_in(0));
   snapshot->add_flag(
       "--observation", args->observation,
-      "Write the observation's \"pixels\" (what the agent sees) instead of render()");
+      "Take the observation's \"pixels\" (what the agent sees, after any --wrap) instead of "
+      "render(); gray images as grey, stacked frames side by side, oldest leftmost");
   add_set_option(*snapshot, args->sets);
+  add_wrap_option(*snapshot, args->wraps);
   return {snapshot, [args] { return run_snapshot(*args); }};
 }
 

@@ -128,13 +128,13 @@ TEST_P(RegisteredEnvTest, StateModeNeedsNoRendering) {
 }
 
 // The 84 x 84 observation after reset(seed=0), against tests/golden/env_<id>.png under the
-// tolerance documented in tests/golden.h.
+// default tolerance documented in testing/snapshot.h.
 TEST_P(RegisteredEnvTest, FirstObservationMatchesItsGolden) {
   std::unique_ptr<Env> env = make(GetParam(), {{"obs_mode", "pixels"}});
   const Array frame = env->reset(0).obs.dict().at("pixels").array();
   ASSERT_EQ(frame.shape(), (Shape{84, 84, 3}));
   std::string name = "env_" + GetParam();
-  EXPECT_TRUE(testing::matches_golden(name, frame.data<std::uint8_t>(), 84, 84));
+  EXPECT_TRUE(testing::matches_golden(name, frame));
 }
 
 INSTANTIATE_TEST_SUITE_P(AllEnvs, RegisteredEnvTest, ::testing::ValuesIn(registered_ids()),

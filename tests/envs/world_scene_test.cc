@@ -119,7 +119,7 @@ TEST_P(GoldenTest, MatchesTheReferenceFrame) {
       c.arm ? testing::arm_scene(c.size, c.size) : testing::cartpole_scene(c.size, c.size);
   render::Renderer renderer;
   const Array frame = draw(f, renderer);
-  EXPECT_TRUE(testing::matches_golden(c.name, frame.data<std::uint8_t>(), c.size, c.size));
+  EXPECT_TRUE(testing::matches_golden(c.name, frame));
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, GoldenTest,

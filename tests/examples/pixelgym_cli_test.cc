@@ -21,6 +21,7 @@
 #include "envs/world_scene.h"
 #include "render/image_io.h"
 #include "render/renderer.h"
+#include "wrappers/wrapper_spec.h"
 
 namespace pixelgym {
 namespace {
@@ -416,7 +417,7 @@ TEST(PixelgymCliTest, WrappersListsEverySpecForm) {
 }
 
 TEST(PixelgymCliTest, EverySubcommandThatMakesAnEnvTakesWrap) {
-  for (const char* command : {"info", "check", "rollout", "bench"}) {
+  for (const char* command : {"info", "check", "snapshot", "rollout", "bench"}) {
     EXPECT_THAT(run(std::string(command) + " --help").output, HasSubstr("--wrap SPEC")) << command;
   }
 }
@@ -434,6 +435,35 @@ TEST(PixelgymCliTest, InfoWrapPrintsTheWrappedSpaces) {
   // The kwarg's default stays the env's own.
   EXPECT_THAT(result.output, HasSubstr("max_episode_steps  int"));
   EXPECT_THAT(result.output, Not(HasSubstr("max_episode_steps  int     50")));
+}
+
+TEST(PixelgymCliTest, SnapshotObservationShowsTheWrappedImage) {
+  const std::string out = fresh_output("wrapped_observation.png");
+  const CliRun result = run("snapshot CartPoleSwingup-v0 --observation --seed 3 --out " + out +
+                            " --wrap resize=32x24 --wrap grayscale");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("24x32 observation"));
+  const auto env =
+      wrappers::apply_wrappers(make("CartPoleSwingup-v0", {}), {"resize=32x24", "grayscale"});
+  const Array gray = env->reset(3).obs.dict().at("pixels").array();
+  ASSERT_EQ(gray.shape(), (Shape{32, 24}));
+  std::vector<std::uint8_t> grey_rgb;
+  for (std::int64_t i = 0; i < gray.size(); ++i)
+    grey_rgb.insert(grey_rgb.end(), 3, gray.data<std::uint8_t>()[i]);
+  const render::Image png = render::read_png(out);
+  EXPECT_EQ(png.width, 24);
+  EXPECT_EQ(png.height, 32);
+  EXPECT_EQ(png.pixels, grey_rgb);
+}
+
+TEST(PixelgymCliTest, SnapshotObservationLaysPlanesSideBySide) {
+  const std::string out = fresh_output("channel_first_observation.png");
+  const CliRun result = run("snapshot CartPoleSwingup-v0 --observation --out " + out +
+                            " --wrap resize=20x16 --wrap channel_first");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const render::Image png = render::read_png(out);
+  EXPECT_EQ(png.width, 48);  // red, green and blue planes, each 16 wide
+  EXPECT_EQ(png.height, 20);
 }
 
 TEST(PixelgymCliTest, RolloutAppliesTheWrappersInOrder) {

@@ -1,8 +1,13 @@
 #include "render/image_io.h"
 
 #include <gtest/gtest.h>
+#include <sched.h>
+#include <sys/mount.h>
 
 #include <filesystem>
+#include <random>
+#include <string>
+#include <vector>
 
 namespace pixelgym::render {
 namespace {
@@ -47,6 +52,119 @@ TEST(ImageIoTest, UnwritablePathThrowsNamingItAndLeavesNothing) {
   } catch (const std::runtime_error& error) {
     EXPECT_NE(std::string(error.what()).find(path), std::string::npos);
   }
+}
+
+// What write_png threw for `path`, or "" when it did not throw.
+std::string write_error(const std::string& path, const ImageView& image) {
+  try {
+    write_png(path, image);
+  } catch (const std::runtime_error& error) {
+    return error.what();
+  }
+  return "";
+}
+
+// Noise compresses badly: 256 x 256 RGB is a PNG of about 200 kB.
+std::vector<std::uint8_t> noise(int height, int width) {
+  std::vector<std::uint8_t> pixels(static_cast<std::size_t>(height * width * 3));
+  std::mt19937 random(7);
+  for (std::uint8_t& v : pixels) v = static_cast<std::uint8_t>(random());
+  return pixels;
+}
+
+std::vector<std::string> entries(const std::string& folder) {
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(folder))
+    names.push_back(entry.path().filename().string());
+  return names;
+}
+
+// Mounts a tmpfs with `options` on a fresh folder, in a mount namespace of this process's own (so
+// nothing outlives the test). Returns "" when mounting is not permitted here.
+std::string mount_tmpfs(const std::string& name, unsigned long flags, const char* options) {
+  if (::unshare(CLONE_NEWNS) != 0) return "";
+  if (::mount(nullptr, "/", nullptr, MS_REC | MS_PRIVATE, nullptr) != 0) return "";
+  const std::string folder = output_path(name);
+  std::filesystem::create_directories(folder);
+  if (::mount("tmpfs", folder.c_str(), "tmpfs", flags, options) != 0) return "";
+  return folder;
+}
+
+// `pixelgym snapshot --out /dev/full` once printed "wrote /dev/full": a device is not a file.
+TEST(ImageIoTest, DevFullIsRefusedNamingIt) {
+  const std::vector<std::uint8_t> pixels(12);
+  const std::string error = write_error("/dev/full", {pixels.data(), 2, 2, 3});
+  EXPECT_NE(error.find("cannot write /dev/full: it is a character device, not a regular file"),
+            std::string::npos)
+      << error;
+  // And the device is still a device, with no temporary left beside it.
+  EXPECT_TRUE(std::filesystem::is_character_file("/dev/full"));
+  for (const std::string& name : entries("/dev")) EXPECT_NE(name.rfind("full.tmp.", 0), 0U) << name;
+}
+
+TEST(ImageIoTest, FolderIsRefused) {
+  const std::vector<std::uint8_t> pixels(12);
+  const std::string folder = output_path("image_io_a_folder.png");
+  std::filesystem::create_directories(folder);
+  EXPECT_NE(write_error(folder, {pixels.data(), 2, 2, 3}).find("it is a folder"),
+            std::string::npos);
+}
+
+// A path under a regular file: the folder cannot exist (root ignores permission bits, so a
+// chmod-ed folder would not test anything here).
+TEST(ImageIoTest, PathUnderAFileThrowsTheOsError) {
+  const std::vector<std::uint8_t> pixels(12);
+  const std::string file = output_path("image_io_plain_file");
+  write_png(file, {pixels.data(), 2, 2, 3});
+  const std::string error = write_error(file + "/x.png", {pixels.data(), 2, 2, 3});
+  EXPECT_NE(error.find("cannot write " + file + "/x.png: Not a directory"), std::string::npos)
+      << error;
+}
+
+TEST(ImageIoTest, ReadOnlyFolderThrowsTheOsErrorAndLeavesNothing) {
+  const std::string folder = mount_tmpfs("image_io_read_only", MS_RDONLY, "size=64k");
+  if (folder.empty()) GTEST_SKIP() << "mounting a tmpfs is not permitted here";
+  const std::vector<std::uint8_t> pixels(12);
+  const std::string path = folder + "/x.png";
+  const std::string error = write_error(path, {pixels.data(), 2, 2, 3});
+  EXPECT_NE(error.find("cannot write " + path + ": Read-only file system"), std::string::npos)
+      << error;
+  EXPECT_TRUE(entries(folder).empty());
+}
+
+// A 16 kB tmpfs: the PNG of noise does not fit. The write fails with the OS error, no temporary
+// or partial file is left, and a file already under the name keeps its old content.
+TEST(ImageIoTest, FullDiskThrowsTheOsErrorAndKeepsTheOldFile) {
+  const std::string folder = mount_tmpfs("image_io_full", 0, "size=16k");
+  if (folder.empty()) GTEST_SKIP() << "mounting a tmpfs is not permitted here";
+  const std::string path = folder + "/x.png";
+  const std::vector<std::uint8_t> small(12, 99);
+  write_png(path, {small.data(), 2, 2, 3});
+  const std::vector<std::uint8_t> big = noise(256, 256);
+  const std::string error = write_error(path, {big.data(), 256, 256, 3});
+  EXPECT_NE(error.find("cannot write " + path + ": No space left on device"), std::string::npos)
+      << error;
+  EXPECT_EQ(entries(folder), std::vector<std::string>{"x.png"});
+  EXPECT_EQ(read_png(path).pixels, small);
+  // A new name: nothing at all is left.
+  const std::string fresh = folder + "/y.png";
+  EXPECT_NE(write_error(fresh, {big.data(), 256, 256, 3}).find("No space left on device"),
+            std::string::npos);
+  EXPECT_EQ(entries(folder), std::vector<std::string>{"x.png"});
+}
+
+// A symbolic link to a file: the file is rewritten, the link stays.
+TEST(ImageIoTest, WritesThroughASymbolicLink) {
+  const std::vector<std::uint8_t> pixels(12, 5);
+  const std::string file = output_path("image_io_link_target.png");
+  const std::string link = output_path("image_io_link.png");
+  std::filesystem::remove(link);
+  write_png(file, {pixels.data(), 2, 2, 3});
+  std::filesystem::create_symlink(file, link);
+  const std::vector<std::uint8_t> other(12, 9);
+  write_png(link, {other.data(), 2, 2, 3});
+  EXPECT_TRUE(std::filesystem::is_symlink(link));
+  EXPECT_EQ(read_png(file).pixels, other);
 }
 
 TEST(ImageIoTest, MalformedViewIsRejected) {
