@@ -20,8 +20,8 @@ PACKAGES=(
   libtorch-dev
   # command line, JSON
   libcli11-dev nlohmann-json3-dev
-  # tests and benchmarks
-  libgtest-dev libgmock-dev libbenchmark-dev
+  # tests and benchmarks; ffmpeg for ffprobe, which the RecordVideo tests read clips back with
+  libgtest-dev libgmock-dev libbenchmark-dev ffmpeg
 )
 
 is_installed() {

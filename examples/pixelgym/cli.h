@@ -77,4 +77,7 @@ std::vector<Command> add_engine_commands(CLI::App& app);
 /// Adds view to `app`.
 std::vector<Command> add_render_commands(CLI::App& app);
 
+/// Adds record (episodes to .mp4 through wrappers::RecordVideo) to `app`.
+std::vector<Command> add_record_commands(CLI::App& app);
+
 }  // namespace pixelgym::cli

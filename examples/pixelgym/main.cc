@@ -1,5 +1,5 @@
 // pixelgym — the command-line front door: list, info, check, snapshot, rollout, bench, inspect,
-// view, help.
+// view, record, help.
 #include <exception>
 #include <iostream>
 #include <string>
@@ -34,7 +34,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("pixelgym ") + PIXELGYM_VERSION,
                        "Print the version and exit");
   std::vector<Command> commands = pixelgym::cli::add_env_commands(app);
-  for (auto* add : {pixelgym::cli::add_engine_commands, pixelgym::cli::add_render_commands}) {
+  for (auto* add : {pixelgym::cli::add_engine_commands, pixelgym::cli::add_render_commands,
+                    pixelgym::cli::add_record_commands}) {
     for (auto& command : add(app)) commands.push_back(std::move(command));
   }
 

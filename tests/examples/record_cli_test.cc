@@ -1,0 +1,182 @@
+// Runs `pixelgym record` as a user would: the clips it says it wrote exist with those frame counts
+// and the returns of the seeded random policy; a folder it cannot write exits 1 and leaves nothing.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <stdlib.h>
+#include <sys/mount.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <opencv2/videoio.hpp>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include "envs/registry.h"
+#include "envs/rollout.h"
+
+namespace pixelgym {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+using ::testing::Not;
+
+struct CliRun {
+  int exit_code;       // -1 when the process did not exit normally (a crash)
+  std::string output;  // stdout and stderr
+};
+
+CliRun run(const std::string& arguments) {
+  const std::string command = std::string(PIXELGYM_CLI) + " " + arguments + " 2>&1";
+  std::FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return {-1, "popen failed"};
+  std::string output;
+  std::array<char, 4096> buffer{};
+  while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) output += buffer.data();
+  const int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
+// A folder of the test's own under the test output folder, removed first.
+fs::path fresh_folder() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  const fs::path folder = fs::path(PIXELGYM_TEST_OUTPUT_DIR) / "record_cli" / info->name();
+  fs::remove_all(folder);
+  return folder;
+}
+
+std::set<std::string> files_in(const fs::path& folder) {
+  std::set<std::string> names;
+  if (!fs::exists(folder)) return names;
+  for (const auto& entry : fs::directory_iterator(folder)) {
+    names.insert(entry.path().filename().string());
+  }
+  return names;
+}
+
+std::int64_t frame_count(const fs::path& path) {
+  cv::VideoCapture capture(path.string(), cv::CAP_FFMPEG);
+  if (!capture.isOpened()) return -1;
+  return static_cast<std::int64_t>(capture.get(cv::CAP_PROP_FRAME_COUNT));
+}
+
+// What `record` prints for these episodes, from the library: the same RandomRollout.
+std::string expected_lines(const std::string& id, const Params& kwargs, std::uint64_t seed,
+                           int episodes, const std::function<std::string(int)>& path) {
+  auto env = make(id, kwargs);
+  RandomRollout random(*env, seed);
+  std::ostringstream out;
+  for (int episode = 0; episode < episodes; ++episode) {
+    const EpisodeSummary& summary = random.finish_episode(false);
+    out << "wrote " << path(episode) << " frames=" << summary.length + 1
+        << " return=" << summary.episode_return << "\n";
+  }
+  return out.str();
+}
+
+TEST(RecordCliTest, OneClipPerEpisodeInAFolder) {
+  const fs::path folder = fresh_folder() / "runs";
+  const CliRun result = run("record GridWorld-v0 --episodes 3 --seed 1 --out " + folder.string());
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const auto path = [&](int episode) {
+    return (folder / ("GridWorld-v0-episode-" + std::to_string(episode) + ".mp4")).string();
+  };
+  EXPECT_EQ(result.output, expected_lines("GridWorld-v0", {}, 1, 3, path));
+  EXPECT_EQ(files_in(folder),
+            (std::set<std::string>{"GridWorld-v0-episode-0.mp4", "GridWorld-v0-episode-1.mp4",
+                                   "GridWorld-v0-episode-2.mp4"}));
+  auto env = make("GridWorld-v0");
+  RandomRollout random(*env, 1);
+  for (int episode = 0; episode < 3; ++episode) {
+    EXPECT_EQ(frame_count(path(episode)), random.finish_episode(false).length + 1) << episode;
+  }
+}
+
+TEST(RecordCliTest, OneFile) {
+  const fs::path folder = fresh_folder();
+  const fs::path file = folder / "swing.mp4";
+  const std::string sets =
+      "--set render_width=64 --set render_height=48 --set max_episode_steps=30";
+  const CliRun result =
+      run("record CartPoleSwingup-v0 --seed 4 --out " + file.string() + " " + sets);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(result.output,
+            expected_lines("CartPoleSwingup-v0",
+                           {{"render_width", 64}, {"render_height", 48}, {"max_episode_steps", 30}},
+                           4, 1, [&](int) { return file.string(); }));
+  EXPECT_EQ(files_in(folder), std::set<std::string>{"swing.mp4"});
+  EXPECT_EQ(frame_count(file), 31);
+}
+
+TEST(RecordCliTest, UsageErrorsExitTwo) {
+  const fs::path folder = fresh_folder();
+  CliRun result = run("record GridWorld-v0 --episodes 2 --out " + (folder / "a.mp4").string());
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("is one clip, but --episodes is 2"));
+  result = run("record GridWorld-v0 --policy greedy --out " + folder.string());
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("--policy"));
+  result = run("record GridWorld-v0");
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("--out is required"));
+  result = run("record NoSuchEnv-v0 --out " + folder.string());
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_FALSE(fs::exists(folder));
+}
+
+TEST(RecordCliTest, HelpIsTheSubcommandsOwn) {
+  const CliRun help = run("record --help");
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_THAT(help.output, HasSubstr("Usage: pixelgym record [OPTIONS] id"));
+  EXPECT_THAT(help.output, HasSubstr("--episodes INT:>= 1=1"));
+  EXPECT_THAT(help.output, HasSubstr("--seed UINT64=0"));
+  EXPECT_EQ(run("help record").output, help.output);
+  EXPECT_THAT(run("help").output, HasSubstr("\n  record "));
+}
+
+TEST(RecordCliTest, FolderThatCannotBeCreatedExitsOneAndLeavesNothing) {
+  const fs::path folder = fresh_folder();
+  fs::create_directories(folder);
+  std::ofstream(folder / "a-file") << "x";
+  const fs::path out = folder / "a-file" / "videos";
+  const CliRun result = run("record GridWorld-v0 --out " + out.string());
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("pixelgym: error: RecordVideo: cannot create the video "
+                                       "folder \"" +
+                                       out.string() + "\""));
+  EXPECT_EQ(files_in(folder), std::set<std::string>{"a-file"});
+}
+
+TEST(RecordCliTest, ReadOnlyFolderExitsOneAndLeavesNothing) {
+  std::string pattern = (fs::temp_directory_path() / "pixelgym-record-cli-XXXXXX").string();
+  ASSERT_NE(mkdtemp(pattern.data()), nullptr);
+  const fs::path mount_point = pattern;
+  // A read-only file system refuses root too (chmod 555 would not).
+  if (mount("tmpfs", mount_point.c_str(), "tmpfs", MS_RDONLY, "size=64k") != 0) {
+    const std::string why = std::strerror(errno);
+    fs::remove(mount_point);
+    GTEST_SKIP() << "cannot mount a tmpfs here: " << why;
+  }
+  const CliRun folder_run = run("record GridWorld-v0 --out " + mount_point.string());
+  const CliRun file_run = run("record GridWorld-v0 --out " + (mount_point / "a.mp4").string());
+  const std::set<std::string> left = files_in(mount_point);
+  umount(mount_point.c_str());
+  fs::remove(mount_point);
+  for (const CliRun& result : {folder_run, file_run}) {
+    EXPECT_EQ(result.exit_code, 1) << result.output;
+    EXPECT_THAT(result.output, HasSubstr("cannot create a file in the video folder \"" +
+                                         mount_point.string() + "\": Read-only file system"));
+    EXPECT_THAT(result.output, Not(HasSubstr("wrote")));
+  }
+  EXPECT_EQ(left, std::set<std::string>{});
+}
+
+}  // namespace
+}  // namespace pixelgym
