@@ -214,6 +214,10 @@ CheckReport check_env(Env& env, const CheckOptions& options) {
                shape[1] > 0,
            std::string("render() returned ") + dtype_name(frame.dtype()) + " " +
                shape_to_string(shape) + ", expected uint8 (H, W, 3) with H, W > 0");
+    const std::optional<Shape>& declared = env.metadata().render_shape;
+    expect(!declared || *declared == shape,
+           "render() returned a " + shape_to_string(shape) + " frame, metadata().render_shape is " +
+               (declared ? shape_to_string(*declared) : std::string()));
   });
 
   run("metadata", [&] {

@@ -44,7 +44,7 @@ struct CheckOptions {
 ///  - observation_aliasing: consecutive observations do not share memory.
 ///  - buffer_path: `reset_into` / `step_into` write into the caller's arrays (no array of the
 ///    env's own swapped in) and give what `reset` / `step` give for the same seed and actions.
-///  - render: `render()` returns an (H, W, 3) uint8 array.
+///  - render: `render()` returns an (H, W, 3) uint8 array, of metadata().render_shape when set.
 ///  - metadata: render_modes holds "rgb_array" and render_fps > 0.
 ///  - close: `close()` twice raises nothing. The env is closed afterwards.
 CheckReport check_env(Env& env, const CheckOptions& options = {});

@@ -30,6 +30,10 @@ struct Metadata {
   std::vector<std::string> render_modes{"rgb_array"};
   /// Frames per second of `render()` output played back in real time; > 0.
   double render_fps = 0.0;
+  /// The shape of `render()` frames, (H, W, 3), when the env knows it without rendering (pixel
+  /// tasks and GridWorld do: it comes from their config); std::nullopt when unknown. Wrappers that
+  /// put frames in observations (AddRenderObservation) need it to build their space up front.
+  std::optional<Shape> render_shape;
 };
 
 /// What `reset` returns, and where `reset_into` writes.

@@ -112,6 +112,7 @@ EnvDescription PixelEnv::describe(const Task& task, const TaskConfig& config) {
   description.max_episode_steps =
       (task.episode_length() + config.action_repeat - 1) / config.action_repeat;
   description.metadata.render_fps = 1.0 / (task.control_timestep_s() * config.action_repeat);
+  description.metadata.render_shape = Shape{config.render_height, config.render_width, 3};
   return description;
 }
 

@@ -75,6 +75,7 @@ GridWorld::GridWorld(GridWorldConfig config)
                              : SpacePtr(std::make_shared<spaces::Discrete>(kSize * kSize))),
       action_space_(std::make_shared<spaces::Discrete>(4)) {
   metadata_.render_fps = 4.0;
+  metadata_.render_shape = Shape{config.render_height, config.render_width, 3};
 }
 
 void GridWorld::do_reset(std::optional<std::uint64_t> /*seed*/, const Options& options,

@@ -1,0 +1,57 @@
+// RunningStatistics: the running mean and variance that NormalizeObservation and NormalizeReward
+// keep (Gymnasium's RunningMeanStd), and their checkpoint form.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "envs/value.h"
+
+namespace pixelgym::wrappers {
+
+/// Element-wise running mean and (population) variance of a stream of samples, as Gymnasium's
+/// `RunningMeanStd`: it starts from mean 0, variance 1 and a pseudo-count of kInitialCount
+/// (1e-4), and each sample x is merged in with the parallel-variance update of Chan et al.
+/// (count' = count + 1, delta = x - mean, mean' = mean + delta / count',
+/// var' = (var * count + delta^2 * count / count') / count'). After n samples the mean is
+/// sum(x) / (n + 1e-4) and the variance that of the samples pooled with the prior, which differs
+/// from the plain sample statistics by about 1e-4 / n relative.
+struct RunningStatistics {
+  static constexpr double kInitialCount = 1e-4;
+
+  std::vector<double> mean;
+  std::vector<double> var;
+  double count = kInitialCount;
+
+  /// The starting statistics of `size` elements: mean 0, variance 1, count 1e-4.
+  static RunningStatistics initial(std::size_t size);
+
+  /// Merges one sample of mean.size() elements, given element by element as doubles by `sample`
+  /// (called with 0 .. size-1). Allocates nothing.
+  template <typename Sample>
+  void update(const Sample& sample) {
+    const double total = count + 1.0;
+    for (std::size_t i = 0; i < mean.size(); ++i) {
+      const double delta = sample(i) - mean[i];
+      mean[i] += delta / total;
+      var[i] = (var[i] * count + delta * delta * count / total) / total;
+    }
+    count = total;
+  }
+
+  /// Why these statistics cannot stand for `size` elements ("var[3] is -1, must be >= 0"), or ""
+  /// when they can: mean and var of `size` entries, every entry finite, var >= 0, count finite
+  /// and > 0.
+  std::string invalid_reason(std::size_t size) const;
+
+  /// The checkpoint form: Dict{"mean": float64 (size,), "var": float64 (size,), "count": float64
+  /// ()}, exact (the doubles are stored as they are).
+  Value to_value() const;
+  /// The inverse of to_value. Throws std::invalid_argument naming `context` when `value` is not
+  /// laid out so (keys, dtypes, shapes) or its statistics are invalid for `size` elements.
+  static RunningStatistics from_value(const Value& value, std::size_t size,
+                                      const std::string& context);
+};
+
+}  // namespace pixelgym::wrappers
