@@ -132,6 +132,10 @@ class Array {
   /// dtype or shape mismatch.
   void copy_from(const Array& source);
 
+  /// The allocation this array keeps alive, shared by every view of it (for `from_external`, the
+  /// owner given): for accounting the memory that arrays hold, and for recognizing whose memory
+  /// a view is (std::get_deleter on an owner made with a deleter of its own).
+  const std::shared_ptr<void>& storage() const { return storage_; }
   /// True when both arrays view the same allocation (numpy's `shares_memory` for our layouts).
   bool shares_memory(const Array& other) const;
   /// Same dtype, same shape and identical bytes.

@@ -41,7 +41,8 @@ struct CheckOptions {
 ///    and (for envs whose start depends on the seed) not a reseed to a fixed state.
 ///  - step: random steps return observations inside the space and finite rewards.
 ///  - step_determinism: the same seed and actions give identical observations, rewards and flags.
-///  - observation_aliasing: consecutive observations do not share memory.
+///  - observation_aliasing: an observation returned by reset() or step() does not change when
+///    later steps run (observations may share memory that is never written again).
 ///  - buffer_path: `reset_into` / `step_into` write into the caller's arrays (no array of the
 ///    env's own swapped in) and give what `reset` / `step` give for the same seed and actions.
 ///  - render: `render()` returns an (H, W, 3) uint8 array, of metadata().render_shape when set.

@@ -24,16 +24,18 @@ void require_layout(const Env& env, const Space& space, const Value& obs, const 
 
 }  // namespace
 
+Value Env::observation_buffer(BufferFor /*call*/) { return observation_space().zeros(); }
+
 ResetResult Env::reset(std::optional<std::uint64_t> seed, const Options& options) {
   ResetResult result;
-  result.obs = observation_space().zeros();
+  result.obs = observation_buffer(BufferFor::kReset);
   reset_into(result, seed, options);
   return result;
 }
 
 StepResult Env::step(const Value& action) {
   StepResult result;
-  result.obs = observation_space().zeros();
+  result.obs = observation_buffer(BufferFor::kStep);
   step_into(action, result);
   return result;
 }

@@ -52,6 +52,9 @@ struct StepResult {
   Info info;
 };
 
+/// Which call an observation buffer is for (see Env::observation_buffer).
+enum class BufferFor : std::uint8_t { kReset, kStep };
+
 /// The environment protocol, named as in Gymnasium.
 ///
 /// The public methods are not virtual: they enforce call order, validate actions against
@@ -70,13 +73,27 @@ class Env {
   Env(const Env&) = delete;
   Env& operator=(const Env&) = delete;
 
-  /// Starts an episode; the observation is a new Value of its own. Throws ResetNeeded after
-  /// `close()`.
+  /// Starts an episode; the observation is `observation_buffer(BufferFor::kReset)` filled by
+  /// `reset_into`. Throws ResetNeeded after `close()`.
   ResetResult reset(std::optional<std::uint64_t> seed = std::nullopt, const Options& options = {});
-  /// Advances one step; the observation is a new Value of its own (never aliased with an earlier
-  /// one). Throws ResetNeeded when called out of order and std::invalid_argument when `action`
-  /// is not in `action_space()` (naming the space and the value).
+  /// Advances one step; the observation is `observation_buffer(BufferFor::kStep)` filled by
+  /// `step_into`: later calls never change it (it may share read-only memory with other
+  /// observations, as FrameStackObservation's stacked frames do). Throws ResetNeeded when called
+  /// out of order and std::invalid_argument when `action` is not in `action_space()` (naming the
+  /// space and the value).
   StepResult step(const Value& action);
+
+  /// The buffer that `reset()` (kReset) or `step()` (kStep) passes to `reset_into` /
+  /// `step_into` and then returns, laid out as `observation_space()`. The default is
+  /// `observation_space().zeros()`. An env may instead hand out memory of its own that the next
+  /// call fills without copying, provided it never writes that memory again once returned
+  /// (observations returned earlier never change) and `reset_into` / `step_into` still accept
+  /// any other buffer laid out as the space. FrameStackObservation returns a view of its frame
+  /// tape where the next stacked window will be, so that consecutive observations share their
+  /// frames. Wrapper forwards the call to the inner env (a wrapper that leaves observations
+  /// alone keeps that sharing); ObservationWrapper returns its own space's zeros(). Calling it
+  /// changes no observation; it may be called at any time.
+  virtual Value observation_buffer(BufferFor call);
 
   /// The buffer path, which `reset` and `step` also take after allocating `out.obs`: the
   /// observation is written into the arrays of `out.obs`, memory the caller owns and laid out as

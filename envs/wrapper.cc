@@ -9,6 +9,11 @@ Wrapper::Wrapper(std::unique_ptr<Env> env) : env_(std::move(env)) {
   if (env_ == nullptr) throw std::invalid_argument("Wrapper: the env to wrap is null");
 }
 
+Value Wrapper::observation_buffer(BufferFor call) {
+  if (&observation_space() != &env_->observation_space()) return observation_space().zeros();
+  return env_->observation_buffer(call);
+}
+
 void Wrapper::do_reset(std::optional<std::uint64_t> seed, const Options& options,
                        ResetResult& out) {
   env_->reset_into(out, seed, options);
@@ -22,6 +27,10 @@ void Wrapper::do_close() { env_->close(); }
 
 const Space& ObservationWrapper::observation_space() const {
   return observation_space_ != nullptr ? *observation_space_ : env_->observation_space();
+}
+
+Value ObservationWrapper::observation_buffer(BufferFor /*call*/) {
+  return observation_space().zeros();
 }
 
 void ObservationWrapper::set_observation_space(SpacePtr space) {

@@ -26,6 +26,13 @@ class Wrapper : public Env {
   const EnvSpec* spec() const override { return env_->spec(); }
   /// "TimeLimit<GridWorld-v0>".
   std::string name() const override { return type_name() + "<" + env_->name() + ">"; }
+  /// The inner env's buffer when this wrapper's observation space is the inner env's (the same
+  /// Space object), so that sharing below (FrameStackObservation) survives TimeLimit and the
+  /// action and reward wrappers above it; else `observation_space().zeros()`. A subclass that
+  /// writes into `out.obs` itself after the inner env did (rather than through
+  /// ObservationWrapper) must override this to return `observation_space().zeros()`: the inner
+  /// env's buffer may be memory that other observations share.
+  Value observation_buffer(BufferFor call) override;
 
   /// The env one level in.
   Env& env() { return *env_; }
@@ -53,6 +60,8 @@ class ObservationWrapper : public Wrapper {
  public:
   using Wrapper::Wrapper;
   const Space& observation_space() const override;
+  /// `observation_space().zeros()`: observations are transformed, never the inner env's memory.
+  Value observation_buffer(BufferFor call) override;
 
  protected:
   /// Writes the transform of `obs` (laid out as the inner env's observation space) into the

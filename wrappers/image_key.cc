@@ -20,6 +20,7 @@ bool is_image(const Space& space, const ImageRequirement& requirement) {
   if (shape.size() != 2 && shape.size() != 3) return false;
   if (shape[0] < 1 || shape[1] < 1) return false;
   const std::int64_t channels = shape.size() == 3 ? shape[2] : 0;
+  if (requirement.any_rank3 && channels != 0) return shape[2] >= 1;
   return std::find(requirement.channels.begin(), requirement.channels.end(), channels) !=
          requirement.channels.end();
 }
@@ -37,6 +38,8 @@ std::string describe(const ImageRequirement& requirement) {
     channels += std::to_string(c);
   }
   std::string text = "a uint8 ";
+  if (requirement.any_rank3)
+    return text + (two_d ? "(H, W), (H, W, C) or (C, H, W) Box" : "(H, W, C) or (C, H, W) Box");
   if (two_d) text += "(H, W) or ";
   if (!channels.empty()) text += "(H, W, C) Box with C = " + channels;
   return text;

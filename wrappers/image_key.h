@@ -38,6 +38,9 @@ struct ImageKey {
 struct ImageRequirement {
   /// The accepted channel counts C of an (H, W, C) image; 0 stands for an (H, W) image.
   std::vector<std::int64_t> channels = {1, 3};
+  /// When true, any rank-3 uint8 Box is accepted whatever its last extent (e.g. a channel-first
+  /// (C, H, W) image); `channels` then only says whether 0, an (H, W) image, is accepted too.
+  bool any_rank3 = false;
 };
 
 /// Finds the image `key` in `space` for `wrapper` (its class name, used in messages).

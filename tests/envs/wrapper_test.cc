@@ -3,6 +3,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <vector>
+
 #include "envs/spaces/box.h"
 #include "tests/envs/probe_env.h"
 
@@ -147,6 +149,57 @@ TEST(WrapperTest, ActionWrapperStepsTheInnerEnvThroughItsOwnActionBuffer) {
   env.step_into(action(-5.0F), step);
   env.step_into(action(5.0F), step);
   EXPECT_NEAR(static_cast<ProbeEnv&>(env.unwrapped()).x(), x0 + 0.05, 1e-6);
+}
+
+// Hands out buffers of its own (as FrameStackObservation does) and records which call asked.
+class OwnBuffer final : public Wrapper {
+ public:
+  using Wrapper::Wrapper;
+  Value observation_buffer(BufferFor call) override {
+    calls.push_back(call);
+    return buffer;
+  }
+  Array buffer{DType::kFloat32, {2}};
+  std::vector<BufferFor> calls;
+};
+
+// Declares a space of its own (the same bounds, another Space object) and writes nothing.
+class OwnSpace final : public Wrapper {
+ public:
+  using Wrapper::Wrapper;
+  const Space& observation_space() const override { return space_; }
+
+ private:
+  spaces::Box space_{-10.0, 10.0, {2}};
+};
+
+TEST(WrapperTest, ResetAndStepTakeTheBufferHooksBuffer) {
+  OwnBuffer env(std::make_unique<ProbeEnv>());
+  const Value reset = env.reset(0).obs;
+  const Value step = env.step(action(0.5F)).obs;
+  EXPECT_TRUE(reset.shares_memory(env.buffer));
+  EXPECT_TRUE(step.shares_memory(env.buffer));
+  EXPECT_EQ(env.calls, (std::vector<BufferFor>{BufferFor::kReset, BufferFor::kStep}));
+}
+
+TEST(WrapperTest, TheBufferHookIsForwardedOnlyByWrappersThatKeepTheSpace) {
+  const Value plain = ProbeEnv().observation_buffer(BufferFor::kStep);
+  EXPECT_EQ(plain.array().shape(), (Shape{2}));
+  EXPECT_EQ(plain.array().data<float>()[0], 0.0F);
+
+  auto own = std::make_unique<OwnBuffer>(std::make_unique<ProbeEnv>());
+  const Array buffer = own->buffer;
+  NegateReward reward(std::move(own));  // the same space: forwarded
+  EXPECT_TRUE(reward.observation_buffer(BufferFor::kReset).shares_memory(buffer));
+  reward.reset(0);
+  EXPECT_TRUE(reward.step(action(0.5F)).obs.shares_memory(buffer));
+
+  DoubleObservation doubled(std::make_unique<OwnBuffer>(std::make_unique<ProbeEnv>()));
+  EXPECT_FALSE(doubled.observation_buffer(BufferFor::kStep)
+                   .shares_memory(static_cast<OwnBuffer&>(doubled.env()).buffer));
+  OwnSpace other(std::make_unique<OwnBuffer>(std::make_unique<ProbeEnv>()));
+  EXPECT_FALSE(other.observation_buffer(BufferFor::kStep)
+                   .shares_memory(static_cast<OwnBuffer&>(other.env()).buffer));
 }
 
 }  // namespace
