@@ -11,8 +11,17 @@
 #include <stdexcept>
 
 #include "envs/time_limit.h"
+#include "wrappers/add_render_observation.h"
 #include "wrappers/channel_first_observation.h"
+#include "wrappers/clip_action.h"
+#include "wrappers/dtype_observation.h"
+#include "wrappers/filter_observation.h"
+#include "wrappers/frame_stack_observation.h"
 #include "wrappers/grayscale_observation.h"
+#include "wrappers/normalize_observation.h"
+#include "wrappers/normalize_reward.h"
+#include "wrappers/record_episode_statistics.h"
+#include "wrappers/rescale_action.h"
 #include "wrappers/resize_observation.h"
 
 namespace pixelgym::wrappers {
@@ -24,7 +33,8 @@ enum class Kind { kInteger, kNumber, kBool, kText, kSize, kKeys };
 struct Param {
   std::string name;
   Kind kind;
-  /// What it means when absent ("pixels", "false"); empty for a required parameter.
+  /// Its value when absent ("pixels", "false"), "<name>" for an optional parameter whose absence
+  /// means something else (no key: a bare Box), or empty for a required parameter.
   std::string default_text;
   bool required() const { return default_text.empty(); }
 };
@@ -192,6 +202,86 @@ const std::vector<Entry>& entries() {
        [](std::unique_ptr<Env> env, const Arguments& args) -> std::unique_ptr<Env> {
          return std::make_unique<ChannelFirstObservation>(std::move(env),
                                                           args.word("key", "pixels"));
+       }},
+      {"frame_stack",
+       "FrameStackObservation: the last N frames (padding: the reset frame or zeros), sharing "
+       "memory between steps",
+       {{"stack_size", Kind::kInteger, ""},
+        {"padding", Kind::kText, "reset"},
+        key_param,
+        {"layout", Kind::kText, "new_axis"}},
+       [](std::unique_ptr<Env> env, const Arguments& args) -> std::unique_ptr<Env> {
+         const std::string padding = args.choice("padding", {"reset", "zero"}, "reset");
+         const std::string layout =
+             args.choice("layout", {"new_axis", "channels_first", "channels_last"}, "new_axis");
+         return std::make_unique<FrameStackObservation>(
+             std::move(env), args.integer("stack_size", 0),
+             padding == "zero" ? FrameStackPadding::kZero : FrameStackPadding::kReset,
+             args.word("key", "pixels"),
+             layout == "channels_first"  ? FrameStackLayout::kChannelsFirst
+             : layout == "channels_last" ? FrameStackLayout::kChannelsLast
+                                         : FrameStackLayout::kNewAxis);
+       }},
+      {"clip_action",
+       "ClipAction: clip Box actions into the bounds (the action space becomes unbounded)",
+       {},
+       [](std::unique_ptr<Env> env, const Arguments&) -> std::unique_ptr<Env> {
+         return std::make_unique<ClipAction>(std::move(env));
+       }},
+      {"rescale_action",
+       "RescaleAction: Box actions in [min, max] mapped onto the env's bounds",
+       {{"min", Kind::kNumber, ""}, {"max", Kind::kNumber, ""}},
+       [](std::unique_ptr<Env> env, const Arguments& args) -> std::unique_ptr<Env> {
+         return std::make_unique<RescaleAction>(std::move(env), args.number("min", 0.0),
+                                                args.number("max", 0.0));
+       }},
+      {"normalize_observation",
+       "NormalizeObservation: running mean and variance, float32 out (a Dict needs the key)",
+       {{"key", Kind::kText, "<key>"}, {"epsilon", Kind::kNumber, "1e-8"}},
+       [](std::unique_ptr<Env> env, const Arguments& args) -> std::unique_ptr<Env> {
+         return std::make_unique<NormalizeObservation>(std::move(env), args.word("key", ""),
+                                                       args.number("epsilon", 1e-8));
+       }},
+      {"normalize_reward",
+       "NormalizeReward: rewards over the running deviation of the discounted return",
+       {{"gamma", Kind::kNumber, "0.99"}, {"epsilon", Kind::kNumber, "1e-8"}},
+       [](std::unique_ptr<Env> env, const Arguments& args) -> std::unique_ptr<Env> {
+         return std::make_unique<NormalizeReward>(std::move(env), args.number("gamma", 0.99),
+                                                  args.number("epsilon", 1e-8));
+       }},
+      {"record_episode_statistics",
+       "RecordEpisodeStatistics: info[\"episode\"] = {r, l, t} at each episode's end",
+       {{"buffer_length", Kind::kInteger, "100"}},
+       [](std::unique_ptr<Env> env, const Arguments& args) -> std::unique_ptr<Env> {
+         return std::make_unique<RecordEpisodeStatistics>(std::move(env),
+                                                          args.integer("buffer_length", 100));
+       }},
+      {"add_render_observation",
+       "AddRenderObservation: render() frames added to the observation under a key",
+       {{"render_key", Kind::kText, "pixels"},
+        {"render_only", Kind::kBool, "false"},
+        {"obs_key", Kind::kText, "state"}},
+       [](std::unique_ptr<Env> env, const Arguments& args) -> std::unique_ptr<Env> {
+         return std::make_unique<AddRenderObservation>(
+             std::move(env), args.boolean("render_only", false), args.word("render_key", "pixels"),
+             args.word("obs_key", "state"));
+       }},
+      {"filter_observation",
+       "FilterObservation: keep only these Dict keys, in this order",
+       {{"keys", Kind::kKeys, ""}},
+       [](std::unique_ptr<Env> env, const Arguments& args) -> std::unique_ptr<Env> {
+         return std::make_unique<FilterObservation>(std::move(env), args.keys("keys"));
+       }},
+      {"dtype_observation",
+       "DtypeObservation: cast a Box observation (or one Dict key) to another dtype",
+       {{"dtype", Kind::kText, ""}, {"key", Kind::kText, "<key>"}},
+       [](std::unique_ptr<Env> env, const Arguments& args) -> std::unique_ptr<Env> {
+         const std::vector<std::string> names = {"bool",  "uint8",   "int32",
+                                                 "int64", "float32", "float64"};
+         const std::string name = args.choice("dtype", names, "");
+         const auto index = std::find(names.begin(), names.end(), name) - names.begin();
+         return std::make_unique<DtypeObservation>(std::move(env), static_cast<DType>(index),
+                                                   args.word("key", ""));
        }},
       {"time_limit",
        "TimeLimit: truncate episodes after N steps",

@@ -21,13 +21,14 @@ struct RecordArguments {
   std::string out;
   std::string policy = "random";
   std::vector<std::string> sets;
+  std::vector<std::string> wraps;
 };
 
 // The env that is recorded, before RecordVideo wraps it: every option that shapes the env is
 // applied here and only here.
-std::unique_ptr<Env> make_recorded_env(const std::string& id,
-                                       const std::vector<std::string>& sets) {
-  return make_env(id, sets);
+std::unique_ptr<Env> make_recorded_env(const std::string& id, const std::vector<std::string>& sets,
+                                       const std::vector<std::string>& wraps) {
+  return make_env(id, sets, wraps);
 }
 
 bool is_mp4_file(const std::string& out) { return fs::path(out).extension() == ".mp4"; }
@@ -42,7 +43,7 @@ int run_record(const RecordArguments& args) {
   if (one_file && fs::path(args.out).filename() == ".mp4") {
     throw UsageError("--out " + args.out + ": the clip needs a name before .mp4");
   }
-  std::unique_ptr<Env> env = make_recorded_env(args.id, args.sets);
+  std::unique_ptr<Env> env = make_recorded_env(args.id, args.sets, args.wraps);
   // A folder: one clip per episode, "{folder}/{id}-episode-{N}.mp4". One file: the clip is
   // started by hand before the first reset, under the file's own name.
   const fs::path folder = one_file ? fs::path(args.out).parent_path() : fs::path(args.out);
@@ -98,6 +99,7 @@ std::vector<Command> add_record_commands(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::IsMember({"random"}));
   add_set_option(*record, args->sets);
+  add_wrap_option(*record, args->wraps);
   return {{record, [args] { return run_record(*args); }}};
 }
 

@@ -262,8 +262,8 @@ TEST(PixelgymCliTest, HelpListsEverySubcommandAndExplainsEach) {
   ASSERT_EQ(help.exit_code, 0) << help.output;
   EXPECT_THAT(help.output, HasSubstr("Usage: pixelgym [OPTIONS] SUBCOMMAND"));
   const std::vector<std::string> subcommands = {"list",     "wrappers", "info",  "check",
-                                                "snapshot", "rollout",  "bench", "inspect",
-                                                "view",     "help"};
+                                                "snapshot", "rollout",  "bench", "record",
+                                                "inspect",  "view",     "help"};
   for (const std::string& name : subcommands) {
     EXPECT_THAT(help.output, HasSubstr("\n  " + name + " ")) << name;
     const CliRun one = run("help " + name);
@@ -417,7 +417,7 @@ TEST(PixelgymCliTest, WrappersListsEverySpecForm) {
 }
 
 TEST(PixelgymCliTest, EverySubcommandThatMakesAnEnvTakesWrap) {
-  for (const char* command : {"info", "check", "snapshot", "rollout", "bench"}) {
+  for (const char* command : {"info", "check", "snapshot", "rollout", "bench", "record"}) {
     EXPECT_THAT(run(std::string(command) + " --help").output, HasSubstr("--wrap SPEC")) << command;
   }
 }

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
@@ -89,21 +90,97 @@ TEST(WrapperSpecTest, SpecValuesReachTheWrapperAndItSteps) {
 }
 
 TEST(WrapperSpecTest, EveryHelpUsageIsItselfAValidSpec) {
+  // Placeholders filled in, longest first ("<max>" is a prefix of "<max_episode_steps>").
+  const std::vector<std::pair<std::string, std::string>> values = {
+      {"<max_episode_steps>", "5"}, {"<stack_size>", "2"},  {"<min>", "-1"},    {"<max>", "1"},
+      {"<keys>", "pixels"},         {"<dtype>", "float32"}, {"<key>", "state"}, {"HxW", "8x8"}};
   for (const WrapperSpecHelp& help : wrapper_spec_help()) {
-    // "resize=HxW[,key=pixels]" -> "resize=8x8"; the optional parts as their defaults.
-    std::string text = help.usage;
     std::string plain;
-    for (char c : text) {
+    for (char c : help.usage) {
       if (c != '[' && c != ']') plain += c;
     }
-    for (const auto& [placeholder, value] : std::vector<std::pair<std::string, std::string>>{
-             {"HxW", "8x8"}, {"<max_episode_steps>", "5"}}) {
-      const std::size_t at = plain.find(placeholder);
-      if (at != std::string::npos) plain.replace(at, placeholder.size(), value);
+    for (const auto& [placeholder, value] : values) {
+      for (std::size_t at = plain.find(placeholder); at != std::string::npos;
+           at = plain.find(placeholder)) {
+        plain.replace(at, placeholder.size(), value);
+      }
     }
-    EXPECT_NO_THROW(apply_wrapper(image_env(), parse_wrapper_spec(plain))) << plain;
+    // Each applies to the image env or (rendering wrappers) to a real one.
+    std::string errors;
+    bool applied = false;
+    for (int candidate = 0; candidate < 2 && !applied; ++candidate) {
+      try {
+        apply_wrapper(
+            candidate == 0 ? image_env() : make("CartPoleSwingup-v0", {{"obs_mode", "state"}}),
+            parse_wrapper_spec(plain));
+        applied = true;
+      } catch (const std::invalid_argument& error) {
+        errors += std::string(error.what()) + "\n";
+      }
+    }
+    EXPECT_TRUE(applied) << help.usage << " as " << plain << ":\n" << errors;
     EXPECT_FALSE(help.summary.empty());
   }
+}
+
+TEST(WrapperSpecTest, EveryWrapperOfTheIssueHasAForm) {
+  std::vector<std::string> names;
+  for (const WrapperSpecHelp& help : wrapper_spec_help()) names.push_back(help.name);
+  for (const char* name :
+       {"resize", "grayscale", "channel_first", "frame_stack", "clip_action", "rescale_action",
+        "normalize_observation", "normalize_reward", "record_episode_statistics",
+        "add_render_observation", "filter_observation", "dtype_observation", "time_limit"}) {
+    EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
+  }
+}
+
+TEST(WrapperSpecTest, FrameStackFromText) {
+  const auto env = apply_wrappers(
+      image_env(), {"resize=16x12", "grayscale", "frame_stack=3,padding=zero,layout=new_axis"});
+  EXPECT_EQ(pixels_shape(*env), (Shape{3, 16, 12}));
+  const auto channels_last = apply_wrappers(image_env(), {"frame_stack=2,layout=channels_last"});
+  EXPECT_EQ(pixels_shape(*channels_last), (Shape{48, 40, 6}));
+  const std::string message =
+      error_of([] { apply_wrappers(image_env(), {"frame_stack=3,padding=repeat"}); });
+  EXPECT_EQ(message,
+            "wrapper spec \"frame_stack=3,padding=repeat\": frame_stack's padding: expected reset "
+            "| zero, got \"repeat\"");
+}
+
+TEST(WrapperSpecTest, ActionRewardAndInfoWrappersFromText) {
+  // The time limit inside the statistics, so that they see the episode end it makes.
+  auto env = apply_wrappers(image_env(), {"time_limit=3", "rescale_action=0,10", "clip_action",
+                                          "normalize_reward=0.9", "record_episode_statistics=5"});
+  EXPECT_EQ(env->action_space().to_string(), "Box(-inf, inf, (1,), float32)");
+  env->reset(1);
+  StepResult result;
+  for (int t = 0; t < 3; ++t) result = env->step(env->action_space().sample());
+  EXPECT_TRUE(result.truncated);
+  EXPECT_TRUE(result.info.contains("episode"));
+}
+
+TEST(WrapperSpecTest, ObservationDictWrappersFromText) {
+  const auto filtered = apply_wrappers(image_env(), {"filter_observation=state+pixels"});
+  const auto& dict = dynamic_cast<const spaces::Dict&>(filtered->observation_space());
+  ASSERT_EQ(dict.entries().size(), 2u);
+  EXPECT_EQ(dict.entries()[0].first, "state");
+  const auto cast = apply_wrappers(image_env(), {"dtype_observation=float32,key=pixels"});
+  EXPECT_EQ(dynamic_cast<const spaces::Dict&>(cast->observation_space()).at("pixels").dtype(),
+            DType::kFloat32);
+  const auto normalized = apply_wrappers(image_env(), {"normalize_observation=state,1e-6"});
+  EXPECT_EQ(normalized->name(), "NormalizeObservation<ImageEnv>");
+  EXPECT_NE(error_of([] { apply_wrappers(image_env(), {"dtype_observation=float16"}); })
+                .find("dtype_observation's dtype: expected bool | uint8 | int32 | int64 | "
+                      "float32 | float64, got \"float16\""),
+            std::string::npos);
+  EXPECT_NE(error_of([] {
+              apply_wrappers(image_env(), {"filter_observation=state++pixels"});
+            }).find("filter_observation's keys: expected observation keys joined by '+'"),
+            std::string::npos);
+  EXPECT_NE(error_of([] {
+              apply_wrappers(image_env(), {"rescale_action=0,nan"});
+            }).find("rescale_action's max: expected a finite number, got \"nan\""),
+            std::string::npos);
 }
 
 TEST(WrapperSpecTest, UnknownWrapperListsTheKnownOnes) {
