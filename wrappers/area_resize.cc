@@ -62,6 +62,38 @@ void blend_columns(const float* __restrict in, const int* __restrict from,
   }
 }
 
+#if defined(__SSE2__)
+// One blended row's columns for 3 or 4 channels: a pixel's channels in the lanes of one
+// register, so each tap is one load of `channels` consecutive floats (the 4th lane of a 3-channel
+// load reads the next pixel's red and is dropped; the row buffer has a float of padding), one
+// multiply by the tap's weight and one add. Each pixel is stored as 4 bytes, the 4th of a
+// 3-channel pixel overwritten by the next one; the row's last pixel as exactly `channels` bytes.
+// kTaps: the taps known at compile time, or 0 for `taps`.
+template <int kTaps>
+void blend_pixel_columns(const float* __restrict in, const int* __restrict first,
+                         const float* __restrict weights, int taps, int channels, int width,
+                         std::uint8_t* __restrict out) {
+  const int count = kTaps > 0 ? kTaps : taps;
+  for (int x = 0; x < width; ++x) {
+    const float* source = in + static_cast<std::ptrdiff_t>(first[x]) * channels;
+    const float* w = weights + static_cast<std::ptrdiff_t>(x) * count;
+    __m128 sum = _mm_mul_ps(_mm_set1_ps(w[0]), _mm_loadu_ps(source));
+    for (int j = 1; j < count; ++j) {
+      sum = _mm_add_ps(sum, _mm_mul_ps(_mm_set1_ps(w[j]), _mm_loadu_ps(source + j * channels)));
+    }
+    const __m128i rounded = _mm_cvtps_epi32(sum);  // nearest, ties to even
+    const __m128i bytes = _mm_packus_epi16(_mm_packs_epi32(rounded, rounded), rounded);
+    const int packed = _mm_cvtsi128_si32(bytes);
+    std::uint8_t* pixel = out + static_cast<std::ptrdiff_t>(x) * channels;
+    if (channels == 4 || x + 1 < width) {
+      std::memcpy(pixel, &packed, 4);
+    } else {
+      std::memcpy(pixel, &packed, 3);
+    }
+  }
+}
+#endif
+
 }  // namespace
 
 AreaResize::Axis AreaResize::axis(int source, int target) {
@@ -124,8 +156,10 @@ AreaResize::AreaResize(int source_height, int source_width, int height, int widt
       }
     }
   }
+  // One float of padding: the 4-lane load of a 3-channel row's last pixel reads one past it.
   blended_.resize(static_cast<std::size_t>(height) * static_cast<std::size_t>(source_width) *
-                  static_cast<std::size_t>(channels));
+                      static_cast<std::size_t>(channels) +
+                  1);
 }
 
 void AreaResize::operator()(const std::uint8_t* source, std::uint8_t* target) {
@@ -135,7 +169,23 @@ void AreaResize::operator()(const std::uint8_t* source, std::uint8_t* target) {
     float* __restrict out = blended_.data() + static_cast<std::size_t>(y) * row;
     const std::uint8_t* in = source + static_cast<std::size_t>(rows_.first[y]) * row;
     const float* weights = &rows_.weights[static_cast<std::size_t>(y * rows_.taps)];
-    for (std::size_t i = 0; i < row; ++i) out[i] = weights[0] * in[i];
+    // Two or three taps (shrinks by less than 2x) in one pass, one store per element.
+    const float w0 = weights[0];
+    if (rows_.taps == 2) {
+      const float w1 = weights[1];
+      const std::uint8_t* __restrict in1 = in + row;
+      for (std::size_t i = 0; i < row; ++i) out[i] = w0 * in[i] + w1 * in1[i];
+      continue;
+    }
+    if (rows_.taps == 3) {
+      const float w1 = weights[1];
+      const float w2 = weights[2];
+      const std::uint8_t* __restrict in1 = in + row;
+      const std::uint8_t* __restrict in2 = in + 2 * row;
+      for (std::size_t i = 0; i < row; ++i) out[i] = w0 * in[i] + w1 * in1[i] + w2 * in2[i];
+      continue;
+    }
+    for (std::size_t i = 0; i < row; ++i) out[i] = w0 * in[i];
     for (int tap = 1; tap < rows_.taps; ++tap) {
       const std::uint8_t* __restrict next = in + static_cast<std::size_t>(tap) * row;
       const float weight = weights[tap];
@@ -144,6 +194,19 @@ void AreaResize::operator()(const std::uint8_t* source, std::uint8_t* target) {
   }
   // Then columns, within each blended row.
   const std::size_t n = static_cast<std::size_t>(width_) * channels_;
+#if defined(__SSE2__)
+  if (channels_ == 3 || channels_ == 4) {
+    const auto pass = columns_.taps == 2   ? &blend_pixel_columns<2>
+                      : columns_.taps == 3 ? &blend_pixel_columns<3>
+                                           : &blend_pixel_columns<0>;
+    for (int y = 0; y < height_; ++y) {
+      pass(blended_.data() + static_cast<std::size_t>(y) * row, columns_.first.data(),
+           columns_.weights.data(), columns_.taps, channels_, width_,
+           target + static_cast<std::size_t>(y) * n);
+    }
+    return;
+  }
+#endif
   for (int y = 0; y < height_; ++y) {
     const float* in = blended_.data() + static_cast<std::size_t>(y) * row;
     std::uint8_t* out = target + static_cast<std::size_t>(y) * n;
