@@ -97,6 +97,26 @@ TEST(GrayscaleObservationTest, DictMatchesOpenCvAndPassesOtherKeys) {
   EXPECT_TRUE(wrapper.observation_space().contains(obs));
 }
 
+// Every value of each channel, in random combinations over a large image: the same bytes as
+// cv::cvtColor (the wrapper computes OpenCV's fixed point itself).
+TEST(GrayscaleObservationTest, MatchesOpenCvOnALargeRandomImage) {
+  Rng rng(11);
+  Array image(DType::kUInt8, {256, 384, 3});
+  for (std::int64_t i = 0; i < image.size(); ++i) {
+    image.data<std::uint8_t>()[i] = static_cast<std::uint8_t>(rng.uniform(0.0, 256.0));
+  }
+  auto env = std::make_unique<ImageEnv>(testing::image_box(256, 384, 3));
+  env->next = Value(image);
+  GrayscaleObservation wrapper(std::move(env));
+  const Array gray = wrapper.reset(0).obs.array();
+  const cv::Mat source(256, 384, CV_8UC3, image.raw_data());
+  cv::Mat reference;
+  cv::cvtColor(source, reference, cv::COLOR_RGB2GRAY);
+  ASSERT_EQ(gray.nbytes(), reference.total());
+  EXPECT_TRUE(
+      std::equal(reference.data, reference.data + reference.total(), gray.data<std::uint8_t>()));
+}
+
 TEST(GrayscaleObservationTest, RefusesAOneChannelImage) {
   expect_invalid(
       [] {
