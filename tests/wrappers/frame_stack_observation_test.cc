@@ -99,7 +99,6 @@ TEST(FrameStackObservationTest, OutputSpacePerLayout) {
   const std::vector<Case> cases = {
       {image_box(84, 80, 3), FrameStackLayout::kNewAxis, {4, 84, 80, 3}},
       {image_box(84, 80, 3), FrameStackLayout::kChannelsLast, {84, 80, 12}},
-      {image_box(84, 80, 3), FrameStackLayout::kChannelsFirst, {336, 80, 3}},
       {image_box(3, 84, 80), FrameStackLayout::kChannelsFirst, {12, 84, 80}},
       {image_box(3, 84, 80), FrameStackLayout::kNewAxis, {4, 3, 84, 80}},
       {image_box(84, 80, 1), FrameStackLayout::kChannelsLast, {84, 80, 4}},
@@ -188,7 +187,7 @@ TEST(FrameStackObservationTest, OtherKeysPassThroughTheLatestStep) {
 }
 
 TEST(FrameStackObservationTest, LayoutsHoldTheSameFrames) {
-  // A patterned (H, W, C) frame per step: element (y, x, c) = v + 3 y + 5 x + c.
+  // A patterned (A, B, C) frame per step: element (y, x, c) = v + 3 y + 5 x + c.
   const auto frame = [](const Space& space, std::uint8_t v) {
     Value value = space.zeros();
     Array& image = value.array();
@@ -204,11 +203,12 @@ TEST(FrameStackObservationTest, LayoutsHoldTheSameFrames) {
     }
     return value;
   };
-  Stack axis = make_stack(image_box(5, 7, 3), 3, FrameStackPadding::kZero);
+  // (4, 5, 7): a rank-3 image channels_first accepts (a channels-last one is refused).
+  Stack axis = make_stack(image_box(4, 5, 7), 3, FrameStackPadding::kZero);
   Stack first =
-      make_stack(image_box(5, 7, 3), 3, FrameStackPadding::kZero, FrameStackLayout::kChannelsFirst);
+      make_stack(image_box(4, 5, 7), 3, FrameStackPadding::kZero, FrameStackLayout::kChannelsFirst);
   Stack last =
-      make_stack(image_box(5, 7, 3), 3, FrameStackPadding::kZero, FrameStackLayout::kChannelsLast);
+      make_stack(image_box(4, 5, 7), 3, FrameStackPadding::kZero, FrameStackLayout::kChannelsLast);
   Value a;
   Value f;
   Value l;
@@ -224,16 +224,16 @@ TEST(FrameStackObservationTest, LayoutsHoldTheSameFrames) {
       f = first.env->step(first.env->action_space().zeros()).obs;
       l = last.env->step(last.env->action_space().zeros()).obs;
     }
-    // channels_first on an (H, W, C) image is the same bytes as new_axis.
-    EXPECT_TRUE(f.array().equals(a.array().reshape({15, 7, 3})));
+    // channels_first is the same bytes as new_axis.
+    EXPECT_TRUE(f.array().equals(a.array().reshape({12, 5, 7})));
     // channels_last: out[y][x][j C + c] = frame_j[y][x][c].
     const auto* stacked = a.array().data<std::uint8_t>();
     const auto* interleaved = l.array().data<std::uint8_t>();
     bool same = true;
     for (std::int64_t j = 0; j < 3; ++j) {
-      for (std::int64_t p = 0; p < 35; ++p) {
-        for (std::int64_t c = 0; c < 3; ++c) {
-          same = same && interleaved[p * 9 + j * 3 + c] == stacked[(j * 35 + p) * 3 + c];
+      for (std::int64_t p = 0; p < 20; ++p) {
+        for (std::int64_t c = 0; c < 7; ++c) {
+          same = same && interleaved[p * 21 + j * 7 + c] == stacked[(j * 20 + p) * 7 + c];
         }
       }
     }
@@ -266,6 +266,10 @@ TEST(FrameStackObservationTest, Errors) {
                  {"FrameStackObservation", "float32", "image keys: none"});
   expect_invalid(make(image_box(8, 8, 3), 4, "depth", axis),
                  {"FrameStackObservation", "key \"depth\" given", "bare Box"});
+  expect_invalid(make(image_box(84, 80, 3), 4, "pixels", FrameStackLayout::kChannelsFirst),
+                 {"FrameStackObservation", "channels_first", "uint8 (84, 80, 3)",
+                  "apply ChannelFirstObservation", "giving (12, 84, 80)",
+                  "channels_last (giving (84, 80, 12))"});
   expect_invalid(make(gray_box(8, 8), 4, "pixels", FrameStackLayout::kChannelsFirst),
                  {"FrameStackObservation", "channels_first", "rank 3", "uint8 (8, 8)",
                   "use layout new_axis (giving (4, 8, 8))"});
@@ -283,7 +287,7 @@ TEST(FrameStackObservationTest, ReturnedObservationsNeverChange) {
         FrameStackLayout::kChannelsLast}) {
     SCOPED_TRACE(to_string(layout));
     // Episodes of 10 steps: resets mid-stream, and several tapes of 64 slots filled.
-    Stack s = make_stack(pixels_and_state(6, 4, 3), 4, FrameStackPadding::kReset, layout);
+    Stack s = make_stack(pixels_and_state(6, 4, 5), 4, FrameStackPadding::kReset, layout);
     std::vector<Value> held;
     std::vector<Value> copies;
     const auto keep = [&](const Value& obs) {
@@ -330,8 +334,8 @@ TEST(FrameStackObservationTest, StepIntoACallerBufferGivesWhatStepGives) {
         FrameStackLayout::kChannelsLast}) {
     SCOPED_TRACE(to_string(layout));
     for (const FrameStackPadding padding : {FrameStackPadding::kReset, FrameStackPadding::kZero}) {
-      Stack returned = make_stack(pixels_and_state(6, 4, 3), 3, padding, layout);
-      Stack into = make_stack(pixels_and_state(6, 4, 3), 3, padding, layout);
+      Stack returned = make_stack(pixels_and_state(6, 4, 5), 3, padding, layout);
+      Stack into = make_stack(pixels_and_state(6, 4, 5), 3, padding, layout);
       ResetResult reset;
       reset.obs = into.env->observation_space().zeros();
       StepResult step;

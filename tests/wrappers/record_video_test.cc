@@ -54,12 +54,15 @@ class FrameEnv final : public Env {
   int width;
   int height;
   bool noise = false;
+  /// When > 0, the step that makes t equal to it throws std::runtime_error.
+  int throw_at_step = 0;
 
  protected:
   std::string type_name() const override { return "FrameEnv"; }
   void do_reset(std::optional<std::uint64_t>, const Options&, ResetResult&) override { t_ = 0; }
   void do_step(const Value&, StepResult& out) override {
     ++t_;
+    if (t_ == throw_at_step) throw std::runtime_error("FrameEnv: step " + std::to_string(t_));
     out.reward = 1.0;
     out.terminated = t_ >= episode_length_;
   }
@@ -479,6 +482,27 @@ TEST(RecordVideoTest, FullDiskInTheDestructorLeavesNoFileAndSaysSo) {
                                 (tiny.path() / "rl-video-episode-0.mp4").string() + "\" failed"));
   EXPECT_THAT(errors, HasSubstr("(in ~RecordVideo)"));
   EXPECT_EQ(files_in(tiny.path()), std::set<std::string>{});
+}
+
+// An episode the env breaks off mid-clip leaves no clip: the file would hold part of it.
+TEST(RecordVideoTest, EnvErrorMidClipLeavesNoFile) {
+  const fs::path folder = fresh_folder();
+  auto env = std::make_unique<FrameEnv>(32, 32, 10);
+  FrameEnv* inner = env.get();
+  inner->throw_at_step = 4;
+  {
+    RecordVideo record(std::move(env), folder, every_episode);
+    record.reset();
+    for (int t = 0; t < 3; ++t) record.step(record.action_space().zeros());
+    EXPECT_THROW(record.step(record.action_space().zeros()), std::runtime_error);
+    EXPECT_FALSE(record.recording());
+    EXPECT_EQ(files_in(folder), std::set<std::string>{});
+    // The next episode records as usual.
+    inner->throw_at_step = 0;
+    run_episode(record);
+  }  // the destructor finishes it
+  EXPECT_EQ(files_in(folder), std::set<std::string>{"rl-video-episode-1.mp4"});
+  EXPECT_EQ(read_back(folder / "rl-video-episode-1.mp4").frames, 11);
 }
 
 TEST(RecordVideoTest, FrameOfAnotherSizeFailsTheClip) {
