@@ -1,8 +1,17 @@
 #include "wrappers/area_resize.h"
 
+// An AVX2 + FMA kernel, compiled for x86-64 with GCC or Clang (function target attributes) and
+// chosen at run time when the CPU has both; elsewhere the portable (SSE2 or plain) one runs.
+#if defined(__x86_64__) && defined(__GNUC__)
+#define PIXELGYM_AREA_RESIZE_AVX2 1
+#endif
+
 #include <algorithm>
 #if defined(__SSE__)
 #include <emmintrin.h>
+#endif
+#if defined(PIXELGYM_AREA_RESIZE_AVX2)
+#include <immintrin.h>
 #endif
 #include <cmath>
 #include <cstddef>
@@ -94,6 +103,126 @@ void blend_pixel_columns(const float* __restrict in, const int* __restrict first
 }
 #endif
 
+#if defined(PIXELGYM_AREA_RESIZE_AVX2)
+// The AVX2 + FMA kernel, chosen at run time where the CPU has both (the build targets baseline
+// x86-64). It works on blocks of 8 output rows held "row-major by element": block[k * 8 + r] is
+// blended row r's element k. Rows are blended 8 elements at a time per row, then an 8 x 8
+// transpose stores them by element; the column pass then computes one output element for all 8
+// rows in one register (one broadcast weight and one load per tap, FMA), and a second transpose
+// turns 8 such registers back into 8 bytes for each of the 8 rows. Every register lane does
+// useful work, whatever the channel count.
+__attribute__((target("avx2,fma"))) inline void transpose8(__m256 (&r)[8]) {
+  const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]);
+  const __m256 t1 = _mm256_unpackhi_ps(r[0], r[1]);
+  const __m256 t2 = _mm256_unpacklo_ps(r[2], r[3]);
+  const __m256 t3 = _mm256_unpackhi_ps(r[2], r[3]);
+  const __m256 t4 = _mm256_unpacklo_ps(r[4], r[5]);
+  const __m256 t5 = _mm256_unpackhi_ps(r[4], r[5]);
+  const __m256 t6 = _mm256_unpacklo_ps(r[6], r[7]);
+  const __m256 t7 = _mm256_unpackhi_ps(r[6], r[7]);
+  const __m256 s0 = _mm256_shuffle_ps(t0, t2, 0x44);
+  const __m256 s1 = _mm256_shuffle_ps(t0, t2, 0xEE);
+  const __m256 s2 = _mm256_shuffle_ps(t1, t3, 0x44);
+  const __m256 s3 = _mm256_shuffle_ps(t1, t3, 0xEE);
+  const __m256 s4 = _mm256_shuffle_ps(t4, t6, 0x44);
+  const __m256 s5 = _mm256_shuffle_ps(t4, t6, 0xEE);
+  const __m256 s6 = _mm256_shuffle_ps(t5, t7, 0x44);
+  const __m256 s7 = _mm256_shuffle_ps(t5, t7, 0xEE);
+  r[0] = _mm256_permute2f128_ps(s0, s4, 0x20);
+  r[1] = _mm256_permute2f128_ps(s1, s5, 0x20);
+  r[2] = _mm256_permute2f128_ps(s2, s6, 0x20);
+  r[3] = _mm256_permute2f128_ps(s3, s7, 0x20);
+  r[4] = _mm256_permute2f128_ps(s0, s4, 0x31);
+  r[5] = _mm256_permute2f128_ps(s1, s5, 0x31);
+  r[6] = _mm256_permute2f128_ps(s2, s6, 0x31);
+  r[7] = _mm256_permute2f128_ps(s3, s7, 0x31);
+}
+
+__attribute__((target("avx2,fma"))) inline __m256 load8_bytes(const std::uint8_t* bytes) {
+  return _mm256_cvtepi32_ps(
+      _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(bytes))));
+}
+
+struct AxisView {
+  int taps;
+  const int* first;
+  const float* weights;  // output index * taps + tap
+};
+
+// kRowTaps, kColumnTaps: the taps known at compile time (unrolled), or 0 for the run-time counts.
+template <int kRowTaps, int kColumnTaps>
+__attribute__((target("avx2,fma"))) void area_resize_avx2(
+    const std::uint8_t* source, std::uint8_t* target, std::size_t row, int height, std::size_t n,
+    AxisView rows, const int* element_first, const float* element_weights, int column_taps,
+    int channels, float* block) {
+  const int row_taps = kRowTaps > 0 ? kRowTaps : rows.taps;
+  if (kColumnTaps > 0) column_taps = kColumnTaps;
+  const std::size_t stride = static_cast<std::size_t>(channels) * 8;  // one source pixel in block
+  for (int y0 = 0; y0 < height; y0 += 8) {
+    // Rows past the last are computed as the last one and not stored.
+    int ys[8];
+    for (int r = 0; r < 8; ++r) ys[r] = std::min(y0 + r, height - 1);
+    const int rows_here = std::min(8, height - y0);
+    std::size_t k = 0;
+    for (; k + 8 <= row; k += 8) {
+      __m256 v[8];
+      for (int r = 0; r < 8; ++r) {
+        const float* w = rows.weights + static_cast<std::ptrdiff_t>(ys[r]) * row_taps;
+        const std::uint8_t* in = source + static_cast<std::size_t>(rows.first[ys[r]]) * row + k;
+        __m256 sum = _mm256_mul_ps(_mm256_set1_ps(w[0]), load8_bytes(in));
+        for (int t = 1; t < row_taps; ++t) {
+          sum = _mm256_fmadd_ps(_mm256_set1_ps(w[t]), load8_bytes(in + t * row), sum);
+        }
+        v[r] = sum;
+      }
+      transpose8(v);
+      for (int j = 0; j < 8; ++j) _mm256_storeu_ps(block + (k + j) * 8, v[j]);
+    }
+    for (; k < row; ++k) {
+      for (int r = 0; r < 8; ++r) {
+        const float* w = rows.weights + static_cast<std::ptrdiff_t>(ys[r]) * row_taps;
+        const std::uint8_t* in = source + static_cast<std::size_t>(rows.first[ys[r]]) * row + k;
+        float sum = w[0] * in[0];
+        for (int t = 1; t < row_taps; ++t) sum += w[t] * in[t * row];
+        block[k * 8 + r] = sum;
+      }
+    }
+    std::uint8_t* out = target + static_cast<std::size_t>(y0) * n;
+    std::size_t e = 0;
+    for (; e + 8 <= n; e += 8) {
+      __m256 v[8];
+      for (int j = 0; j < 8; ++j) {
+        const float* from = block + static_cast<std::size_t>(element_first[e + j]) * 8;
+        __m256 sum = _mm256_mul_ps(_mm256_set1_ps(element_weights[e + j]), _mm256_loadu_ps(from));
+        for (int t = 1; t < column_taps; ++t) {
+          sum = _mm256_fmadd_ps(_mm256_set1_ps(element_weights[t * n + e + j]),
+                                _mm256_loadu_ps(from + t * stride), sum);
+        }
+        v[j] = sum;
+      }
+      transpose8(v);  // v[r]: row r's elements e .. e + 7
+      for (int r = 0; r < rows_here; ++r) {
+        const __m256i rounded = _mm256_cvtps_epi32(v[r]);  // nearest, ties to even
+        const __m128i words =
+            _mm_packs_epi32(_mm256_castsi256_si128(rounded), _mm256_extracti128_si256(rounded, 1));
+        _mm_storel_epi64(reinterpret_cast<__m128i*>(out + r * n + e),
+                         _mm_packus_epi16(words, words));
+      }
+    }
+    for (; e < n; ++e) {
+      const float* from = block + static_cast<std::size_t>(element_first[e]) * 8;
+      for (int r = 0; r < rows_here; ++r) {
+        float sum = element_weights[e] * from[r];
+        for (int t = 1; t < column_taps; ++t) {
+          sum += element_weights[t * n + e] * from[t * stride + r];
+        }
+        out[r * n + e] = to_uint8(sum);
+      }
+    }
+  }
+}
+#endif
+
 }  // namespace
 
 AreaResize::Axis AreaResize::axis(int source, int target) {
@@ -132,8 +261,15 @@ AreaResize::Axis AreaResize::axis(int source, int target) {
   return axis;
 }
 
-AreaResize::AreaResize(int source_height, int source_width, int height, int width, int channels)
+AreaResize::AreaResize(int source_height, int source_width, int height, int width, int channels,
+                       bool allow_avx2)
     : source_width_(source_width), height_(height), width_(width), channels_(channels) {
+#if defined(PIXELGYM_AREA_RESIZE_AVX2)
+  __builtin_cpu_init();  // needed where this runs before main (a static AreaResize)
+  use_avx2_ = allow_avx2 && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+#else
+  (void)allow_avx2;
+#endif
   if (height < 1 || width < 1 || height > source_height || width > source_width || channels < 1) {
     throw std::invalid_argument("AreaResize: expected a shrink to at least 1x1, got " +
                                 std::to_string(source_height) + "x" + std::to_string(source_width) +
@@ -156,6 +292,11 @@ AreaResize::AreaResize(int source_height, int source_width, int height, int widt
       }
     }
   }
+  if (use_avx2_) {
+    block_.resize(static_cast<std::size_t>(source_width) * static_cast<std::size_t>(channels) * 8);
+
+    return;
+  }
   // One float of padding: the 4-lane load of a 3-channel row's last pixel reads one past it.
   blended_.resize(static_cast<std::size_t>(height) * static_cast<std::size_t>(source_width) *
                       static_cast<std::size_t>(channels) +
@@ -164,6 +305,19 @@ AreaResize::AreaResize(int source_height, int source_width, int height, int widt
 
 void AreaResize::operator()(const std::uint8_t* source, std::uint8_t* target) {
   const std::size_t row = static_cast<std::size_t>(source_width_) * channels_;
+#if defined(PIXELGYM_AREA_RESIZE_AVX2)
+  if (use_avx2_) {
+    const auto kernel = rows_.taps == 3 && columns_.taps == 3   ? &area_resize_avx2<3, 3>
+                        : rows_.taps == 2 && columns_.taps == 2 ? &area_resize_avx2<2, 2>
+                        : rows_.taps == 3 && columns_.taps == 2 ? &area_resize_avx2<3, 2>
+                        : rows_.taps == 2 && columns_.taps == 3 ? &area_resize_avx2<2, 3>
+                                                                : &area_resize_avx2<0, 0>;
+    kernel(source, target, row, height_, static_cast<std::size_t>(width_) * channels_,
+           AxisView{rows_.taps, rows_.first.data(), rows_.weights.data()}, element_first_.data(),
+           element_weights_.data(), columns_.taps, channels_, block_.data());
+    return;
+  }
+#endif
   // Rows first: each output row is a weighted sum of `taps` consecutive source rows.
   for (int y = 0; y < height_; ++y) {
     float* __restrict out = blended_.data() + static_cast<std::size_t>(y) * row;

@@ -21,14 +21,14 @@ struct Comparison {
 };
 
 Comparison compare_with_opencv(int source_height, int source_width, int height, int width,
-                               int channels, unsigned seed) {
+                               int channels, unsigned seed, bool allow_avx2) {
   cv::Mat source(source_height, source_width, CV_8UC(channels));
   cv::theRNG().state = seed;
   cv::randu(source, 0, 256);
   cv::Mat expected;
   cv::resize(source, expected, cv::Size(width, height), 0, 0, cv::INTER_AREA);
   std::vector<std::uint8_t> actual(static_cast<std::size_t>(height * width * channels));
-  AreaResize resize(source_height, source_width, height, width, channels);
+  AreaResize resize(source_height, source_width, height, width, channels, allow_avx2);
   resize(source.data, actual.data());
   Comparison result;
   result.elements = static_cast<long>(actual.size());
@@ -40,7 +40,14 @@ Comparison compare_with_opencv(int source_height, int source_width, int height, 
   return result;
 }
 
-TEST(AreaResizeTest, MatchesOpenCvWithinOneLevelOnRareElements) {
+// Both kernels: the portable one, and AVX2 + FMA where this CPU has them.
+class AreaResizeKernelTest : public ::testing::TestWithParam<bool> {};
+
+TEST_P(AreaResizeKernelTest, MatchesOpenCvWithinOneLevelOnRareElements) {
+  const bool allow_avx2 = GetParam();
+  if (allow_avx2 && !AreaResize(2, 2, 1, 1, 1).uses_avx2()) {
+    GTEST_SKIP() << "this CPU has no AVX2 + FMA: the portable kernel is the one that runs";
+  }
   long differing = 0;
   long elements = 0;
   const std::vector<std::vector<int>> sizes = {
@@ -49,18 +56,23 @@ TEST(AreaResizeTest, MatchesOpenCvWithinOneLevelOnRareElements) {
       {48, 64, 20, 28}, {7, 5, 3, 2},     {84, 84, 84, 50},  {100, 3, 99, 3}};
   for (const auto& size : sizes) {
     for (int channels : {1, 3, 4}) {
-      const Comparison c =
-          compare_with_opencv(size[0], size[1], size[2], size[3], channels, 7u + channels);
+      const Comparison c = compare_with_opencv(size[0], size[1], size[2], size[3], channels,
+                                               7u + channels, allow_avx2);
       EXPECT_LE(c.max_difference, 1)
           << size[0] << "x" << size[1] << " -> " << size[2] << "x" << size[3] << " x" << channels;
       differing += c.differing;
       elements += c.elements;
     }
   }
-  std::printf("AreaResize vs cv::resize INTER_AREA: %ld of %ld elements one level apart\n",
-              differing, elements);
+  std::printf("AreaResize (%s) vs cv::resize INTER_AREA: %ld of %ld elements one level apart\n",
+              allow_avx2 ? "AVX2" : "portable", differing, elements);
   EXPECT_LT(differing, elements / 100);  // rare: float sums in another order
 }
+
+INSTANTIATE_TEST_SUITE_P(Kernels, AreaResizeKernelTest, ::testing::Values(false, true),
+                         [](const ::testing::TestParamInfo<bool>& kernel) {
+                           return kernel.param ? "Avx2" : "Portable";
+                         });
 
 TEST(AreaResizeTest, KeepsAFlatImageFlat) {
   cv::Mat source(84, 84, CV_8UC3, cv::Scalar(10, 128, 255));
