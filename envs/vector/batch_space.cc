@@ -94,6 +94,15 @@ Value batch_slot(const Value& batch, std::int64_t i) {
   return batch.array().index(i);
 }
 
+namespace {
+
+// The memory of an array inside a const Value: the elements of a view are not const (the Value is
+// const only because Tuple items are reachable through const accessors alone). Copying the
+// Array handle instead would allocate (its shape is a std::vector).
+void* writable_data(const Array& array) { return const_cast<void*>(array.raw_data()); }
+
+}  // namespace
+
 void copy_value(const Value& source, const Value& destination) {
   if (source.is_dict() && destination.is_dict()) {
     const ValueDict& from = source.dict();
@@ -116,8 +125,13 @@ void copy_value(const Value& source, const Value& destination) {
     return;
   }
   if (source.is_array() && destination.is_array()) {
-    Array target = destination.array();  // a view of the same memory
-    target.copy_from(source.array());
+    const Array& from = source.array();
+    const Array& to = destination.array();
+    if (from.dtype() != to.dtype() || from.shape() != to.shape()) {
+      throw std::invalid_argument("copy_value: cannot copy " + from.to_string() + " into " +
+                                  to.to_string());
+    }
+    if (to.nbytes() > 0) std::memmove(writable_data(to), from.raw_data(), to.nbytes());
     return;
   }
   throw std::invalid_argument(std::string("copy_value: cannot copy a ") + source.kind() +
@@ -129,9 +143,8 @@ void zero_value(const Value& value) {
     for (const Value& entry : value.dict().values()) zero_value(entry);
   } else if (value.is_tuple()) {
     for (const Value& item : value.tuple().items()) zero_value(item);
-  } else {
-    Array target = value.array();
-    std::memset(target.raw_data(), 0, target.nbytes());
+  } else if (value.array().nbytes() > 0) {
+    std::memset(writable_data(value.array()), 0, value.array().nbytes());
   }
 }
 
