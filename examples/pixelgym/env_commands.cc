@@ -13,6 +13,8 @@
 #include "envs/spaces/box.h"
 #include "envs/spaces/dict.h"
 #include "envs/spaces/discrete.h"
+#include "envs/vector/async_vector_env.h"
+#include "envs/vector/make_vec.h"
 #include "examples/pixelgym/cli.h"
 #include "testing/snapshot.h"
 #include "wrappers/wrapper_spec.h"
@@ -423,11 +425,52 @@ struct BenchArguments {
   std::string id;
   std::uint64_t seed = 0;
   int steps = 2000;
+  int num_envs = 0;  // 0: one Env in a loop; else a vector env
+  int threads = 0;   // with num_envs: 0 for SyncVectorEnv, else AsyncVectorEnv's worker threads
   std::vector<std::string> sets;
   std::vector<std::string> wraps;
 };
 
+// `num_envs` envs in a vector env, stepped with seeded random actions (a pool of batches drawn
+// before timing) until `steps` env steps are done; autoreset NextStep.
+int run_vector_bench(const BenchArguments& args) {
+  const vector::VectorOptions options{
+      args.threads == 0 ? vector::VectorMode::kSync : vector::VectorMode::kAsync, args.threads,
+      vector::AutoresetMode::kNextStep};
+  const std::unique_ptr<vector::VectorEnv> env =
+      vector::make_vec(args.id, args.num_envs, parse_sets(args.id, args.sets), args.wraps, options);
+  Rng rng(args.seed);
+  std::vector<Value> actions;
+  for (int k = 0; k < 64; ++k) actions.push_back(env->action_space().sample(rng));
+  env->reset(args.seed);
+  for (int t = 0; t < 20; ++t) env->step(actions[static_cast<std::size_t>(t) % actions.size()]);
+  const int batches = (args.steps + args.num_envs - 1) / args.num_envs;
+  std::int64_t resets = 0;
+  const auto start = std::chrono::steady_clock::now();
+  for (int t = 0; t < batches; ++t) {
+    const vector::VectorStepResult& result =
+        env->step(actions[static_cast<std::size_t>(t) % actions.size()]);
+    for (int i = 0; i < args.num_envs; ++i) {
+      resets += result.terminated.data<bool>()[i] || result.truncated.data<bool>()[i] ? 1 : 0;
+    }
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const std::int64_t env_steps = static_cast<std::int64_t>(batches) * args.num_envs;
+  const int threads =
+      args.threads == 0 ? 1 : dynamic_cast<const vector::AsyncVectorEnv&>(*env).num_threads();
+  std::cout << args.id << ": " << env_steps << " env steps (" << batches << " batches of "
+            << args.num_envs << " envs, " << resets << " resets) in " << seconds << " s, "
+            << (args.threads == 0 ? std::string("SyncVectorEnv, one thread")
+                                  : "AsyncVectorEnv, " + std::to_string(threads) + " threads")
+            << "\n";
+  std::cout << "steps_per_s=" << static_cast<long>(std::lround(env_steps / seconds)) << "\n";
+  env->close();
+  return 0;
+}
+
 int run_bench(const BenchArguments& args) {
+  if (args.num_envs > 0) return run_vector_bench(args);
   std::unique_ptr<Env> env = make_env(args.id, args.sets, args.wraps);
   RandomRollout random(*env, args.seed);
   // Warm up (shader compilation, caches) outside the timed loop.
@@ -455,6 +498,17 @@ Command add_bench(CLI::App& app) {
       ->capture_default_str()
       ->check(integer_in(1));
   add_seed_option(*bench, args->seed, "Seed for the reset and the random actions");
+  bench
+      ->add_option("--num-envs", args->num_envs,
+                   "Step N envs as one vector env (make_vec) and count steps_per_s= over all of "
+                   "them; --steps is then the total of env steps")
+      ->check(integer_in(1));
+  bench
+      ->add_option("--threads", args->threads,
+                   "With --num-envs: 0 for SyncVectorEnv (a loop on this thread), T for an "
+                   "AsyncVectorEnv of T worker threads (clamped to N)")
+      ->capture_default_str()
+      ->check(integer_in(0));
   add_set_option(*bench, args->sets);
   add_wrap_option(*bench, args->wraps);
   return {bench, [args] { return run_bench(*args); }};
