@@ -2,6 +2,8 @@
 # (Release, in build/), then run.
 #   make demo   the main job
 #   make test   every test, through ctest (FormatCheck among them: see format-check)
+#   make test-tsan   the tests labelled threads, built with ThreadSanitizer in build-tsan/ (not in
+#                    `make test`: about 4 minutes from scratch, 40-70 s with ccache)
 #   make format-check   the project's C++ files against .clang-format (clang-format 14); exits 1
 #                       naming the files that differ. `make format` rewrites them.
 BUILD_DIR ?= build
@@ -9,7 +11,7 @@ BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 PIXELGYM := $(BUILD_DIR)/examples/pixelgym
 
-.PHONY: all deps configure build demo test format-check format goldens bench clean
+.PHONY: all deps configure build demo test test-tsan format-check format goldens bench clean
 
 all: build
 
@@ -29,6 +31,18 @@ demo: build
 
 test: build
 	ctest --test-dir $(BUILD_DIR) --output-on-failure --parallel $(JOBS)
+
+# ThreadSanitizer over the threading tests (ctest label threads; a test joins with
+# `pixelgym_add_test(... LABELS threads)`). Only the tests labelled threads are built. tsan.supp
+# names the third-party libraries whose reports are suppressed, each with its reason, and why
+# detect_deadlocks=0 (llvmpipe's LLVM JIT overflows TSan's lock table).
+TSAN_BUILD_DIR ?= build-tsan
+test-tsan: deps
+	cmake -S . -B $(TSAN_BUILD_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPIXELGYM_SANITIZE=thread \
+	  -DPIXELGYM_BUILD_BENCH=OFF
+	cmake --build $(TSAN_BUILD_DIR) --parallel $(JOBS) --target threads_tests
+	TSAN_OPTIONS="suppressions=$(CURDIR)/tsan.supp halt_on_error=1 detect_deadlocks=0 $(TSAN_OPTIONS)" \
+	  ctest --test-dir $(TSAN_BUILD_DIR) -L threads --output-on-failure --parallel $(JOBS)
 
 # CI runs `make test`, which runs this same check as the ctest test FormatCheck
 # (tests/examples/CMakeLists.txt): it then shows in ctest's summary beside the other tests, and a

@@ -27,9 +27,11 @@ endfunction()
 # pixelgym_add_test(SOURCE LIBS ...): one GoogleTest executable per test file, named after its
 # path under tests/ (tests/envs/array_test.cc -> envs_array_test), its tests registered with
 # ctest by gtest_discover_tests at test time. Tests run in the build tree with
-# PIXELGYM_TEST_OUTPUT_DIR naming where they may write files a person should look at.
+# PIXELGYM_TEST_OUTPUT_DIR naming where they may write files a person should look at. LABELS
+# gives every test of the file those ctest labels (`threads`: built by the target threads_tests
+# and run under ThreadSanitizer by `make test-tsan`).
 function(pixelgym_add_test source)
-  cmake_parse_arguments(ARG "" "" "LIBS" ${ARGN})
+  cmake_parse_arguments(ARG "" "" "LIBS;LABELS" ${ARGN})
   file(RELATIVE_PATH relative ${PROJECT_SOURCE_DIR}/tests ${CMAKE_CURRENT_SOURCE_DIR}/${source})
   string(REGEX REPLACE "\\.cc$" "" target ${relative})
   string(REPLACE "/" "_" target ${target})
@@ -39,6 +41,13 @@ function(pixelgym_add_test source)
     PIXELGYM_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     PIXELGYM_TEST_OUTPUT_DIR="${PROJECT_BINARY_DIR}/test_output")
   pixelgym_set_warnings(${target})
+  set(properties "")
+  if("threads" IN_LIST ARG_LABELS)
+    add_dependencies(threads_tests ${target})
+  endif()
+  if(ARG_LABELS)
+    set(properties PROPERTIES LABELS "${ARG_LABELS}")
+  endif()
   gtest_discover_tests(${target} DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60
-                       WORKING_DIRECTORY ${PROJECT_BINARY_DIR})
+                       WORKING_DIRECTORY ${PROJECT_BINARY_DIR} ${properties})
 endfunction()

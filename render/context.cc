@@ -56,14 +56,29 @@ Context::~Context() {
 }
 
 void Context::make_current() {
-  if (OSMesaGetCurrentContext() == impl_->context) return;
+  if (is_current()) return;
   if (!OSMesaMakeCurrent(impl_->context, impl_->dummy.data(), GL_UNSIGNED_BYTE, 1, 1)) {
     throw std::runtime_error("Context: OSMesaMakeCurrent failed");
   }
 }
 
+void Context::release() {
+  // OSMesa's way to unbind: no context and no buffer.
+  if (is_current()) OSMesaMakeCurrent(nullptr, nullptr, 0, 0, 0);
+}
+
+bool Context::is_current() const { return OSMesaGetCurrentContext() == impl_->context; }
+
+Context::Scope::Scope(Context& context) : context_(context), was_current_(context.is_current()) {
+  context_.make_current();
+}
+
+Context::Scope::~Scope() {
+  if (!was_current_) context_.release();
+}
+
 std::string Context::description() {
-  make_current();
+  const Scope scope(*this);
   const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
   const auto* version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
   return std::string(renderer != nullptr ? renderer : "?") + ", " +
@@ -71,7 +86,7 @@ std::string Context::description() {
 }
 
 int Context::max_samples() {
-  make_current();
+  const Scope scope(*this);
   GLint samples = 0;
   glGetIntegerv(GL_MAX_SAMPLES, &samples);
   return samples;

@@ -16,6 +16,13 @@ enum class GlBackend {
 /// thread at a time (any thread, one after the other); contexts in different threads are
 /// independent.
 ///
+/// Threads: a thread that made a context current keeps it bound until it calls `release()` (or
+/// binds another). While bound there, no other thread may use or destroy it: Mesa flushes the
+/// old context of a thread that binds another, and reads it, freed or not, on the next
+/// `make_current` of that thread (a crash when another thread destroyed it). So a thread that is
+/// done with a context for now releases it, as `Scope` does; Renderer binds its context only
+/// for the length of each call.
+///
 /// llvmpipe threads: Mesa's software rasterizer starts LP_NUM_THREADS worker threads per context
 /// (by default one per core). For the small images of pixel observations they cost more than they
 /// give (measured in bench/render_bench), so the first context pixelgym creates in a process sets
@@ -23,15 +30,35 @@ enum class GlBackend {
 /// before the first render to override this.
 class Context {
  public:
-  /// Creates a context. Throws std::runtime_error naming the backend and Mesa's reason when it
-  /// cannot be created.
+  /// Creates a context, current on the calling thread. Throws std::runtime_error naming the backend
+  /// and Mesa's reason when it cannot be created.
   explicit Context(GlBackend backend = GlBackend::kOSMesa);
+  /// Destroys the context, on any thread, provided no other thread has it current.
   ~Context();
   Context(const Context&) = delete;
   Context& operator=(const Context&) = delete;
 
   /// Makes this context current on the calling thread (cheap when it already is).
   void make_current();
+  /// Unbinds this context from the calling thread if it is current there; does nothing
+  /// otherwise.
+  void release();
+
+  /// Binds `context` on this thread for the scope's life and then releases it, unless it was
+  /// already current here when the scope began (then it stays bound).
+  class Scope {
+   public:
+    explicit Scope(Context& context);
+    ~Scope();
+    Scope(const Scope&) = delete;
+    Scope& operator=(const Scope&) = delete;
+
+   private:
+    Context& context_;
+    bool was_current_;
+  };
+  /// True when this context is current on the calling thread.
+  bool is_current() const;
   GlBackend backend() const { return backend_; }
   /// GL_RENDERER and GL_VERSION, e.g. "llvmpipe (LLVM 15.0.6, 256 bits), 4.5 (Core Profile)
   /// Mesa 22.3.6".

@@ -84,6 +84,7 @@ struct Renderer::Impl {
 
   // The GL objects below are deleted by their owners, after this (the context is declared first,
   // so it goes last).
+  // Destroying the context while it is current here unbinds it from this thread.
   ~Impl() { context.make_current(); }
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
@@ -198,7 +199,8 @@ struct Renderer::Impl {
   void render(const Scene& scene, const Camera& camera, const RenderTargets& out) {
     camera.validate();
     check_sizes(camera, out);
-    context.make_current();
+    // Bound for this call only: the next call may come from another thread (see Context).
+    const Context::Scope current(context);
     if (camera.msaa_samples > max_samples) {
       throw std::invalid_argument("Renderer: msaa_samples " + std::to_string(camera.msaa_samples) +
                                   " is more than this OpenGL offers: at most " +
@@ -348,7 +350,9 @@ struct Renderer::Impl {
   std::vector<std::uint8_t> readback;  // RGBA, packed into RGB
 };
 
-Renderer::Renderer(GlBackend backend) : impl_(std::make_unique<Impl>(backend)) {}
+Renderer::Renderer(GlBackend backend) : impl_(std::make_unique<Impl>(backend)) {
+  impl_->context.release();  // current since its creation; see render()
+}
 
 Renderer::~Renderer() = default;
 

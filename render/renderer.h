@@ -31,9 +31,10 @@ struct RenderTargets {
 /// use and kept for later frames (keyed by MeshData address, kept alive by the renderer, and by
 /// texture path).
 ///
-/// Threading: a Renderer is used by one thread at a time; different renderers can draw
-/// concurrently in different threads. The same scene and camera give identical bytes on one
-/// machine and one Mesa build.
+/// Threading: a Renderer is used by one thread at a time, any thread, one after the other (made,
+/// drawn and destroyed on different threads if need be: its context is bound only during each
+/// call, see Context); different renderers can draw concurrently in different threads. The same
+/// scene and camera give identical bytes on one machine and one Mesa build.
 class Renderer {
  public:
   /// Throws std::runtime_error when the GL context cannot be created or the shaders do not build.
