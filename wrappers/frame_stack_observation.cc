@@ -125,6 +125,21 @@ FrameStackObservation::FrameStackObservation(std::unique_ptr<Env> env, std::int6
   observation_space_ = replace_image(inner, image_, uint8_image_space(stacked_shape_));
 }
 
+namespace {
+
+// After use_count() == 1 is seen: orders the releases of the last views (their reads, on any
+// thread) before this wrapper's writes. ThreadSanitizer does not model fences (GCC refuses them
+// under -fsanitize=thread), so a TSan build goes without; shared_ptr's own count is atomic.
+inline void acquire_after_last_release() {
+#if defined(__SANITIZE_THREAD__)
+  // Nothing: see above.
+#else
+  std::atomic_thread_fence(std::memory_order_acquire);
+#endif
+}
+
+}  // namespace
+
 std::byte* FrameStackObservation::slot(std::int64_t index) const {
   return static_cast<std::byte*>(tape_.get()) + static_cast<std::size_t>(index) * frame_bytes_;
 }
@@ -134,7 +149,7 @@ void FrameStackObservation::switch_tape(std::int64_t carry) {
   // use_count() == 1: no observation views this tape, and none can appear but through this
   // wrapper. The fence orders the releases of the last views (their reads) before our writes.
   if (tape_ != nullptr && tape_.use_count() == 1) {
-    std::atomic_thread_fence(std::memory_order_acquire);
+    acquire_after_last_release();
     if (carry_bytes > 0) std::memmove(slot(0), slot(next_ - carry), carry_bytes);
   } else {
     std::shared_ptr<void> old = std::move(tape_);
@@ -144,7 +159,7 @@ void FrameStackObservation::switch_tape(std::int64_t carry) {
                                 : nullptr;
     if (spare_ != nullptr && spare_.use_count() == 1) {
       // The tape before the last one, which nobody views any more: no allocation.
-      std::atomic_thread_fence(std::memory_order_acquire);
+      acquire_after_last_release();
       tape_ = std::move(spare_);
     } else {
       void* memory = std::malloc(static_cast<std::size_t>(tape_slots_) * frame_bytes_);
