@@ -3,7 +3,7 @@
 #   make demo   the main job
 #   make test   every test, through ctest (FormatCheck among them: see format-check)
 #   make test-tsan   the tests labelled threads, built with ThreadSanitizer in build-tsan/ (not in
-#                    `make test`: about 4 minutes from scratch, 40-70 s with ccache)
+#                    `make test`: about 4 minutes of tests, plus the build)
 #   make format-check   the project's C++ files against .clang-format (clang-format 14); exits 1
 #                       naming the files that differ. `make format` rewrites them.
 BUILD_DIR ?= build
