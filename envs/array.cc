@@ -1,8 +1,10 @@
 #include "envs/array.h"
 
 #include <cstring>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 
 namespace pixelgym {
 
@@ -44,6 +46,24 @@ bool is_integer(DType dtype) {
 }
 
 bool is_floating(DType dtype) { return dtype == DType::kFloat32 || dtype == DType::kFloat64; }
+
+DTypeRange integer_range(DType dtype) {
+  switch (dtype) {
+    case DType::kBool:
+      return {0.0, 1.0};
+    case DType::kUInt8:
+      return {0.0, 255.0};
+    case DType::kInt32:
+      return {static_cast<double>(std::numeric_limits<std::int32_t>::min()),
+              static_cast<double>(std::numeric_limits<std::int32_t>::max())};
+    case DType::kInt64:
+      return {static_cast<double>(std::numeric_limits<std::int64_t>::min()),
+              static_cast<double>(std::numeric_limits<std::int64_t>::max())};
+    default:
+      throw std::invalid_argument(std::string("integer_range: ") + dtype_name(dtype) +
+                                  " is not an integer dtype");
+  }
+}
 
 std::string shape_to_string(const Shape& shape) {
   std::string text = "(";

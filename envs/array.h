@@ -23,6 +23,15 @@ bool is_integer(DType dtype);
 /// True for kFloat32 and kFloat64.
 bool is_floating(DType dtype);
 
+/// The values a dtype can hold, as doubles (int64's ends rounded to the nearest double).
+struct DTypeRange {
+  double low;
+  double high;
+};
+/// The range of an integer dtype (kUInt8, kInt32, kInt64); kBool gives [0, 1]. Throws
+/// std::invalid_argument for a floating dtype.
+DTypeRange integer_range(DType dtype);
+
 /// The DType that stores C++ type T; a compile error for any other type.
 template <typename T>
 constexpr DType dtype_of() {

@@ -38,24 +38,6 @@ void ObservationWrapper::set_observation_space(SpacePtr space) {
   observation_space_ = std::move(space);
 }
 
-namespace {
-
-// Swaps `a` and `b` now and again when it goes out of scope, even by an exception: the inner env
-// writes into this wrapper's buffer through the caller's result, which gets its own buffer back.
-class SwapBack {
- public:
-  SwapBack(Value& a, Value& b) : a_(a), b_(b) { a_.swap(b_); }
-  ~SwapBack() { a_.swap(b_); }
-  SwapBack(const SwapBack&) = delete;
-  SwapBack& operator=(const SwapBack&) = delete;
-
- private:
-  Value& a_;
-  Value& b_;
-};
-
-}  // namespace
-
 void ObservationWrapper::do_reset(std::optional<std::uint64_t> seed, const Options& options,
                                   ResetResult& out) {
   if (!inner_obs_) inner_obs_ = env_->observation_space().zeros();

@@ -50,6 +50,22 @@ class Wrapper : public Env {
   std::unique_ptr<Env> env_;
 };
 
+/// Swaps two Values now and back when it goes out of scope, even by an exception: how a wrapper
+/// lets the inner env write into a buffer of the wrapper's own through the caller's result (the
+/// caller's `out.obs` is swapped with the wrapper's buffer around the inner call), so that the
+/// caller gets its own buffer back whatever happens. Allocates nothing.
+class SwapBack {
+ public:
+  SwapBack(Value& a, Value& b) : a_(a), b_(b) { a_.swap(b_); }
+  ~SwapBack() { a_.swap(b_); }
+  SwapBack(const SwapBack&) = delete;
+  SwapBack& operator=(const SwapBack&) = delete;
+
+ private:
+  Value& a_;
+  Value& b_;
+};
+
 /// A wrapper that transforms observations. Subclasses implement `observation()` and, when it
 /// changes the space, call `set_observation_space()` from their constructor.
 ///

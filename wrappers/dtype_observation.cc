@@ -12,24 +12,6 @@
 namespace pixelgym::wrappers {
 namespace {
 
-struct Range {
-  double low;
-  double high;
-};
-
-Range integer_range(DType dtype) {
-  switch (dtype) {
-    case DType::kUInt8:
-      return {0.0, 255.0};
-    case DType::kInt32:
-      return {static_cast<double>(std::numeric_limits<std::int32_t>::min()),
-              static_cast<double>(std::numeric_limits<std::int32_t>::max())};
-    default:
-      return {static_cast<double>(std::numeric_limits<std::int64_t>::min()),
-              static_cast<double>(std::numeric_limits<std::int64_t>::max())};
-  }
-}
-
 std::string format(double value) {
   std::ostringstream text;
   text << value;
@@ -103,8 +85,9 @@ DtypeObservation::DtypeObservation(std::unique_ptr<Env> env, DType dtype, const 
   std::vector<double> low = box.low();
   std::vector<double> high = box.high();
   if (is_integer(dtype)) {
-    const Range target = integer_range(dtype);
-    const Range own = is_integer(source) ? integer_range(source) : Range{-HUGE_VAL, HUGE_VAL};
+    const DTypeRange target = integer_range(dtype);
+    const DTypeRange own =
+        is_integer(source) ? integer_range(source) : DTypeRange{-HUGE_VAL, HUGE_VAL};
     const auto bound = [&](double value, bool is_low, std::size_t i) {
       // Unbounded on this side: the target's limit.
       if (is_low ? value <= own.low : value >= own.high) return is_low ? target.low : target.high;

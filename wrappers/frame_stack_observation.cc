@@ -23,20 +23,6 @@ bool is_tape_view(const Array& array) {
   return array.storage() != nullptr && std::get_deleter<TapeDeleter>(array.storage()) != nullptr;
 }
 
-// Swaps `a` and `b` now and back when it goes out of scope, even by an exception: the inner env
-// writes into this wrapper's buffer through the caller's result, which gets its own buffer back.
-class SwapBack {
- public:
-  SwapBack(Value& a, Value& b) : a_(a), b_(b) { a_.swap(b_); }
-  ~SwapBack() { a_.swap(b_); }
-  SwapBack(const SwapBack&) = delete;
-  SwapBack& operator=(const SwapBack&) = delete;
-
- private:
-  Value& a_;
-  Value& b_;
-};
-
 std::string describe_key(const ImageKey& image) {
   return image.in_dict ? "key \"" + image.key + "\"" : "the observation";
 }

@@ -9,24 +9,6 @@
 namespace pixelgym::spaces {
 namespace {
 
-struct Range {
-  double low;
-  double high;
-};
-
-Range integer_range(DType dtype) {
-  switch (dtype) {
-    case DType::kUInt8:
-      return {0.0, 255.0};
-    case DType::kInt32:
-      return {static_cast<double>(std::numeric_limits<std::int32_t>::min()),
-              static_cast<double>(std::numeric_limits<std::int32_t>::max())};
-    default:
-      return {static_cast<double>(std::numeric_limits<std::int64_t>::min()),
-              static_cast<double>(std::numeric_limits<std::int64_t>::max())};
-  }
-}
-
 std::string format_bound(double bound) {
   std::ostringstream out;
   if (std::isinf(bound)) return bound > 0 ? "inf" : "-inf";
@@ -102,7 +84,7 @@ Box::Box(std::vector<double> low, std::vector<double> high, Shape shape, DType d
       throw std::invalid_argument(where + ": bound " + std::to_string(i) + " is NaN");
     }
     if (is_integer(dtype_)) {
-      const Range range = integer_range(dtype_);
+      const DTypeRange range = integer_range(dtype_);
       low_[i] = std::max(low_[i], range.low);
       high_[i] = std::min(high_[i], range.high);
       if (low_[i] != std::floor(low_[i]) || high_[i] != std::floor(high_[i]) ||

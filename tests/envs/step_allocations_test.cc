@@ -16,8 +16,8 @@
 
 #include "envs/pixel_env.h"
 #include "envs/registry.h"
-#include "tests/alloc_counter.h"
 #include "tests/envs/env_ids.h"
+#include "tests/envs/step_allocation_counter.h"
 
 namespace pixelgym {
 namespace {
@@ -25,30 +25,7 @@ namespace {
 using testing::AllocCounts;
 using testing::AllocOwner;
 using testing::count_allocations;
-
-// Steps `env` through the buffer path for `steps` steps with pre-drawn actions, resetting (into
-// the same buffer) when an episode ends, and returns the allocations counted during the steps.
-AllocCounts count_step_allocations(Env& env, int warmup_steps, int steps) {
-  ResetResult reset;
-  reset.obs = env.observation_space().zeros();
-  env.reset_into(reset, /*seed=*/0);
-  StepResult step;
-  step.obs = env.observation_space().zeros();
-  Rng rng(1);
-  std::vector<Value> actions;
-  for (int i = 0; i < warmup_steps + steps; ++i) actions.push_back(env.action_space().sample(rng));
-  AllocCounts counts;
-  for (int i = 0; i < warmup_steps + steps; ++i) {
-    const Value& action = actions[static_cast<std::size_t>(i)];
-    if (i >= warmup_steps) {
-      counts += count_allocations([&] { env.step_into(action, step); });
-    } else {
-      env.step_into(action, step);
-    }
-    if (step.terminated || step.truncated) env.reset_into(reset);  // not counted
-  }
-  return counts;
-}
+using testing::count_step_allocations;
 
 TEST(StepAllocationsTest, TheCounterSeesAllocations) {
   // Guards the test itself: a counter that sees nothing would make every test below pass.

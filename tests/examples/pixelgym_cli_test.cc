@@ -21,6 +21,7 @@
 #include "envs/world_scene.h"
 #include "render/image_io.h"
 #include "render/renderer.h"
+#include "tests/examples/cli_run.h"
 #include "wrappers/wrapper_spec.h"
 
 namespace pixelgym {
@@ -30,21 +31,11 @@ using ::testing::HasSubstr;
 using ::testing::Not;
 using ::testing::StartsWith;
 
-struct CliRun {
-  int exit_code;       // -1 when the process did not exit normally (a crash)
-  std::string output;  // stdout and stderr
-};
+using testing::CliRun;
 
 // Runs `pixelgym ARGUMENTS`, with `environment` ("NAME=value ...") set for it.
 CliRun run(const std::string& arguments, const std::string& environment = "") {
-  const std::string command = environment + " " + PIXELGYM_CLI + " " + arguments + " 2>&1";
-  std::FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return {-1, "popen failed"};
-  std::string output;
-  std::array<char, 4096> buffer{};
-  while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) output += buffer.data();
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+  return testing::run_cli(arguments, environment);
 }
 
 // A path under the test output folder, with no file there yet.

@@ -20,6 +20,7 @@
 
 #include "envs/registry.h"
 #include "envs/rollout.h"
+#include "tests/examples/cli_run.h"
 
 namespace pixelgym {
 namespace {
@@ -28,21 +29,9 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
-struct CliRun {
-  int exit_code;       // -1 when the process did not exit normally (a crash)
-  std::string output;  // stdout and stderr
-};
+using testing::CliRun;
 
-CliRun run(const std::string& arguments) {
-  const std::string command = std::string(PIXELGYM_CLI) + " " + arguments + " 2>&1";
-  std::FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return {-1, "popen failed"};
-  std::string output;
-  std::array<char, 4096> buffer{};
-  while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) output += buffer.data();
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
-}
+CliRun run(const std::string& arguments) { return testing::run_cli(arguments); }
 
 // A folder of the test's own under the test output folder, removed first.
 fs::path fresh_folder() {

@@ -11,6 +11,7 @@
 
 #include "envs/registry.h"
 #include "render/image_io.h"
+#include "tests/examples/cli_run.h"
 
 namespace pixelgym {
 namespace {
@@ -19,24 +20,14 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
-struct CliRun {
-  int exit_code;       // -1 when the process did not exit normally (a crash)
-  std::string output;  // stdout and stderr
-};
+using testing::CliRun;
 
 const fs::path kFolder = fs::path(PIXELGYM_TEST_OUTPUT_DIR) / "snapshot_cli";
 
 // Runs `pixelgym ARGUMENTS` with the diff images going to kFolder/out.
 CliRun run(const std::string& arguments, const std::string& environment = "") {
-  const std::string command = "PIXELGYM_SNAPSHOT_OUTPUT_DIR=" + (kFolder / "out").string() + " " +
-                              environment + " " + PIXELGYM_CLI + " " + arguments + " 2>&1";
-  std::FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return {-1, "popen failed"};
-  std::string output;
-  std::array<char, 4096> buffer{};
-  while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) output += buffer.data();
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+  return testing::run_cli(
+      arguments, "PIXELGYM_SNAPSHOT_OUTPUT_DIR=" + (kFolder / "out").string() + " " + environment);
 }
 
 // A path under this test's folder, with no file there yet.

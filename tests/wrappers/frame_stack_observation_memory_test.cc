@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "envs/registry.h"
-#include "tests/alloc_counter.h"
+#include "tests/envs/step_allocation_counter.h"
 #include "tests/wrappers/image_env.h"
 #include "wrappers/frame_stack_observation.h"
 
@@ -130,27 +130,8 @@ TEST(FrameStackMemoryTest, ACallerThatKeepsNothingUsesOneTape) {
 // operator new calls (all but OpenCV's) in `steps` step_into calls into a caller buffer after
 // `warmup` uncounted ones; resets are not counted.
 long count_step_news(Env& env, int warmup, int steps) {
-  ResetResult reset;
-  reset.obs = env.observation_space().zeros();
-  env.reset_into(reset, /*seed=*/0);
-  StepResult step;
-  step.obs = env.observation_space().zeros();
-  Rng rng(1);
-  std::vector<Value> actions;
-  for (int i = 0; i < warmup + steps; ++i) actions.push_back(env.action_space().sample(rng));
-  long news = 0;
-  for (int i = 0; i < warmup + steps; ++i) {
-    const Value& action = actions[static_cast<std::size_t>(i)];
-    if (i >= warmup) {
-      const testing::AllocCounts counts =
-          testing::count_allocations([&] { env.step_into(action, step); });
-      news += counts.news_total() - counts.news_of(testing::AllocOwner::kOpenCv);
-    } else {
-      env.step_into(action, step);
-    }
-    if (step.terminated || step.truncated) env.reset_into(reset);
-  }
-  return news;
+  const testing::AllocCounts counts = testing::count_step_allocations(env, warmup, steps);
+  return counts.news_total() - counts.news_of(testing::AllocOwner::kOpenCv);
 }
 
 TEST(FrameStackMemoryTest, StepIntoACallerBufferAllocatesNothing) {

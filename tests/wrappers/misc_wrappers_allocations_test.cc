@@ -9,7 +9,7 @@
 
 #include "envs/checker.h"
 #include "envs/registry.h"
-#include "tests/alloc_counter.h"
+#include "tests/envs/step_allocation_counter.h"
 #include "tests/wrappers/scripted_env.h"
 #include "wrappers/add_render_observation.h"
 #include "wrappers/clip_action.h"
@@ -26,24 +26,8 @@ namespace {
 // operator new calls in `steps` step_into calls after `warmup` uncounted ones; a step that ends
 // an episode is not counted (RecordEpisodeStatistics allocates its info there, by design).
 long count_step_news(Env& env, int warmup, int steps) {
-  ResetResult reset;
-  reset.obs = env.observation_space().zeros();
-  env.reset_into(reset, 0);
-  StepResult step;
-  step.obs = env.observation_space().zeros();
-  Rng rng(1);
-  std::vector<Value> actions;
-  for (int i = 0; i < warmup + steps; ++i) actions.push_back(env.action_space().sample(rng));
-  long news = 0;
-  for (int i = 0; i < warmup + steps; ++i) {
-    const Value& action = actions[static_cast<std::size_t>(i)];
-    const testing::AllocCounts counts =
-        testing::count_allocations([&] { env.step_into(action, step); });
-    const bool ended = step.terminated || step.truncated;
-    if (i >= warmup && !ended) news += counts.news_total();
-    if (ended) env.reset_into(reset);
-  }
-  return news;
+  return testing::count_step_allocations(env, warmup, steps, testing::CountedSteps::kWithinEpisodes)
+      .news_total();
 }
 
 void expect_no_allocations(Env& env, int warmup = 5, int steps = 40) {

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "envs/registry.h"
-#include "tests/alloc_counter.h"
+#include "tests/envs/step_allocation_counter.h"
 #include "tests/wrappers/image_env.h"
 #include "wrappers/channel_first_observation.h"
 #include "wrappers/grayscale_observation.h"
@@ -31,29 +31,9 @@ struct News {
 
 // operator new calls during `steps` step_into calls after `warmup_steps` uncounted ones.
 News count_step_news(Env& env, int warmup_steps, int steps) {
-  ResetResult reset;
-  reset.obs = env.observation_space().zeros();
-  env.reset_into(reset, /*seed=*/0);
-  StepResult step;
-  step.obs = env.observation_space().zeros();
-  Rng rng(1);
-  std::vector<Value> actions;
-  for (int i = 0; i < warmup_steps + steps; ++i) actions.push_back(env.action_space().sample(rng));
-  News news;
-  for (int i = 0; i < warmup_steps + steps; ++i) {
-    const Value& action = actions[static_cast<std::size_t>(i)];
-    if (i >= warmup_steps) {
-      const testing::AllocCounts counts =
-          testing::count_allocations([&] { env.step_into(action, step); });
-      const long opencv = counts.news_of(testing::AllocOwner::kOpenCv);
-      news.opencv += opencv;
-      news.pixelgym += counts.news_total() - opencv;
-    } else {
-      env.step_into(action, step);
-    }
-    if (step.terminated || step.truncated) env.reset_into(reset);  // not counted
-  }
-  return news;
+  const testing::AllocCounts counts = testing::count_step_allocations(env, warmup_steps, steps);
+  const long opencv = counts.news_of(testing::AllocOwner::kOpenCv);
+  return {counts.news_total() - opencv, opencv};
 }
 
 std::unique_ptr<Env> dict_env() {
