@@ -492,7 +492,8 @@ Command add_bench(CLI::App& app) {
   CLI::App* bench = app.add_subcommand(
       "bench",
       "Step an env with seeded random actions (resetting when done) and print steps_per_s= for "
-      "physics + render + observation, one thread (--set obs_mode=state for physics alone)");
+      "physics + render + observation, one env on this thread, or with --num-envs N a vector env "
+      "of N (--threads T workers); --set obs_mode=state for physics alone");
   add_id_argument(*bench, args->id, "CartPoleSwingup-v0");
   bench->add_option("--steps", args->steps, "Steps to time")
       ->capture_default_str()
