@@ -1,0 +1,190 @@
+// Vector-env scaling: total env steps per second of SyncVectorEnv and AsyncVectorEnv at 1, 2, 4,
+// 8 and 16 envs, each beside the single-env loop in the same run.
+//
+// For each env count the configurations are built, warmed up, and then stepped in turn, round
+// after round: the single-env loop (one Env, step_into with seeded random actions, reset when
+// done), N envs stepped one after the other in a plain loop (no vector env: what N envs cost by
+// themselves), SyncVectorEnv, and AsyncVectorEnv with 1 and 2 worker threads. Each block runs
+// for about `block_ms` of wall time. A configuration's ratio to the single-env loop is taken
+// within each round (so drift on a shared machine hits both alike) and the medians over rounds
+// are printed.
+//
+// usage: vector_bench [IDS] [rounds] [block_ms] [max_envs]
+//   IDS: comma-separated env ids (default CartPoleSwingup-v0,ArmReach-v0), 84x84 (their default)
+// Prints a table per id and, per id, the two figures the vector-env issue sets targets for:
+//   <id> two_threads_over_one_8envs=   AsyncVectorEnv(2 threads) / SyncVectorEnv at 8 envs
+//   <id> one_thread_8envs_over_loop=   SyncVectorEnv at 8 envs / the single-env loop
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "envs/registry.h"
+#include "envs/rng.h"
+#include "envs/vector/make_vec.h"
+
+namespace {
+
+using pixelgym::Env;
+using pixelgym::Rng;
+using pixelgym::Value;
+namespace vector = pixelgym::vector;
+
+double now_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  return values[values.size() / 2];
+}
+
+constexpr int kActionPool = 64;
+
+// One env stepped with a fixed pool of seeded random actions, reset (unseeded) when done.
+class LoopedEnv {
+ public:
+  LoopedEnv(const std::string& id, std::uint64_t seed) : env_(pixelgym::make(id)) {
+    Rng rng(seed);
+    for (int k = 0; k < kActionPool; ++k) actions_.push_back(env_->action_space().sample(rng));
+    reset_.obs = env_->observation_space().zeros();
+    step_.obs = env_->observation_space().zeros();
+    env_->reset_into(reset_, seed);
+  }
+  void step() {
+    env_->step_into(actions_[next_++ % actions_.size()], step_);
+    if (step_.terminated || step_.truncated) env_->reset_into(reset_);
+  }
+
+ private:
+  std::unique_ptr<Env> env_;
+  std::vector<Value> actions_;
+  std::size_t next_ = 0;
+  pixelgym::ResetResult reset_;
+  pixelgym::StepResult step_;
+};
+
+// A configuration: `batch()` advances `envs_per_batch` env steps.
+struct Config {
+  std::string name;
+  int envs_per_batch = 1;
+  std::function<void()> batch;
+  std::vector<double> steps_per_s;
+  std::vector<double> over_loop;  // steps_per_s / the single-env loop's, same round
+};
+
+// Runs `config` for about `seconds` of wall time; returns env steps per second.
+double time_block(Config& config, double seconds) {
+  const double start = now_seconds();
+  double elapsed = 0.0;
+  long batches = 0;
+  while (elapsed < seconds) {
+    for (int k = 0; k < 8; ++k) config.batch();
+    batches += 8;
+    elapsed = now_seconds() - start;
+  }
+  return static_cast<double>(batches * config.envs_per_batch) / elapsed;
+}
+
+std::vector<std::string> split(const std::string& text) {
+  std::vector<std::string> parts;
+  std::stringstream stream(text);
+  for (std::string part; std::getline(stream, part, ',');) {
+    if (!part.empty()) parts.push_back(part);
+  }
+  return parts;
+}
+
+struct Row {
+  int num_envs;
+  double loop;                 // single-env loop, steps/s
+  std::vector<double> values;  // per configuration (after the loop): steps/s
+  std::vector<double> ratios;  // per configuration: over the loop
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::vector<std::string> ids = split(argc > 1 ? argv[1] : "CartPoleSwingup-v0,ArmReach-v0");
+  const int rounds = argc > 2 ? std::atoi(argv[2]) : 7;
+  const double block = (argc > 3 ? std::atof(argv[3]) : 250.0) / 1000.0;
+  const int max_envs = argc > 4 ? std::atoi(argv[4]) : 16;
+  const char* names[] = {"plain loop", "sync", "async 1 thr", "async 2 thr"};
+  for (const std::string& id : ids) {
+    std::vector<Row> rows;
+    for (int n = 1; n <= max_envs; n *= 2) {
+      std::vector<Config> configs;
+      auto single = std::make_shared<LoopedEnv>(id, 0);
+      configs.push_back({"single-env loop", 1, [single] { single->step(); }, {}, {}});
+      auto plain = std::make_shared<std::vector<LoopedEnv>>();
+      for (int i = 0; i < n; ++i) plain->emplace_back(id, static_cast<std::uint64_t>(i));
+      configs.push_back({names[0],
+                         n,
+                         [plain] {
+                           for (LoopedEnv& env : *plain) env.step();
+                         },
+                         {},
+                         {}});
+      const vector::VectorOptions modes[] = {
+          {vector::VectorMode::kSync, 0, vector::AutoresetMode::kNextStep},
+          {vector::VectorMode::kAsync, 1, vector::AutoresetMode::kNextStep},
+          {vector::VectorMode::kAsync, 2, vector::AutoresetMode::kNextStep},
+      };
+      for (int m = 0; m < 3; ++m) {
+        std::shared_ptr<vector::VectorEnv> env = vector::make_vec(id, n, {}, {}, modes[m]);
+        auto actions = std::make_shared<std::vector<Value>>();
+        Rng rng(0);
+        for (int k = 0; k < kActionPool; ++k) actions->push_back(env->action_space().sample(rng));
+        env->reset(0);
+        auto next = std::make_shared<std::size_t>(0);
+        configs.push_back(
+            {names[m + 1],
+             n,
+             [env, actions, next] { env->step((*actions)[(*next)++ % actions->size()]); },
+             {},
+             {}});
+      }
+      for (Config& config : configs) time_block(config, 0.05);  // warm up: shaders, caches
+      for (int round = 0; round < rounds; ++round) {
+        for (Config& config : configs) config.steps_per_s.push_back(time_block(config, block));
+        for (Config& config : configs) {
+          config.over_loop.push_back(config.steps_per_s.back() / configs[0].steps_per_s.back());
+        }
+      }
+      Row row{n, median(configs[0].steps_per_s), {}, {}};
+      for (std::size_t c = 1; c < configs.size(); ++c) {
+        row.values.push_back(median(configs[c].steps_per_s));
+        row.ratios.push_back(median(configs[c].over_loop));
+      }
+      rows.push_back(row);
+      std::fprintf(stderr, "%s: %d envs done\n", id.c_str(), n);
+    }
+    std::printf(
+        "%s: total env steps/s (wall time), medians of %d rounds of %.0f ms; (x) = over the "
+        "single-env loop in the same rounds\n",
+        id.c_str(), rounds, block * 1000.0);
+    std::printf("  %8s %12s", "num_envs", "single loop");
+    for (const char* name : names) std::printf(" %20s", name);
+    std::printf("\n");
+    for (const Row& row : rows) {
+      std::printf("  %8d %12.0f", row.num_envs, row.loop);
+      for (std::size_t c = 0; c < row.values.size(); ++c) {
+        std::printf(" %12.0f (%4.2fx)", row.values[c], row.ratios[c]);
+      }
+      std::printf("\n");
+    }
+    for (const Row& row : rows) {
+      if (row.num_envs != 8) continue;
+      std::printf("%s two_threads_over_one_8envs=%.2f\n", id.c_str(),
+                  row.ratios[3] / row.ratios[1]);
+      std::printf("%s one_thread_8envs_over_loop=%.2f\n", id.c_str(), row.ratios[1]);
+    }
+    std::fflush(stdout);
+  }
+  return 0;
+}
