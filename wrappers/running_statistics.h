@@ -40,6 +40,38 @@ struct RunningStatistics {
     count = total;
   }
 
+  /// Merges a batch of `rows` samples at once, as RunningMeanStd.update(x) with x of shape
+  /// (rows, size): the batch's own mean and population variance, then the merge of Chan et al.
+  /// (delta = batch_mean - mean, total = count + rows, mean' = mean + delta * rows / total,
+  /// var' = (var * count + batch_var * rows + delta^2 * count * rows / total) / total). `sample`
+  /// is called with (row, element), rows 0 .. rows-1 and elements 0 .. size-1, several times per
+  /// entry. A batch of one row gives exactly (bit for bit) what `update` gives; a batch of n rows
+  /// what n updates give up to rounding (finite samples). No rows: nothing changes. Allocates
+  /// nothing.
+  template <typename Batch>
+  void update_batch(std::size_t rows, const Batch& sample) {
+    if (rows == 0) return;
+    const auto batch_count = static_cast<double>(rows);
+    const double total = count + batch_count;
+    for (std::size_t i = 0; i < mean.size(); ++i) {
+      double sum = 0.0;
+      for (std::size_t row = 0; row < rows; ++row) sum += sample(row, i);
+      const double batch_mean = sum / batch_count;
+      double squares = 0.0;
+      for (std::size_t row = 0; row < rows; ++row) {
+        const double deviation = sample(row, i) - batch_mean;
+        squares += deviation * deviation;
+      }
+      const double batch_var = squares / batch_count;
+      const double delta = batch_mean - mean[i];
+      mean[i] += delta * batch_count / total;
+      var[i] =
+          (var[i] * count + batch_var * batch_count + delta * delta * count * batch_count / total) /
+          total;
+    }
+    count = total;
+  }
+
   /// Why these statistics cannot stand for `size` elements ("var[3] is -1, must be >= 0"), or ""
   /// when they can: mean and var of `size` entries, every entry finite, var >= 0, count finite
   /// and > 0.
