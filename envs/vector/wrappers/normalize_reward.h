@@ -1,0 +1,70 @@
+// vector::NormalizeReward: rewards scaled by the running standard deviation of the discounted
+// returns, one set of statistics shared across the batch (gymnasium.wrappers.vector.
+// NormalizeReward).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "envs/vector/wrappers/vector_wrapper.h"
+#include "wrappers/running_statistics.h"
+
+namespace pixelgym::vector {
+
+/// Each env i keeps a discounted return R_i = gamma * R_i + r_i; every step merges the returns of
+/// the envs that stepped into one RunningStatistics of one element (Gymnasium's RunningMeanStd,
+/// from var 1 and count 1e-4), as one batch (RunningStatistics::update_batch), and then every
+/// reward r_i becomes r_i / sqrt(var + epsilon). As in Gymnasium, the mean is not subtracted.
+/// Observations, flags and infos pass through.
+///
+/// As the per-env wrappers::NormalizeReward, and on purpose unlike Gymnasium 1.x (which multiplies
+/// R_i by 1 - terminated_i of the current step and never resets it on truncation or reset):
+/// R_i goes back to 0 after a step that ends env i's episode (terminated or truncated) and when
+/// env i is reset (reset(); reset with a mask: the masked envs only), so each episode's return
+/// is its own. Under NextStep the step after env i's done is env i's reset (reward 0, no action
+/// taken): its R_i (0) is not merged, as the per-env wrapper has no step there; Gymnasium merges
+/// every row. So a batch of one env gives exactly the per-env wrapper's rewards and statistics.
+///
+/// `set_update_statistics(false)` freezes the variance (for evaluation); `statistics()` /
+/// `set_statistics()` read and write it (RunningStatistics::to_value / from_value for
+/// checkpoints). Allocates nothing per step beyond copying non-empty infos (VectorWrapper).
+class NormalizeReward final : public VectorWrapper {
+ public:
+  /// Throws std::invalid_argument unless 0 <= gamma <= 1 and epsilon is finite and > 0.
+  explicit NormalizeReward(InnerVectorEnv env, double gamma = 0.99, double epsilon = 1e-8);
+
+  double gamma() const { return gamma_; }
+  double epsilon() const { return epsilon_; }
+  /// Each env's discounted return R_i of its current episode so far (num_envs entries).
+  const std::vector<double>& discounted_returns() const { return returns_; }
+
+  /// Whether steps update the statistics (true at construction).
+  bool update_statistics() const { return update_statistics_; }
+  void set_update_statistics(bool update) { update_statistics_ = update; }
+
+  /// The running statistics of the returns (one element).
+  const wrappers::RunningStatistics& statistics() const { return statistics_; }
+  /// Replaces them (restoring a checkpoint). Throws std::invalid_argument naming the wrapper when
+  /// they are not valid statistics of one element; nothing changes then.
+  void set_statistics(wrappers::RunningStatistics statistics);
+
+ protected:
+  std::string type_name() const override { return "NormalizeReward"; }
+  const VectorResetResult& do_reset(std::optional<std::uint64_t> seed, const Options& options,
+                                    const Array* reset_mask) override;
+  const VectorStepResult& do_step(const Value& actions) override;
+
+ private:
+  double gamma_;
+  double epsilon_;
+  bool update_statistics_ = true;
+  wrappers::RunningStatistics statistics_ = wrappers::RunningStatistics::initial(1);
+  std::vector<double> returns_;
+  std::vector<std::uint8_t> ended_;  // NextStep: env i's episode ended at the last step
+  std::vector<double> merged_;       // the returns one step merges (capacity num_envs)
+  Array rewards_;                    // float64 (num_envs,): the results' rewards
+  VectorStepResult result_;
+};
+
+}  // namespace pixelgym::vector
