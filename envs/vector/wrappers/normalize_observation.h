@@ -33,7 +33,11 @@ namespace pixelgym::vector {
 ///   wrapper's own batch, laid out as observation_space(): the ended envs' rows normalized with
 ///   the same statistics as this step's observations, the others zero ("_final_obs" says which).
 ///   (Gymnasium's wrapper refuses SameStep.)
-/// A batch of one env gives exactly the per-env wrapper's observations and statistics.
+/// Under NextStep and Disabled a batch of one env gives exactly (bit for bit) the per-env
+/// wrapper's observations and statistics; under SameStep an ended env's last and reset
+/// observations are merged as one batch of two (the per-env wrapper merges them one at a time):
+/// the statistics agree up to rounding, and the last observation is normalized with statistics
+/// that already include the reset one.
 ///
 /// `set_update_statistics(false)` freezes the statistics (for evaluation); `statistics()` /
 /// `set_statistics()` read and write them (RunningStatistics::to_value / from_value give the

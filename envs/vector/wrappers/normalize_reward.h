@@ -18,13 +18,14 @@ namespace pixelgym::vector {
 /// reward r_i becomes r_i / sqrt(var + epsilon). As in Gymnasium, the mean is not subtracted.
 /// Observations, flags and infos pass through.
 ///
-/// As the per-env wrappers::NormalizeReward, and on purpose unlike Gymnasium 1.x (which multiplies
-/// R_i by 1 - terminated_i of the current step and never resets it on truncation or reset):
-/// R_i goes back to 0 after a step that ends env i's episode (terminated or truncated) and when
-/// env i is reset (reset(); reset with a mask: the masked envs only), so each episode's return
-/// is its own. Under NextStep the step after env i's done is env i's reset (reward 0, no action
-/// taken): its R_i (0) is not merged, as the per-env wrapper has no step there; Gymnasium merges
-/// every row. So a batch of one env gives exactly the per-env wrapper's rewards and statistics.
+/// As the per-env wrappers::NormalizeReward, and on purpose unlike Gymnasium (which multiplies
+/// R_i by 1 - terminated_i of the current step, so that a truncated episode's return leaks into
+/// the next one): R_i goes back to 0 after a step that ends env i's episode (terminated or
+/// truncated) and when env i is reset (reset(); reset with a mask: the masked envs only), so each
+/// episode's return is its own. Under NextStep the step after env i's done is env i's reset
+/// (reward 0, no action taken): its R_i is not merged, as the per-env wrapper has no step there
+/// (Gymnasium releases up to 1.3.0 merge every row; its development version skips these rows
+/// too). So a batch of one env gives exactly the per-env wrapper's rewards and statistics.
 ///
 /// `set_update_statistics(false)` freezes the variance (for evaluation); `statistics()` /
 /// `set_statistics()` read and write it (RunningStatistics::to_value / from_value for

@@ -23,7 +23,9 @@ namespace pixelgym::vector {
 /// The last `buffer_length` episodes are kept, oldest first, episodes that end in the same step in
 /// env order (Gymnasium's return_queue, length_queue, time_queue).
 ///
-/// Which steps count, by autoreset mode (as Gymnasium 1.2's vector wrapper):
+/// Which steps count, by autoreset mode (as Gymnasium's vector wrapper since its SameStep fix,
+/// Farama-Foundation/Gymnasium#1624, after 1.3.0; releases up to 1.3.0 count SameStep as
+/// NextStep, which drops the first step of every episode after an env's first):
 /// - NextStep: the step after the one that ended env i's episode is env i's reset (reward 0,
 ///   both flags false, its action ignored): it belongs to no episode. Env i's counters restart
 ///   there (return 0, length 0, clock restarted), and its next episode's first step is the step
