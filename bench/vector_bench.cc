@@ -3,8 +3,10 @@
 //
 // For each env count the configurations are built, warmed up, and then stepped in turn, round
 // after round: the single-env loop (one Env, step_into with seeded random actions, reset when
-// done), N envs stepped one after the other in a plain loop (no vector env: what N envs cost by
-// themselves), SyncVectorEnv, and AsyncVectorEnv with 1 and 2 worker threads. Each block runs
+// done), N envs stepped one after the other in a plain loop (no vector env, each env with a GL
+// context of its own: what N separate envs cost by themselves), SyncVectorEnv, and
+// AsyncVectorEnv with 1 and 2 threads (the vector envs share one GL context per thread, their
+// default). Each block runs
 // for about `block_ms` of wall time. A configuration's ratio to the single-env loop is taken
 // within each round (so drift on a shared machine hits both alike) and the medians over rounds
 // are printed.
@@ -114,7 +116,7 @@ int main(int argc, char** argv) {
   const int rounds = argc > 2 ? std::atoi(argv[2]) : 7;
   const double block = (argc > 3 ? std::atof(argv[3]) : 250.0) / 1000.0;
   const int max_envs = argc > 4 ? std::atoi(argv[4]) : 16;
-  const char* names[] = {"plain loop", "sync", "async 1 thr", "async 2 thr"};
+  const char* names[] = {"loop, own contexts", "sync", "async 1 thread", "async 2 threads"};
   for (const std::string& id : ids) {
     std::vector<Row> rows;
     for (int n = 1; n <= max_envs; n *= 2) {

@@ -72,19 +72,71 @@ struct Background {
   std::vector<float> key;
 };
 
+// The calling thread's SharedContext in use (SharedContext::Use).
+thread_local SharedContext* shared_in_use = nullptr;
+
+}  // namespace
+
+struct SharedContext::State {
+  explicit State(GlBackend backend) : context(backend) {}
+  Context context;  // current on the creating thread from here on, for the programs below
+  ShaderPrograms programs;
+};
+
+SharedContext::SharedContext(GlBackend backend) : backend_(backend) {}
+
+SharedContext::~SharedContext() = default;
+
+SharedContext::Use::Use(SharedContext& shared) : previous_(shared_in_use) {
+  shared_in_use = &shared;
+}
+
+SharedContext::Use::~Use() { shared_in_use = previous_; }
+
+SharedContext* SharedContext::in_use() { return shared_in_use; }
+
+std::shared_ptr<SharedContext::State> SharedContext::state() {
+  if (state_ == nullptr) {
+    state_ = std::make_shared<State>(backend_);
+  } else {
+    state_->context.make_current();
+  }
+  return state_;
+}
+
+namespace {
+
+// The context and programs a new renderer draws with, current on the calling thread: the
+// SharedContext's in use here when it is of `backend`, else new ones.
+std::shared_ptr<SharedContext::State> context_for(GlBackend backend) {
+  SharedContext* shared = SharedContext::in_use();
+  if (shared != nullptr && shared->backend() == backend) return shared->state();
+  return std::make_shared<SharedContext::State>(backend);
+}
+
+// Unbinds `context` from the calling thread when destroyed.
+struct Unbind {
+  Context& context;
+  ~Unbind() { context.release(); }
+};
+
 }  // namespace
 
 struct Renderer::Impl {
-  explicit Impl(GlBackend backend) : context(backend), floor(make_floor_mesh()) {
+  explicit Impl(GlBackend backend)
+      : gl(context_for(backend)),
+        unbind{gl->context},
+        context(gl->context),
+        programs(gl->programs),
+        floor(make_floor_mesh()) {
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     glFrontFace(GL_CW);  // the flipped projection mirrors the winding
     glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
   }
 
-  // The GL objects below are deleted by their owners, after this (the context is declared first,
-  // so it goes last).
-  // Destroying the context while it is current here unbinds it from this thread.
+  // The GL objects below are deleted by their owners, after this; then `unbind` unbinds the
+  // context and `gl` destroys it unless another renderer or its SharedContext still uses it.
   ~Impl() { context.make_current(); }
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
@@ -331,8 +383,13 @@ struct Renderer::Impl {
     read_segmentation(camera.width, camera.height, out);
   }
 
-  Context context;  // first: destroyed after every GL object below
-  ShaderPrograms programs;
+  std::shared_ptr<SharedContext::State> gl;  // first: destroyed after every GL object below
+  Unbind unbind;
+  Context& context;
+  // Shared with the other renderers of a SharedContext, as is all GL state but this renderer's
+  // own objects: every uniform and state a frame draws with is set during that frame, never
+  // left from an earlier one (tests/render/shared_context_test.cc checks).
+  ShaderPrograms& programs;
   MeshArena arena;
   TextureCache textures;
   ShadowPass shadow_pass;

@@ -1,11 +1,19 @@
 #include "envs/vector/async_vector_env.h"
 
 #include <algorithm>
+#include <chrono>
 #include <stdexcept>
 #include <string>
 
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
+
 namespace pixelgym::vector {
 namespace {
+
+// How long a thread waiting for work, or for the other threads, spins before it sleeps.
+constexpr std::chrono::microseconds kSpin{200};
 
 int clamp_threads(int num_envs, int num_threads) {
   if (num_threads < 0) {
@@ -18,16 +26,47 @@ int clamp_threads(int num_envs, int num_threads) {
   return std::max(1, std::min(num_threads, num_envs));
 }
 
+void pause() {
+#if defined(__x86_64__) || defined(__i386__)
+  _mm_pause();
+#else
+  std::this_thread::yield();
+#endif
+}
+
+// Spins until `done()` or kSpin has passed; returns done().
+template <typename Done>
+bool spin_until(const Done& done) {
+  const auto deadline = std::chrono::steady_clock::now() + kSpin;
+  for (;;) {
+    for (int k = 0; k < 64; ++k) {
+      if (done()) return true;
+      pause();
+    }
+    if (std::chrono::steady_clock::now() >= deadline) return done();
+  }
+}
+
 }  // namespace
 
+// One worker: its thread and how it is handed calls.
+struct AsyncVectorEnv::Worker {
+  std::thread thread;
+  // Bumped (under `mutex`) to hand the worker the current call.
+  std::atomic<std::uint64_t> ticket{0};
+  std::mutex mutex;
+  std::condition_variable wake;
+};
+
 AsyncVectorEnv::AsyncVectorEnv(int num_envs, const EnvFactory& make_env, int num_threads,
-                               AutoresetMode autoreset)
-    : VectorEnv("AsyncVectorEnv", num_envs, autoreset) {
+                               AutoresetMode autoreset, bool share_gl_contexts)
+    : VectorEnv("AsyncVectorEnv", num_envs, autoreset, share_gl_contexts) {
   const int threads = clamp_threads(num_envs, num_threads);
+  spin_ = threads <= static_cast<int>(std::thread::hardware_concurrency());
+  for (int w = 0; w < threads; ++w) workers_.push_back(std::make_unique<Worker>());
   try {
-    for (int w = 0; w < threads; ++w)
-      threads_.emplace_back([this, w, threads] { work(w, threads); });
-    build(make_env);
+    for (int w = 0; w < threads; ++w) workers_[w]->thread = std::thread([this, w] { work(w); });
+    build(make_env, threads);
   } catch (...) {
     stop();
     throw;
@@ -41,50 +80,73 @@ AsyncVectorEnv::~AsyncVectorEnv() {
 }
 
 void AsyncVectorEnv::stop() noexcept {
-  {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    stopping_ = true;
+  stopping_.store(true, std::memory_order_release);
+  for (auto& worker : workers_) {
+    { const std::lock_guard<std::mutex> lock(worker->mutex); }
+    worker->wake.notify_one();
   }
-  start_.notify_all();
-  for (std::thread& thread : threads_) {
-    if (thread.joinable()) thread.join();
+  for (auto& worker : workers_) {
+    if (worker->thread.joinable()) worker->thread.join();
   }
 }
 
-void AsyncVectorEnv::work(int worker, int stride) {
+void AsyncVectorEnv::work(int index) {
+  Worker& worker = *workers_[static_cast<std::size_t>(index)];
   std::uint64_t seen = 0;
+  const auto handed = [&] {
+    return stopping_.load(std::memory_order_acquire) ||
+           worker.ticket.load(std::memory_order_acquire) != seen;
+  };
   for (;;) {
-    {
-      std::unique_lock<std::mutex> lock(mutex_);
-      start_.wait(lock, [&] { return stopping_ || generation_ != seen; });
-      if (stopping_) return;
-      seen = generation_;
+    if (!(spin_ && spin_until(handed))) {
+      std::unique_lock<std::mutex> lock(worker.mutex);
+      worker.wake.wait(lock, handed);
     }
-    for (int i = worker; i < num_envs(); i += stride) run_env(i);
-    bool last = false;
-    {
-      const std::lock_guard<std::mutex> lock(mutex_);
-      last = --running_ == 0;
+    if (stopping_.load(std::memory_order_acquire)) return;
+    seen = worker.ticket.load(std::memory_order_acquire);
+    run_share(index);
+    if (running_.fetch_sub(1, std::memory_order_acq_rel) == 1) {
+      const std::lock_guard<std::mutex> lock(done_mutex_);
+      done_.notify_one();
     }
-    if (last) done_.notify_one();
   }
 }
 
-void AsyncVectorEnv::start_all() {
-  {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    running_ = static_cast<int>(threads_.size());
-    ++generation_;
+void AsyncVectorEnv::run_share(int worker) {
+  for (int i = worker; i < num_envs(); i += num_threads()) run_env(i);
+}
+
+void AsyncVectorEnv::hand(int first_worker) {
+  running_.store(num_threads() - first_worker, std::memory_order_relaxed);
+  for (int w = first_worker; w < num_threads(); ++w) {
+    Worker& worker = *workers_[static_cast<std::size_t>(w)];
+    {
+      // Under the mutex, so that a worker about to sleep either sees the new ticket or is woken.
+      const std::lock_guard<std::mutex> lock(worker.mutex);
+      worker.ticket.fetch_add(1, std::memory_order_release);
+    }
+    worker.wake.notify_one();
   }
-  start_.notify_all();
+}
+
+void AsyncVectorEnv::start_all() { hand(0); }
+
+void AsyncVectorEnv::run_all() {
+  hand(1);
+  run_share(0);
+  wait_all();
 }
 
 void AsyncVectorEnv::wait_all() {
-  std::unique_lock<std::mutex> lock(mutex_);
-  done_.wait(lock, [&] { return running_ == 0; });
+  const auto finished = [this] { return running_.load(std::memory_order_acquire) == 0; };
+  if (spin_ && spin_until(finished)) return;
+  std::unique_lock<std::mutex> lock(done_mutex_);
+  done_.wait(lock, finished);
 }
 
-void AsyncVectorEnv::step_async(const Value& actions) { begin_step(actions, "step_async()"); }
+void AsyncVectorEnv::step_async(const Value& actions) {
+  begin_step(actions, "step_async()", false);
+}
 
 const VectorStepResult& AsyncVectorEnv::step_wait() { return end_step("step_wait()"); }
 

@@ -2,8 +2,10 @@
 // (gymnasium.vector.AsyncVectorEnv, with threads instead of processes).
 #pragma once
 
+#include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <memory>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -12,63 +14,78 @@
 
 namespace pixelgym::vector {
 
-/// A VectorEnv whose envs run on `num_threads()` worker threads, results written straight into
-/// the shared batch buffers (each env into its own row, so workers never write the same bytes).
+/// A VectorEnv whose envs run on `num_threads()` threads, results written straight into the
+/// shared batch buffers (each env into its own row, so threads never write the same bytes).
 ///
-/// Pinning. Env i lives on worker i % num_threads() for its whole life: the worker builds it
-/// (calls the factory), resets, steps and closes it, and destroys it. Why: an OSMesa context is
-/// current on one thread at a time, and Mesa keeps a per-thread pointer to the current context
-/// that outlives any switch. An env that moved between threads would leave its context current
-/// on a thread it had left — a thread that, when it later made another context current, would
-/// flush the first (a use after free once that env is destroyed elsewhere, a data race while it
-/// renders on its new thread). Pinned, every context is created, made current, used and
-/// destroyed by one thread, the renderer's make_current is a no-op check, and each Bullet world
-/// stays in one core's cache. The cost is balance: with num_envs not a multiple of num_threads,
-/// some workers run one env more per step (8 envs on 3 threads: 3, 3, 2).
+/// Threads. Env i belongs to worker i % num_threads() for its whole life: that worker builds it
+/// (calls the factory), resets, steps, closes and destroys it, and its envs draw with one shared
+/// GL context (see VectorEnv: GL contexts). Worker 0's envs run on the calling thread in the calls
+/// that wait for the envs (the constructor, reset, step, close, the destructor), since the caller
+/// would otherwise sit idle: step() with T threads keeps exactly T threads busy, and with one
+/// thread it is a plain loop on the caller, as SyncVectorEnv. Only step_async hands worker 0's
+/// envs to worker thread 0, so that the caller is free until step_wait. So an env runs on one
+/// thread at a time, always the same one for workers 1..T-1, and the caller or worker thread 0
+/// (never both at once) for worker 0. That is safe because a renderer binds its GL context only
+/// for the length of each frame (render::Context: a context left bound on a thread it moved away
+/// from would be flushed, and read after it was freed, by that thread).
+///
+/// Waiting. Handing a batch to a sleeping thread and waking the caller when the last finishes
+/// costs tens of microseconds each on a VM (a futex wake is an inter-processor interrupt there),
+/// as much as a pixel step. So a worker done with a call, and the caller done with its share,
+/// first spin (pausing the core) for up to 200 microseconds for the next call or the other
+/// threads, and only then sleep on a condition variable. They spin only when the threads are no
+/// more than the cores (spinning threads would otherwise take cores from those still working).
+/// Between the steps of a learner that computes for longer, each worker spins 200 microseconds and
+/// then sleeps.
 ///
 /// Threads: `num_threads` 0 means min(num_envs, std::thread::hardware_concurrency()); more
 /// threads than envs are clamped to num_envs (a thread without envs would only wait), not an
-/// error. The calling thread only dispatches and batches infos; it waits while workers step.
+/// error. With num_envs not a multiple of num_threads some threads run one env more per step
+/// (8 envs on 3 threads: 3, 3, 2).
 ///
 /// Results are byte-identical to SyncVectorEnv's for the same seeds and actions, for any number
-/// of threads: envs share nothing, and infos are batched on the calling thread in index order.
+/// of threads: envs share nothing but GL contexts (and those only between envs that run one after
+/// another), and infos are batched on the calling thread in index order.
 class AsyncVectorEnv final : public VectorEnv {
  public:
-  /// Starts the workers and builds env i with `make_env(i)` on its worker (several at once:
+  /// Starts the workers and builds env i with `make_env(i)` on its thread (several at once:
   /// make_env must be thread-safe). Throws std::invalid_argument for num_envs < 1, num_threads
   /// < 0 or envs whose spaces differ, and what make_env throws, naming the env index (the envs
   /// built are destroyed and the workers stopped first).
   AsyncVectorEnv(int num_envs, const EnvFactory& make_env, int num_threads = 0,
-                 AutoresetMode autoreset = AutoresetMode::kNextStep);
-  /// Waits for a pending step, destroys the envs on their workers and stops the workers.
+                 AutoresetMode autoreset = AutoresetMode::kNextStep, bool share_gl_contexts = true);
+  /// Waits for a pending step, destroys the envs on their threads and stops the workers.
   ~AsyncVectorEnv() override;
 
   /// Validates and copies `actions` (the caller may reuse them at once), starts every env's
-  /// step and returns without waiting. Throws as step() does before any env steps, and
-  /// ResetNeeded when a step is already pending.
+  /// step on the worker threads and returns without waiting. Throws as step() does before any
+  /// env steps, and ResetNeeded when a step is already pending.
   void step_async(const Value& actions);
   /// Waits for the step begun by step_async and returns its batched results (as step()). Throws
   /// ResetNeeded without a pending step_async, and an env's error as step() does.
   const VectorStepResult& step_wait();
 
-  /// Worker threads (after clamping).
-  int num_threads() const { return static_cast<int>(threads_.size()); }
+  /// Threads that run envs, the caller's share included (after clamping).
+  int num_threads() const { return static_cast<int>(workers_.size()); }
 
  protected:
   void start_all() override;
   void wait_all() override;
+  void run_all() override;
 
  private:
-  void work(int worker, int stride);
+  struct Worker;
+  void work(int worker);
+  void hand(int first_worker);  // gives workers first_worker.. the current call
+  void run_share(int worker);   // run_env for worker's envs
   void stop() noexcept;
 
-  std::vector<std::thread> threads_;
-  std::mutex mutex_;
-  std::condition_variable start_;
+  std::vector<std::unique_ptr<Worker>> workers_;
+  bool spin_ = false;            // threads <= cores
+  std::atomic<int> running_{0};  // workers still running the current call
+  std::atomic<bool> stopping_{false};
+  std::mutex done_mutex_;
   std::condition_variable done_;
-  std::uint64_t generation_ = 0;  // bumped by start_all; each worker runs once per value
-  int running_ = 0;               // workers still running the current generation
-  bool stopping_ = false;
 };
 
 }  // namespace pixelgym::vector

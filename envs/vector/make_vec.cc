@@ -18,9 +18,10 @@ std::unique_ptr<VectorEnv> make_vec(const std::string& id, int num_envs, const P
   };
   if (options.mode == VectorMode::kAsync) {
     return std::make_unique<AsyncVectorEnv>(num_envs, make_env, options.num_threads,
-                                            options.autoreset);
+                                            options.autoreset, options.share_gl_contexts);
   }
-  return std::make_unique<SyncVectorEnv>(num_envs, make_env, options.autoreset);
+  return std::make_unique<SyncVectorEnv>(num_envs, make_env, options.autoreset,
+                                         options.share_gl_contexts);
 }
 
 }  // namespace pixelgym::vector

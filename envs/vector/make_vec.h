@@ -23,6 +23,9 @@ struct VectorOptions {
   /// AsyncVectorEnv's worker threads: 0 for one per core; clamped to num_envs. Ignored by kSync.
   int num_threads = 0;
   AutoresetMode autoreset = AutoresetMode::kNextStep;
+  /// Whether the envs one thread runs draw with one shared GL context (see VectorEnv: GL
+  /// contexts); false gives every env its own.
+  bool share_gl_contexts = true;
 };
 
 /// `num_envs` copies of `make(id, kwargs)`, each wrapped by `wrappers` (the `--wrap` text form,

@@ -88,8 +88,9 @@ AutoresetMode parse_autoreset_mode(const std::string& name) {
                               name + "\"");
 }
 
-VectorEnv::VectorEnv(std::string type_name, int num_envs, AutoresetMode autoreset)
-    : type_name_(std::move(type_name)), num_envs_(num_envs) {
+VectorEnv::VectorEnv(std::string type_name, int num_envs, AutoresetMode autoreset,
+                     bool share_gl_contexts)
+    : type_name_(std::move(type_name)), num_envs_(num_envs), share_gl_contexts_(share_gl_contexts) {
   if (num_envs < 1) {
     throw std::invalid_argument(
         type_name_ + ": num_envs must be >= 1, got num_envs = " + std::to_string(num_envs));
@@ -117,8 +118,14 @@ const Env& VectorEnv::env(int i) const {
 const Space& VectorEnv::single_observation_space() const { return envs_[0]->observation_space(); }
 const Space& VectorEnv::single_action_space() const { return envs_[0]->action_space(); }
 
-void VectorEnv::build(const EnvFactory& make_env) {
+void VectorEnv::build(const EnvFactory& make_env, int context_groups) {
   const auto n = static_cast<std::size_t>(num_envs_);
+  if (share_gl_contexts_) {
+    // Cheap: each creates its GL context when its first env renders.
+    for (int g = 0; g < context_groups; ++g) {
+      shared_contexts_.push_back(std::make_unique<render::SharedContext>());
+    }
+  }
   envs_.resize(n);
   errors_.assign(n, nullptr);
   make_env_ = &make_env;
@@ -186,14 +193,22 @@ void VectorEnv::destroy_envs() noexcept {
   for (auto& error : errors_) error = nullptr;
 }
 
-void VectorEnv::run_phase(Phase phase) {
-  phase_ = phase;
+void VectorEnv::run_all() {
   start_all();
   wait_all();
 }
 
+void VectorEnv::run_phase(Phase phase) {
+  phase_ = phase;
+  run_all();
+}
+
 void VectorEnv::run_env(int i) noexcept {
   const auto index = static_cast<std::size_t>(i);
+  std::optional<render::SharedContext::Use> shared_context;
+  if (!shared_contexts_.empty()) {
+    shared_context.emplace(*shared_contexts_[index % shared_contexts_.size()]);
+  }
   try {
     switch (phase_) {
       case Phase::kBuild:
@@ -327,11 +342,11 @@ const VectorResetResult& VectorEnv::do_reset(std::optional<std::uint64_t> seed,
 }
 
 const VectorStepResult& VectorEnv::step(const Value& actions) {
-  begin_step(actions, "step()");
+  begin_step(actions, "step()", true);
   return end_step("step()");
 }
 
-void VectorEnv::begin_step(const Value& actions, const char* method) {
+void VectorEnv::begin_step(const Value& actions, const char* method, bool wait) {
   require_usable(method);
   if (failed_) {
     throw ResetNeeded(name() + ": " + method + " after a failed call; call reset() first");
@@ -354,14 +369,20 @@ void VectorEnv::begin_step(const Value& actions, const char* method) {
   copy_value(actions, actions_);
   phase_ = Phase::kStep;
   step_pending_ = true;
-  start_all();
+  if (wait) {
+    run_all();
+    finished_ = true;
+  } else {
+    start_all();
+  }
 }
 
 const VectorStepResult& VectorEnv::end_step(const char* method) {
   if (!step_pending_) {
     throw ResetNeeded(name() + ": " + method + " called without a pending step_async()");
   }
-  wait_all();
+  if (!finished_) wait_all();
+  finished_ = false;
   step_pending_ = false;
   throw_first_error(true);
   const bool any_final = std::any_of(final_.begin(), final_.end(), [](auto f) { return f != 0; });

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "envs/env.h"
+#include "render/renderer.h"
 
 namespace pixelgym::vector {
 
@@ -99,6 +100,14 @@ using EnvFactory = std::function<std::unique_ptr<Env>(int index)>;
 /// throws ResetNeeded: the batch is not a consistent state. A full `reset()` makes the vector
 /// env usable again (worker threads are kept).
 ///
+/// GL contexts. By default the pixel envs that one thread runs draw with one shared GL context
+/// (render::SharedContext: one for SyncVectorEnv, one per worker of AsyncVectorEnv); each env
+/// keeps its own Bullet world and its own GL objects (framebuffers, meshes, textures), and its
+/// frames are byte-identical to an env drawing with a context of its own. Separate contexts keep
+/// a copy of llvmpipe's compiled shaders and state each, which at 8 envs on one core costs about
+/// a fifth of the steps per second (see render::SharedContext); `share_gl_contexts = false`
+/// gives every env its own context instead.
+///
 /// One thread at a time calls a vector env's methods.
 class VectorEnv {
  public:
@@ -110,10 +119,11 @@ class VectorEnv {
   /// error state left by a failed call.
   const VectorResetResult& reset(std::optional<std::uint64_t> seed = std::nullopt,
                                  const Options& options = {});
-  /// Resets the envs whose entry of `reset_mask` (a bool (num_envs,) array, at least one true;
-  /// Gymnasium's options["reset_mask"]) is true, as `reset` would; the other rows of the
-  /// observation batch keep their last observation and their infos are absent. Throws
-  /// std::invalid_argument for a mask of another dtype or shape or with no true entry.
+  /// Resets the envs whose entry of `reset_mask` (a bool (num_envs,) array, at least one true)
+  /// is true, as `reset` would. Gymnasium passes the mask as options["reset_mask"]; here it is
+  /// an argument of its own because Options (Params) hold scalars and strings, not arrays; the
+  /// other rows of the observation batch keep their last observation and their infos are absent.
+  /// Throws std::invalid_argument for a mask of another dtype or shape or with no true entry.
   const VectorResetResult& reset(std::optional<std::uint64_t> seed, const Options& options,
                                  const Array& reset_mask);
   /// Steps every env with its row of `actions` (laid out as action_space()), autoresetting as
@@ -142,13 +152,15 @@ class VectorEnv {
 
  protected:
   /// Throws std::invalid_argument naming `type_name` unless num_envs >= 1.
-  VectorEnv(std::string type_name, int num_envs, AutoresetMode autoreset);
+  VectorEnv(std::string type_name, int num_envs, AutoresetMode autoreset, bool share_gl_contexts);
 
   /// Builds the envs with `make_env` (through run_all: on the threads that will run them), checks
-  /// that their spaces agree and allocates every buffer. Subclass constructors call it last.
+  /// that their spaces agree and allocates every buffer. Env i draws with shared GL context
+  /// i % `context_groups` (when sharing): one per thread that runs envs. Subclass constructors
+  /// call it last.
   /// Throws what make_env throws (with the env index), destroying the envs already built, or
   /// std::invalid_argument when an env's spaces differ from env 0's or cannot be batched.
-  void build(const EnvFactory& make_env);
+  void build(const EnvFactory& make_env, int context_groups);
   /// Destroys the envs through run_all. AsyncVectorEnv's destructor calls it while its workers
   /// still run; the base destructor destroys what is left on the calling thread.
   void destroy_envs() noexcept;
@@ -158,12 +170,16 @@ class VectorEnv {
   virtual void start_all() = 0;
   /// Returns once every call begun by start_all has returned.
   virtual void wait_all() = 0;
+  /// Runs `run_env(i)` for every env i and returns when all have returned: start_all() then
+  /// wait_all(), unless a subclass does better (AsyncVectorEnv runs a share on the caller).
+  virtual void run_all();
   /// Does env i's part of the current call; catches what it throws (see VectorEnv: Errors).
   void run_env(int i) noexcept;
 
-  /// The two halves of step(): validates and copies `actions`, starts the envs; then waits for
-  /// them and batches the results. AsyncVectorEnv exposes them as step_async / step_wait.
-  void begin_step(const Value& actions, const char* method);
+  /// The two halves of step(): validates and copies `actions` and starts the envs (all at once
+  /// through run_all when `wait`, else through start_all); then waits for them (unless they
+  /// finished) and batches the results. AsyncVectorEnv exposes them as step_async / step_wait.
+  void begin_step(const Value& actions, const char* method, bool wait);
   const VectorStepResult& end_step(const char* method);
   bool step_pending() const { return step_pending_; }
 
@@ -200,6 +216,8 @@ class VectorEnv {
   std::vector<std::uint8_t> autoreset_;  // env i's episode ended at the last step
   std::vector<std::uint8_t> final_;      // kSameStep: env i ended and was reset in this step
   std::vector<std::exception_ptr> errors_;
+  bool share_gl_contexts_;
+  std::vector<std::unique_ptr<render::SharedContext>> shared_contexts_;  // env i: i % size
 
   // The current call's arguments, read by run_env.
   Phase phase_ = Phase::kBuild;
@@ -211,6 +229,7 @@ class VectorEnv {
   bool has_reset_ = false;
   bool failed_ = false;  // a call failed: only reset() and close() are allowed
   bool step_pending_ = false;
+  bool finished_ = false;  // the pending step ran through run_all: nothing to wait for
   bool closed_ = false;
 };
 

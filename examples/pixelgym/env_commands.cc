@@ -507,7 +507,7 @@ Command add_bench(CLI::App& app) {
   bench
       ->add_option("--threads", args->threads,
                    "With --num-envs: 0 for SyncVectorEnv (a loop on this thread), T for an "
-                   "AsyncVectorEnv of T worker threads (clamped to N)")
+                   "AsyncVectorEnv on T threads, this one included (clamped to N)")
       ->capture_default_str()
       ->check(integer_in(0));
   add_set_option(*bench, args->sets);

@@ -2,12 +2,18 @@
 // from AsyncVectorEnv on 1, 2 and 4 threads, and from the envs stepped one by one with Env
 // (with NextStep's autoreset done by hand), for 1, 3 and 8 envs. Episodes are cut at 4 steps so
 // that autoresets happen inside the 9 steps compared; renders are small to keep this quick.
+// The pools alternate step() (worker 0's envs run on the calling thread) with step_async() +
+// step_wait() (they run on worker thread 0), and the vector envs run with GL contexts shared per
+// thread (their default) and, sync and on 2 threads, with a context per env.
 #include <gtest/gtest.h>
 
+#include <ostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "envs/registry.h"
+#include "envs/vector/async_vector_env.h"
 #include "envs/vector/batch_space.h"
 #include "envs/vector/make_vec.h"
 #include "wrappers/wrapper_spec.h"
@@ -24,6 +30,12 @@ struct Case {
   Params kwargs;
   std::vector<std::string> wrappers;
 };
+
+void PrintTo(const Case& c, std::ostream* os) {
+  *os << c.id;
+  for (const auto& [key, value] : c.kwargs) *os << " " << key << "=" << value.to_string();
+  for (const std::string& wrapper : c.wrappers) *os << " --wrap " << wrapper;
+}
 
 // One step of one env.
 struct EnvStep {
@@ -93,17 +105,29 @@ TEST_P(VectorDeterminismTest, SyncAndPoolsEqualSingleEnvsByteForByte) {
       for (const EnvStep& step : row) ended = ended || step.terminated || step.truncated;
     }
     EXPECT_TRUE(ended) << "no episode ended: the autoreset is not exercised";
-    for (const int threads : {0, 1, 2, 4}) {
+    // {threads (0: sync), shared GL contexts}
+    const std::pair<int, bool> runners[] = {{0, true}, {1, true},  {2, true},
+                                            {4, true}, {0, false}, {2, false}};
+    for (const auto& [threads, shared] : runners) {
       const std::string runner =
           std::to_string(num_envs) + " envs, " +
-          (threads == 0 ? std::string("sync") : std::to_string(threads) + " threads");
+          (threads == 0 ? std::string("sync") : std::to_string(threads) + " threads") +
+          (shared ? "" : ", a GL context per env");
       const VectorOptions options{threads == 0 ? VectorMode::kSync : VectorMode::kAsync, threads,
-                                  AutoresetMode::kNextStep};
+                                  AutoresetMode::kNextStep, shared};
       const auto env = make_vec(c.id, num_envs, c.kwargs, c.wrappers, options);
+      auto* pool = dynamic_cast<AsyncVectorEnv*>(env.get());
       expect_same(expected, *env, env->reset(kSeed).obs, nullptr, 0, runner);
       for (int t = 0; t < kSteps; ++t) {
-        const VectorStepResult& step = env->step(actions[static_cast<std::size_t>(t)]);
-        expect_same(expected, *env, step.obs, &step, t + 1, runner);
+        const Value& actions_t = actions[static_cast<std::size_t>(t)];
+        if (pool != nullptr && t % 2 == 1) {
+          pool->step_async(actions_t);
+          const VectorStepResult& step = pool->step_wait();
+          expect_same(expected, *env, step.obs, &step, t + 1, runner + ", step_async");
+        } else {
+          const VectorStepResult& step = env->step(actions_t);
+          expect_same(expected, *env, step.obs, &step, t + 1, runner);
+        }
       }
     }
   }
