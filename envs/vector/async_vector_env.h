@@ -38,6 +38,13 @@ namespace pixelgym::vector {
 /// Between the steps of a learner that computes for longer, each worker spins 200 microseconds and
 /// then sleeps.
 ///
+/// Speed-up. With pixel envs on OSMesa, a second thread adds 10-30 % (bench/vector_bench, the
+/// README's scaling table), not 2x: OSMesa has one llvmpipe screen per process and llvmpipe
+/// rasterizes every context's frames under that screen's one lock (with LP_NUM_THREADS=0, inside
+/// it), so threads take turns for most of a pixel step; physics, scene updates and wrappers still
+/// run in parallel. Threads pay off fully for state-only envs, and for overlapping env steps with
+/// the caller's own work (step_async, compute, step_wait).
+///
 /// Threads: `num_threads` 0 means min(num_envs, std::thread::hardware_concurrency()); more
 /// threads than envs are clamped to num_envs (a thread without envs would only wait), not an
 /// error. With num_envs not a multiple of num_threads some threads run one env more per step
