@@ -11,11 +11,16 @@
 // within each round (so drift on a shared machine hits both alike) and the medians over rounds
 // are printed.
 //
-// usage: vector_bench [IDS] [rounds] [block_ms] [max_envs]
+// usage: vector_bench [IDS] [rounds] [block_ms] [max_envs] [cpu]
 //   IDS: comma-separated env ids (default CartPoleSwingup-v0,ArmReach-v0), 84x84 (their default)
+//   cpu: time the one-thread configurations (the loops and sync) by the thread's CPU time
+//        instead of wall time, and skip the async ones: steadier on a busy machine, for
+//        decisions about per-env costs (another process taking the core does not count)
 // Prints a table per id and, per id, the two figures the vector-env issue sets targets for:
 //   <id> two_threads_over_one_8envs=   AsyncVectorEnv(2 threads) / SyncVectorEnv at 8 envs
 //   <id> one_thread_8envs_over_loop=   SyncVectorEnv at 8 envs / the single-env loop
+#include <time.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -37,7 +42,14 @@ using pixelgym::Rng;
 using pixelgym::Value;
 namespace vector = pixelgym::vector;
 
+bool cpu_time = false;  // see usage
+
 double now_seconds() {
+  if (cpu_time) {
+    timespec now{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+    return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
+  }
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
@@ -116,6 +128,7 @@ int main(int argc, char** argv) {
   const int rounds = argc > 2 ? std::atoi(argv[2]) : 7;
   const double block = (argc > 3 ? std::atof(argv[3]) : 250.0) / 1000.0;
   const int max_envs = argc > 4 ? std::atoi(argv[4]) : 16;
+  cpu_time = argc > 5 && std::string(argv[5]) == "cpu";
   const char* names[] = {"loop, own contexts", "sync", "async 1 thread", "async 2 threads"};
   for (const std::string& id : ids) {
     std::vector<Row> rows;
@@ -137,7 +150,7 @@ int main(int argc, char** argv) {
           {vector::VectorMode::kAsync, 1, vector::AutoresetMode::kNextStep},
           {vector::VectorMode::kAsync, 2, vector::AutoresetMode::kNextStep},
       };
-      for (int m = 0; m < 3; ++m) {
+      for (int m = 0; m < (cpu_time ? 1 : 3); ++m) {
         std::shared_ptr<vector::VectorEnv> env = vector::make_vec(id, n, {}, {}, modes[m]);
         auto actions = std::make_shared<std::vector<Value>>();
         Rng rng(0);
@@ -167,9 +180,9 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "%s: %d envs done\n", id.c_str(), n);
     }
     std::printf(
-        "%s: total env steps/s (wall time), medians of %d rounds of %.0f ms; (x) = over the "
+        "%s: total env steps/s (%s), medians of %d rounds of %.0f ms; (x) = over the "
         "single-env loop in the same rounds\n",
-        id.c_str(), rounds, block * 1000.0);
+        id.c_str(), cpu_time ? "thread CPU time" : "wall time", rounds, block * 1000.0);
     std::printf("  %8s %12s", "num_envs", "single loop");
     for (const char* name : names) std::printf(" %20s", name);
     std::printf("\n");
@@ -181,7 +194,7 @@ int main(int argc, char** argv) {
       std::printf("\n");
     }
     for (const Row& row : rows) {
-      if (row.num_envs != 8) continue;
+      if (row.num_envs != 8 || row.ratios.size() < 4) continue;
       std::printf("%s two_threads_over_one_8envs=%.2f\n", id.c_str(),
                   row.ratios[3] / row.ratios[1]);
       std::printf("%s one_thread_8envs_over_loop=%.2f\n", id.c_str(), row.ratios[1]);

@@ -70,18 +70,16 @@ using TargetKey = std::tuple<int, int, int>;
 struct Background {
   ColorTarget target;
   std::vector<float> key;
+  std::uint64_t last_used = 0;  // frame count
 };
+
+// Backgrounds kept per image size and sample count.
+constexpr std::size_t kBackgroundsPerSize = 16;
 
 // The calling thread's SharedContext in use (SharedContext::Use).
 thread_local SharedContext* shared_in_use = nullptr;
 
 }  // namespace
-
-struct SharedContext::State {
-  explicit State(GlBackend backend) : context(backend) {}
-  Context context;  // current on the creating thread from here on, for the programs below
-  ShaderPrograms programs;
-};
 
 SharedContext::SharedContext(GlBackend backend) : backend_(backend) {}
 
@@ -95,51 +93,23 @@ SharedContext::Use::~Use() { shared_in_use = previous_; }
 
 SharedContext* SharedContext::in_use() { return shared_in_use; }
 
-std::shared_ptr<SharedContext::State> SharedContext::state() {
-  if (state_ == nullptr) {
-    state_ = std::make_shared<State>(backend_);
-  } else {
-    state_->context.make_current();
-  }
-  return state_;
-}
-
-namespace {
-
-// The context and programs a new renderer draws with, current on the calling thread: the
-// SharedContext's in use here when it is of `backend`, else new ones.
-std::shared_ptr<SharedContext::State> context_for(GlBackend backend) {
-  SharedContext* shared = SharedContext::in_use();
-  if (shared != nullptr && shared->backend() == backend) return shared->state();
-  return std::make_shared<SharedContext::State>(backend);
-}
-
-// Unbinds `context` from the calling thread when destroyed.
-struct Unbind {
-  Context& context;
-  ~Unbind() { context.release(); }
-};
-
-}  // namespace
-
-struct Renderer::Impl {
-  explicit Impl(GlBackend backend)
-      : gl(context_for(backend)),
-        unbind{gl->context},
-        context(gl->context),
-        programs(gl->programs),
-        floor(make_floor_mesh()) {
+// Everything a renderer draws with: the GL context, the shader programs, the meshes, textures and
+// framebuffers, and per-frame scratch. A Renderer of its own context has a State of its own; the
+// renderers of a SharedContext share one, drawing one after another: every frame sets all the GL
+// state and uniforms it draws with and redraws every pixel of the scratch targets it reads.
+struct SharedContext::State {
+  explicit State(GlBackend backend) : context(backend), floor(make_floor_mesh()) {
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     glFrontFace(GL_CW);  // the flipped projection mirrors the winding
     glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
   }
 
-  // The GL objects below are deleted by their owners, after this; then `unbind` unbinds the
-  // context and `gl` destroys it unless another renderer or its SharedContext still uses it.
-  ~Impl() { context.make_current(); }
-  Impl(const Impl&) = delete;
-  Impl& operator=(const Impl&) = delete;
+  // The GL objects below are deleted by their owners, after this, and then the context (declared
+  // first, so it goes last; destroying it while current here unbinds it from this thread).
+  ~State() { context.make_current(); }
+  State(const State&) = delete;
+  State& operator=(const State&) = delete;
 
   // The frame being drawn, by size and samples.
   ColorTarget& target(const Camera& camera) {
@@ -151,14 +121,29 @@ struct Renderer::Impl {
         .first->second;
   }
 
-  // The cached background (sky and unshadowed floor), by size and samples.
+  // The cached background (sky and unshadowed floor) drawn from `frame_key` when there is one; else
+  // one to draw it into (with another key: a new one, or the least recently used when
+  // kBackgroundsPerSize exist).
   Background& background(const Camera& camera) {
-    const TargetKey key{camera.width, camera.height, camera.msaa_samples};
-    auto found = backgrounds.find(key);
-    if (found != backgrounds.end()) return found->second;
-    Background made{
-        ColorTarget(camera.width, camera.height, camera.msaa_samples, false, "background"), {}};
-    return backgrounds.emplace(key, std::move(made)).first->second;
+    std::vector<Background>& kept =
+        backgrounds[TargetKey{camera.width, camera.height, camera.msaa_samples}];
+    Background* chosen = nullptr;
+    for (Background& candidate : kept) {
+      if (candidate.key == frame_key) {
+        chosen = &candidate;
+        break;
+      }
+      if (chosen == nullptr || candidate.last_used < chosen->last_used) chosen = &candidate;
+    }
+    if (chosen == nullptr || (chosen->key != frame_key && kept.size() < kBackgroundsPerSize)) {
+      kept.push_back(
+          {ColorTarget(camera.width, camera.height, camera.msaa_samples, false, "background"),
+           {},
+           0});
+      chosen = &kept.back();
+    }
+    chosen->last_used = ++frames;
+    return *chosen;
   }
 
   SegmentationTarget& segmentation_target(const Camera& camera) {
@@ -309,8 +294,8 @@ struct Renderer::Impl {
     // floor are drawn again (same shader, now with the shadow lookup). Every frame, the first
     // included, takes this path, so a scene always gives the same bytes.
     const ColorTarget& frame = target(camera);
-    Background& cached = background(camera);
     background_key(scene, camera, view_projection, frame_key);
+    Background& cached = background(camera);
     if (frame_key != cached.key) {
       glBindFramebuffer(GL_FRAMEBUFFER, cached.target.framebuffer());
       glViewport(0, 0, camera.width, camera.height);
@@ -383,20 +368,20 @@ struct Renderer::Impl {
     read_segmentation(camera.width, camera.height, out);
   }
 
-  std::shared_ptr<SharedContext::State> gl;  // first: destroyed after every GL object below
-  Unbind unbind;
-  Context& context;
-  // Shared with the other renderers of a SharedContext, as is all GL state but this renderer's
-  // own objects: every uniform and state a frame draws with is set during that frame, never
-  // left from an earlier one (tests/render/shared_context_test.cc checks).
-  ShaderPrograms& programs;
+  Context context;  // first: destroyed after every GL object below
+  // Shared by the renderers of a SharedContext: every uniform a frame draws with is set during
+  // that frame, never left from an earlier one (tests/render/shared_context_test.cc checks).
+  ShaderPrograms programs;
   MeshArena arena;
   TextureCache textures;
   ShadowPass shadow_pass;
   ShadowFootprints shadow_floor;
   std::shared_ptr<const MeshData> floor;
   std::map<TargetKey, ColorTarget> targets;
-  std::map<TargetKey, Background> backgrounds;
+  // Several per size (the renderers of a SharedContext may look from different cameras), the
+  // least recently used redrawn when none matches.
+  std::map<TargetKey, std::vector<Background>> backgrounds;
+  std::uint64_t frames = 0;
   std::map<std::pair<int, int>, SegmentationTarget> segmentation_targets;
   GLint max_samples = 0;
   // Per-frame scratch, kept so that a frame allocates nothing once the renderer is warm.
@@ -407,16 +392,44 @@ struct Renderer::Impl {
   std::vector<std::uint8_t> readback;  // RGBA, packed into RGB
 };
 
-Renderer::Renderer(GlBackend backend) : impl_(std::make_unique<Impl>(backend)) {
-  impl_->context.release();  // current since its creation; see render()
+std::shared_ptr<SharedContext::State> SharedContext::state() {
+  if (state_ == nullptr) {
+    state_ = std::make_shared<State>(backend_);
+  } else {
+    state_->context.make_current();
+  }
+  return state_;
 }
 
-Renderer::~Renderer() = default;
+namespace {
+
+// The state a new renderer draws with, its context current on the calling thread: the
+// SharedContext's in use here when it is of `backend`, else its own.
+std::shared_ptr<SharedContext::State> state_for(GlBackend backend) {
+  SharedContext* shared = SharedContext::in_use();
+  if (shared != nullptr && shared->backend() == backend) return shared->state();
+  return std::make_shared<SharedContext::State>(backend);
+}
+
+}  // namespace
+
+struct Renderer::Impl {
+  std::shared_ptr<SharedContext::State> state;
+};
+
+Renderer::Renderer(GlBackend backend) : impl_(std::make_unique<Impl>(Impl{state_for(backend)})) {
+  impl_->state->context.release();  // current since state_for; see render()
+}
+
+Renderer::~Renderer() {
+  // The last renderer of a state deletes its GL objects and context (see State); otherwise
+  // nothing of this renderer's is left to delete but what the state keeps.
+}
 
 void Renderer::render(const Scene& scene, const Camera& camera, const RenderTargets& targets) {
-  impl_->render(scene, camera, targets);
+  impl_->state->render(scene, camera, targets);
 }
 
-std::string Renderer::description() { return impl_->context.description(); }
+std::string Renderer::description() { return impl_->state->context.description(); }
 
 }  // namespace pixelgym::render

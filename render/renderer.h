@@ -27,18 +27,22 @@ struct RenderTargets {
   std::int32_t* segmentation = nullptr;
 };
 
-/// A GL context, and the shader programs compiled in it, that several Renderers draw with, one
-/// after another: the renderers constructed on a thread while a `SharedContext::Use` is alive there
-/// draw with that SharedContext's context instead of one of their own. Each renderer still has
-/// its own GL objects (framebuffers, meshes, textures, background cache) and sets every state it
-/// draws with, so its frames are byte-identical to those of a renderer with its own context.
+/// A GL context, with everything drawn with it, that several Renderers share, drawing one after
+/// another: the renderers constructed on a thread while a `SharedContext::Use` is alive there
+/// draw with that SharedContext's context instead of one of their own. They share the compiled
+/// shader programs, the meshes and textures uploaded (by MeshData address and texture path, so
+/// envs of one task upload each mesh once), the framebuffers a frame is drawn in, the shadow map,
+/// and the cached backgrounds (by camera and scene settings, up to 16 per image size). Every frame
+/// sets all the GL state it draws with and redraws every pixel it reads, so a renderer's frames
+/// are byte-identical to those of a renderer with a context of its own. Meshes and textures stay
+/// until the SharedContext and all its renderers are gone.
 ///
 /// Why: llvmpipe compiles shaders per context into machine code of its own and keeps per-context
-/// state; N renderers with N contexts drawn in turn on one core keep N copies of that in the
-/// caches. Measured with bench/vector_bench (CartPoleSwingup-v0, 84x84, thread CPU time): 8 envs
-/// with their own contexts stepped in turn cost 0.79-0.82x the steps/s of one env stepped alone,
-/// 16 envs 0.73-0.78x; sharing one context, 1.0x and 0.91-0.97x. The vector envs give each thread
-/// that runs envs one SharedContext.
+/// state; N renderers with N contexts drawn in turn on one core keep N copies of that, and of
+/// every mesh and framebuffer, in the caches. Measured with bench/vector_bench (CartPoleSwingup-v0,
+/// 84x84, thread CPU time): 8 envs with their own contexts stepped in turn cost 0.79-0.82x the
+/// steps/s of one env stepped alone, 16 envs 0.73-0.78x; sharing one context, 1.0x and 0.91-0.97x.
+/// The vector envs give each thread that runs envs one SharedContext.
 ///
 /// Threads: the renderers sharing a context must never draw (or be made or destroyed) at the same
 /// time: use one SharedContext for renderers that one thread runs in turn (or several threads,

@@ -37,13 +37,13 @@ struct Look {
   bool depth_and_segmentation;
 };
 
+// Renderers 0 and 3 share an image size and sample count but not a camera, so their
+// backgrounds are kept side by side.
 const Look kLooks[] = {
-    {32, 0, true, true, false},
-    {48, 4, false, true, true},
-    {40, 0, false, false, true},
-    {32, 2, true, true, true},
+    {32, 0, true, true, false}, {48, 4, false, true, true}, {40, 0, false, false, true},
+    {32, 0, true, true, true},  {32, 2, true, true, true},
 };
-constexpr int kRenderers = 4;
+constexpr int kRenderers = 5;
 
 Scene scene(int r, int frame) {
   const Look& look = kLooks[r];
@@ -131,6 +131,33 @@ TEST(SharedContextTest, RenderersTakingTurnsGiveTheBytesOfRenderersWithTheirOwnC
                   expected[static_cast<std::size_t>(r)][static_cast<std::size_t>(f)])
           << "renderer " << r << ", frame " << f;
     }
+  }
+}
+
+TEST(SharedContextTest, MoreCamerasThanKeptBackgroundsGiveTheBytesOfOneCameraEach) {
+  // 20 cameras at one size take turns with one renderer, so backgrounds are evicted and redrawn;
+  // every frame equals that camera's frame from a renderer that never saw another camera.
+  constexpr int kCameras = 20;
+  const auto camera_at = [](int c) {
+    Camera camera = Camera::look_at({-1.0F + 0.1F * static_cast<float>(c), -3, 0.5F}, {0, 0, 0.5F});
+    camera.width = 24;
+    camera.height = 24;
+    return camera;
+  };
+  const auto frame = [&](Renderer& renderer, int c) {
+    std::vector<std::uint8_t> rgb(24 * 24 * 3);
+    renderer.render(scene(0, 0), camera_at(c), {24, 24, rgb.data()});
+    return rgb;
+  };
+  Renderer cycling;
+  std::vector<std::vector<std::uint8_t>> first;
+  for (int c = 0; c < kCameras; ++c) first.push_back(frame(cycling, c));
+  for (int c = 0; c < kCameras; ++c) {
+    EXPECT_EQ(frame(cycling, c), first[static_cast<std::size_t>(c)]) << "camera " << c;
+  }
+  for (const int c : {0, 7, 19}) {
+    Renderer fresh;
+    EXPECT_EQ(frame(fresh, c), first[static_cast<std::size_t>(c)]) << "camera " << c;
   }
 }
 
