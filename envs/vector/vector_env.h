@@ -101,12 +101,12 @@ using EnvFactory = std::function<std::unique_ptr<Env>(int index)>;
 /// env usable again (worker threads are kept).
 ///
 /// GL contexts. By default the pixel envs that one thread runs draw with one shared GL context
-/// (render::SharedContext: one for SyncVectorEnv, one per worker of AsyncVectorEnv); each env
-/// keeps its own Bullet world and its own GL objects (framebuffers, meshes, textures), and its
-/// frames are byte-identical to an env drawing with a context of its own. Separate contexts keep
-/// a copy of llvmpipe's compiled shaders and state each, which at 8 envs on one core costs about
-/// a fifth of the steps per second (see render::SharedContext); `share_gl_contexts = false`
-/// gives every env its own context instead.
+/// (render::SharedContext: one for SyncVectorEnv, one per worker of AsyncVectorEnv), sharing its
+/// compiled shaders, uploaded meshes and scratch framebuffers; each env keeps its own Bullet
+/// world and scene, and its frames are byte-identical to an env drawing with a context of its
+/// own. Separate contexts keep a copy of all that each, which at 8 envs on one core costs about a
+/// fifth of the steps per second (see render::SharedContext); `share_gl_contexts = false` gives
+/// every env its own context instead.
 ///
 /// One thread at a time calls a vector env's methods.
 class VectorEnv {
