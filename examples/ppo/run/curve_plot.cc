@@ -208,10 +208,10 @@ AxisTicks nice_axis(double low, double high, int target_count) {
 std::string format_tick(double value, double step, double axis_max_magnitude) {
   double unit = 1.0;
   const char* suffix = "";
-  if (axis_max_magnitude >= 1e10) {
+  if (axis_max_magnitude >= 1e9) {
     unit = 1e9;
     suffix = "G";
-  } else if (axis_max_magnitude >= 1e7) {
+  } else if (axis_max_magnitude >= 1e6) {
     unit = 1e6;
     suffix = "M";
   } else if (axis_max_magnitude >= 1e4) {
@@ -290,7 +290,8 @@ render::Image draw_curve(const ProgressTable& progress, const CurvePlotOptions& 
   const int top = legend_y + 34;
   const int bottom_margin = 52;
   const int gap = 30;
-  const int panel_width = (options.width - 2 * left_margin - gap - 16) / 2;
+  const int right_margin = 24;  // room for half the last x tick label
+  const int panel_width = (options.width - 2 * left_margin - gap - right_margin) / 2;
   const int panel_height = options.height - top - bottom_margin;
 
   const auto [wall_time, wall_label] = wall_time_axis(wall_time_s);

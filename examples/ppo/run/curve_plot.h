@@ -31,8 +31,9 @@ struct AxisTicks {
 /// Throws std::invalid_argument for a non-finite bound or target_count < 1.
 AxisTicks nice_axis(double low, double high, int target_count);
 
-/// A tick label: `value` with just enough decimals for ticks `step` apart, and a k / M / G
-/// suffix when the axis reaches 10,000 (20000 -> "20k", 1500000 -> "1.5M", 0.25 -> "0.25").
+/// A tick label: `value` with just enough decimals for ticks `step` apart, and a k suffix when
+/// the axis reaches 10,000, M from a million, G from a billion (20000 -> "20k", 1500000 on a 2M
+/// axis with 0.5M ticks -> "1.5M", 0.25 -> "0.25").
 std::string format_tick(double value, double step, double axis_max_magnitude);
 
 /// Draws the curve: two panels, episode return against env steps and against wall time (in s,
