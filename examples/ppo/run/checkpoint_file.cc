@@ -278,6 +278,7 @@ CheckpointSearch find_latest_checkpoint(const fs::path& folder) {
           LoadedCheckpoint{*path, *checkpoint_update(path->filename().string()), std::move(blobs)};
       break;
     } catch (const std::runtime_error& error) {
+      // Not swallowed: skipping an invalid checkpoint and reporting why is this lookup's job.
       search.skipped.push_back({*path, error.what()});
     }
   }
