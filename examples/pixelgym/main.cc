@@ -1,5 +1,5 @@
 // pixelgym — the command-line front door: list, info, check, snapshot, rollout, bench, inspect,
-// view, record, help.
+// view, record, train, eval, help.
 #include <exception>
 #include <iostream>
 #include <string>
@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
                        "Print the version and exit");
   std::vector<Command> commands = pixelgym::cli::add_env_commands(app);
   for (auto* add : {pixelgym::cli::add_engine_commands, pixelgym::cli::add_render_commands,
-                    pixelgym::cli::add_record_commands}) {
+                    pixelgym::cli::add_record_commands, pixelgym::cli::add_train_commands}) {
     for (auto& command : add(app)) commands.push_back(std::move(command));
   }
 

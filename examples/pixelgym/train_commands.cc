@@ -1,0 +1,507 @@
+// pixelgym train / eval: PPO from pixels (examples/ppo) with a run folder (examples/ppo/run).
+#include <torch/torch.h>
+
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "envs/registry.h"
+#include "envs/vector/make_vec.h"
+#include "envs/vector/sync_vector_env.h"
+#include "examples/pixelgym/cli.h"
+#include "examples/ppo/policy.h"
+#include "examples/ppo/ppo.h"
+#include "examples/ppo/run/checkpoint_file.h"
+#include "examples/ppo/run/progress_line.h"
+#include "examples/ppo/run/run_folder.h"
+#include "wrappers/record_video.h"
+#include "wrappers/wrapper_spec.h"
+
+namespace pixelgym::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// Episodes whose returns the progress rows summarize (as Stable-Baselines3's ep_info_buffer).
+constexpr std::size_t kReturnWindow = 100;
+
+// What a run is: the env and how the trainer is set up. Written to config.json; `eval` and
+// `--resume` read it back.
+struct RunSettings {
+  std::string id;
+  std::vector<std::string> sets;  // KEY=VALUE, as --set takes them
+  std::vector<std::string> wraps;
+  int num_threads = 2;
+  std::int64_t checkpoint_every = 10;  // updates
+  double minutes = 0.0;                // 0: no time limit
+  std::int64_t eval_episodes = 5;
+  ppo::PpoConfig ppo;
+};
+
+json settings_to_json(const RunSettings& settings) {
+  json out;
+  out["env_id"] = settings.id;
+  out["set"] = settings.sets;
+  out["wrap"] = settings.wraps;
+  out["num_threads"] = settings.num_threads;
+  out["checkpoint_every"] = settings.checkpoint_every;
+  out["minutes"] = settings.minutes;
+  out["eval_episodes"] = settings.eval_episodes;
+  out["ppo"] = json::parse(ppo::config_to_json(settings.ppo));
+  return out;
+}
+
+RunSettings settings_from_json(const json& in, const fs::path& where) {
+  try {
+    RunSettings settings;
+    settings.id = in.at("env_id").get<std::string>();
+    settings.sets = in.at("set").get<std::vector<std::string>>();
+    settings.wraps = in.at("wrap").get<std::vector<std::string>>();
+    settings.num_threads = in.at("num_threads").get<int>();
+    settings.checkpoint_every = in.at("checkpoint_every").get<std::int64_t>();
+    settings.minutes = in.at("minutes").get<double>();
+    settings.eval_episodes = in.at("eval_episodes").get<std::int64_t>();
+    settings.ppo = ppo::config_from_json(in.at("ppo").dump());
+    return settings;
+  } catch (const json::exception& e) {
+    throw std::runtime_error(where.string() + ": not a pixelgym train config: " + e.what());
+  }
+}
+
+// The training env: num_envs copies, SameStep autoreset (the trainer bootstraps truncated
+// steps from infos["final_obs"]).
+std::unique_ptr<vector::VectorEnv> make_training_env(const RunSettings& settings) {
+  const vector::VectorOptions options{vector::VectorMode::kAsync, settings.num_threads,
+                                      vector::AutoresetMode::kSameStep, true};
+  return vector::make_vec(settings.id, static_cast<int>(settings.ppo.num_envs),
+                          parse_sets(settings.id, settings.sets), settings.wraps, options);
+}
+
+std::string to_bytes(const std::function<void(std::ostream&)>& save) {
+  std::ostringstream out(std::ios::binary);
+  save(out);
+  return out.str();
+}
+
+// The checkpoint of `trainer` after its latest update: model, optimizer, generators, progress.
+ppo::CheckpointBlobs checkpoint_blobs(ppo::Trainer& trainer, const std::deque<double>& returns,
+                                      double wall_time_s) {
+  ppo::CheckpointBlobs blobs;
+  blobs["model"] = to_bytes([&](std::ostream& out) { torch::save(trainer.policy_ptr(), out); });
+  blobs["optimizer"] = to_bytes([&](std::ostream& out) { torch::save(trainer.optimizer(), out); });
+  const ppo::TrainerRngState rng = trainer.rng_state();
+  blobs["rng_sampling"] = to_bytes([&](std::ostream& out) { torch::save(rng.sampling, out); });
+  blobs["rng_augmentation"] =
+      to_bytes([&](std::ostream& out) { torch::save(rng.augmentation, out); });
+  json meta;
+  meta["env_steps"] = trainer.env_steps();
+  meta["updates"] = trainer.updates();
+  meta["wall_time_s"] = wall_time_s;
+  meta["recent_returns"] = std::vector<double>(returns.begin(), returns.end());
+  blobs["meta"] = meta.dump();
+  return blobs;
+}
+
+template <typename T>
+void load_blob(const ppo::CheckpointBlobs& blobs, const std::string& name, T& into,
+               const fs::path& path) {
+  const auto found = blobs.find(name);
+  if (found == blobs.end()) {
+    throw std::runtime_error(path.string() + ": the checkpoint has no \"" + name + "\" entry");
+  }
+  std::istringstream in(found->second, std::ios::binary);
+  torch::load(into, in);
+}
+
+json read_meta(const ppo::CheckpointBlobs& blobs, const fs::path& path) {
+  const auto found = blobs.find("meta");
+  if (found == blobs.end()) {
+    throw std::runtime_error(path.string() + ": the checkpoint has no \"meta\" entry");
+  }
+  return json::parse(found->second);
+}
+
+struct Evaluation {
+  double mean = 0.0;
+  double std = 0.0;
+  std::vector<double> returns;
+};
+
+// `episodes` episodes of `policy` on one env built as the run's (env i seeded seed + i), with
+// deterministic (mean / argmax) actions unless `stochastic`; the first recorded to `video`
+// when given.
+Evaluation evaluate(ppo::Policy& policy, const RunSettings& settings, std::int64_t episodes,
+                    std::uint64_t seed, bool stochastic, const std::optional<fs::path>& video) {
+  wrappers::RecordVideo* recorder = nullptr;
+  const vector::EnvFactory factory = [&](int) {
+    std::unique_ptr<Env> env = wrappers::apply_wrappers(
+        make(settings.id, parse_sets(settings.id, settings.sets)), settings.wraps);
+    if (!video) return env;
+    const fs::path folder = video->parent_path().empty() ? fs::path(".") : video->parent_path();
+    auto recorded = std::make_unique<wrappers::RecordVideo>(
+        std::move(env), folder, [](std::int64_t) { return false; }, nullptr, 0, "eval");
+    recorder = recorded.get();
+    return std::unique_ptr<Env>(std::move(recorded));
+  };
+  vector::SyncVectorEnv env(1, factory, vector::AutoresetMode::kDisabled);
+  torch::NoGradGuard no_grad;
+  Value actions = env.action_space().zeros();
+  Array& action = actions.array();
+  Evaluation result;
+  for (std::int64_t e = 0; e < episodes; ++e) {
+    if (e == 0 && recorder != nullptr) recorder->start_recording(video->stem().string());
+    const Value* obs = &env.reset(seed + static_cast<std::uint64_t>(e)).obs;
+    double total = 0.0;
+    for (;;) {
+      const ppo::ActResult act = policy.act(ppo::observation_tensors(*obs), !stochastic);
+      const torch::Tensor chosen = act.env_action.to(ppo::torch_dtype(action.dtype())).contiguous();
+      std::memcpy(action.raw_data(), chosen.data_ptr(), action.nbytes());
+      const vector::VectorStepResult& step = env.step(actions);
+      total += step.rewards.data<double>()[0];
+      obs = &step.obs;
+      if (step.terminated.data<bool>()[0] || step.truncated.data<bool>()[0]) break;
+    }
+    if (e == 0 && recorder != nullptr) recorder->stop_recording();
+    result.returns.push_back(total);
+  }
+  double sum = 0.0;
+  for (const double r : result.returns) sum += r;
+  result.mean = sum / static_cast<double>(result.returns.size());
+  double squares = 0.0;
+  for (const double r : result.returns) squares += (r - result.mean) * (r - result.mean);
+  result.std = std::sqrt(squares / static_cast<double>(result.returns.size()));
+  env.close();
+  return result;
+}
+
+json evaluation_json(const Evaluation& evaluation, std::uint64_t seed, bool stochastic) {
+  json out;
+  out["episodes"] = evaluation.returns.size();
+  out["seed"] = seed;
+  out["deterministic"] = !stochastic;
+  out["return_mean"] = evaluation.mean;
+  out["return_std"] = evaluation.std;
+  out["returns"] = evaluation.returns;
+  return out;
+}
+
+// --- train ---
+
+struct TrainArguments {
+  std::string id;
+  std::vector<std::string> sets;
+  std::vector<std::string> wraps;
+  std::string config_file;
+  std::int64_t steps = 0;  // 0: the config's total_env_steps
+  double minutes = 0.0;
+  std::string out;
+  std::string resume;
+  bool quiet = false;
+  std::uint64_t seed = 0;
+  bool seed_given = false;
+  int num_envs = 0;
+  int threads = 2;
+  std::int64_t checkpoint_every = 10;
+  std::int64_t eval_episodes = 5;
+};
+
+double mean_of(const std::deque<double>& values) {
+  if (values.empty()) return std::nan("");
+  double sum = 0.0;
+  for (const double v : values) sum += v;
+  return sum / static_cast<double>(values.size());
+}
+
+double std_of(const std::deque<double>& values) {
+  if (values.empty()) return std::nan("");
+  const double mean = mean_of(values);
+  double squares = 0.0;
+  for (const double v : values) squares += (v - mean) * (v - mean);
+  return std::sqrt(squares / static_cast<double>(values.size()));
+}
+
+int run_train(const TrainArguments& args) {
+  RunSettings settings;
+  std::optional<ppo::LoadedCheckpoint> checkpoint;
+  fs::path folder;
+  if (!args.resume.empty()) {
+    folder = args.resume;
+    std::ifstream config_file(folder / "config.json");
+    if (!config_file) {
+      throw std::runtime_error("--resume " + folder.string() + ": no config.json there");
+    }
+    settings = settings_from_json(json::parse(config_file), folder / "config.json");
+    const ppo::CheckpointSearch search = ppo::find_latest_checkpoint(folder);
+    for (const auto& skipped : search.skipped) {
+      std::cerr << "train: skipping " << skipped.path.string() << ": " << skipped.reason << "\n";
+    }
+    if (!search.latest) {
+      throw std::runtime_error("--resume " + folder.string() + ": no valid checkpoint there");
+    }
+    checkpoint = *search.latest;
+  } else {
+    settings.id = args.id;
+    settings.sets = args.sets;
+    settings.wraps = args.wraps;
+    if (!args.config_file.empty()) {
+      std::ifstream in(args.config_file);
+      if (!in) throw UsageError("--config " + args.config_file + ": cannot read it");
+      std::stringstream text;
+      text << in.rdbuf();
+      settings.ppo = ppo::config_from_json(text.str());
+    }
+    if (args.seed_given) settings.ppo.seed = args.seed;
+    if (args.num_envs > 0) settings.ppo.num_envs = args.num_envs;
+    settings.num_threads = args.threads;
+    settings.checkpoint_every = args.checkpoint_every;
+    settings.eval_episodes = args.eval_episodes;
+    folder = args.out.empty() ? fs::path("runs") / settings.id : fs::path(args.out);
+  }
+  if (args.steps > 0) settings.ppo.total_env_steps = args.steps;
+  if (args.minutes > 0.0) settings.minutes = args.minutes;
+  settings.ppo.validate();
+
+  const std::unique_ptr<vector::VectorEnv> env = make_training_env(settings);
+  ppo::Trainer trainer(*env, settings.ppo);
+  std::deque<double> returns;
+  double wall_before = 0.0;  // wall time of the run before this process
+  std::optional<ppo::RunFolder> run;
+  if (checkpoint) {
+    load_blob(checkpoint->blobs, "model", trainer.policy_ptr(), checkpoint->path);
+    load_blob(checkpoint->blobs, "optimizer", trainer.optimizer(), checkpoint->path);
+    ppo::TrainerRngState rng;
+    load_blob(checkpoint->blobs, "rng_sampling", rng.sampling, checkpoint->path);
+    load_blob(checkpoint->blobs, "rng_augmentation", rng.augmentation, checkpoint->path);
+    trainer.set_rng_state(rng);
+    const json meta = read_meta(checkpoint->blobs, checkpoint->path);
+    trainer.set_progress(meta.at("env_steps").get<std::int64_t>(),
+                         meta.at("updates").get<std::int64_t>());
+    wall_before = meta.at("wall_time_s").get<double>();
+    for (const double r : meta.at("recent_returns").get<std::vector<double>>()) {
+      returns.push_back(r);
+    }
+    run.emplace(ppo::RunFolder::resume(folder, trainer.env_steps()));
+    std::cout << "resuming " << folder.string() << " from " << checkpoint->path.filename().string()
+              << " (" << trainer.env_steps() << " env steps, " << trainer.updates()
+              << " updates)\n";
+  } else {
+    run.emplace(ppo::RunFolder::create(folder, settings_to_json(settings)));
+  }
+
+  const std::string title = settings.id + " (" + folder.filename().string() + ")";
+  ppo::ProgressLine progress(std::cout, ppo::ProgressLine::mode_for_stdout(args.quiet), 10,
+                             ppo::ProgressLine::stdout_columns());
+  const auto start = std::chrono::steady_clock::now();
+  const auto elapsed = [&] {
+    return wall_before +
+           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  const double time_limit_s = settings.minutes * 60.0;
+  ppo::ProgressStatus status;
+  const auto save_checkpoint = [&] {
+    ppo::write_checkpoint(run->checkpoint_path(trainer.updates()),
+                          checkpoint_blobs(trainer, returns, elapsed()));
+  };
+  while (trainer.env_steps() < settings.ppo.total_env_steps &&
+         (time_limit_s <= 0.0 || elapsed() - wall_before < time_limit_s)) {
+    const auto update_start = std::chrono::steady_clock::now();
+    const std::int64_t steps_before = trainer.env_steps();
+    const ppo::RolloutStats rollout = trainer.collect();
+    const ppo::UpdateStats update = trainer.update();
+    for (const ppo::Episode& episode : rollout.episodes) {
+      returns.push_back(episode.episode_return);
+      if (returns.size() > kReturnWindow) returns.pop_front();
+    }
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - update_start).count();
+    ppo::ProgressRow row;
+    row.steps = trainer.env_steps();
+    row.wall_time_s = elapsed();
+    row.fps = static_cast<double>(trainer.env_steps() - steps_before) / seconds;
+    row.episode_return_mean = mean_of(returns);
+    row.episode_return_std = std_of(returns);
+    row.policy_loss = update.policy_loss;
+    row.value_loss = update.value_loss;
+    row.entropy = update.entropy;
+    row.approx_kl = update.approx_kl;
+    row.clip_fraction = update.clip_fraction;
+    run->append_progress(row);
+    run->write_curve(title);
+    if (trainer.updates() % settings.checkpoint_every == 0) save_checkpoint();
+    status = {trainer.env_steps(), settings.ppo.total_env_steps, elapsed() - wall_before,
+              time_limit_s, row.fps, row.episode_return_mean};
+    progress.update(status);
+  }
+  progress.finish(status);
+  save_checkpoint();
+  env->close();
+
+  const fs::path video = run->path() / "final.mp4";
+  const Evaluation evaluation = evaluate(trainer.policy(), settings, settings.eval_episodes,
+                                         settings.ppo.seed + 1'000'000, false, video);
+  json summary;
+  summary["env_id"] = settings.id;
+  summary["env_steps"] = trainer.env_steps();
+  summary["updates"] = trainer.updates();
+  summary["wall_time_s"] = elapsed();
+  summary["evaluation"] = evaluation_json(evaluation, settings.ppo.seed + 1'000'000, false);
+  summary["video"] = video.filename().string();
+  run->write_summary(summary);
+  std::cout << "evaluation: return " << evaluation.mean << " +/- " << evaluation.std << " over "
+            << evaluation.returns.size() << " episodes\n"
+            << "wrote " << run->path().string() << "/{config.json, progress.csv, curve.png, "
+            << run->checkpoint_path(trainer.updates()).filename().string()
+            << ", final.mp4, summary.json}\n";
+  return 0;
+}
+
+CLI::App* add_run_options(CLI::App& train, TrainArguments& args) {
+  train.add_option("--config", args.config_file,
+                   "PPO settings as JSON (any subset of the fields; the rest keep their defaults: "
+                   "see examples/ppo/ppo.h, PpoConfig)");
+  train.add_option("--steps", args.steps,
+                   "Env steps to train for, all envs together (default: the config's "
+                   "total_env_steps, 1,000,000)");
+  train.add_option("--minutes", args.minutes,
+                   "Stop after this much wall time (then checkpoint, evaluate, write the video)");
+  return &train;
+}
+
+Command add_train(CLI::App& app) {
+  auto args = std::make_shared<TrainArguments>();
+  CLI::App* train = app.add_subcommand(
+      "train",
+      "Train a PPO policy from the env's observations (pixels included) and write a run folder: "
+      "config.json, progress.csv, curve.png, checkpoints, and at the end final.mp4 and "
+      "summary.json (an evaluation over seeded episodes)");
+  train->add_option("id", args->id, "Env id, e.g. CartPoleBalance-v0 (`pixelgym list` shows them)");
+  add_set_option(*train, args->sets);
+  add_wrap_option(*train, args->wraps);
+  add_run_options(*train, *args);
+  train->add_option("--out", args->out, "The run folder (default runs/ID); must not hold a run");
+  train->add_option("--resume", args->resume,
+                    "Continue the run in this folder from its latest valid checkpoint (its "
+                    "config.json gives the env and the settings; --steps and --minutes may "
+                    "change the budget)");
+  train->add_flag("--quiet", args->quiet,
+                  "No progress bar: a plain line every 10 updates (also when stdout is not a "
+                  "terminal)");
+  train->add_option("--seed", args->seed, "Seed for torch, the envs and augmentation (default 0)")
+      ->each([args](const std::string&) { args->seed_given = true; });
+  train->add_option("--num-envs", args->num_envs, "Envs stepped together (default 8)")
+      ->check(integer_in(1));
+  train->add_option("--threads", args->threads, "Env threads (AsyncVectorEnv)")
+      ->capture_default_str()
+      ->check(integer_in(1));
+  train->add_option("--checkpoint-every", args->checkpoint_every, "Updates between checkpoints")
+      ->capture_default_str()
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 40));
+  train->add_option("--eval-episodes", args->eval_episodes,
+                    "Seeded episodes of the final evaluation (deterministic actions)")
+      ->capture_default_str()
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 20));
+  return {train, [args, train] {
+            if (args->resume.empty() && args->id.empty()) {
+              throw UsageError("train: give an env id, or --resume RUN_FOLDER");
+            }
+            if (!args->resume.empty() &&
+                (!args->id.empty() || !args->sets.empty() || !args->wraps.empty() ||
+                 !args->config_file.empty() || !args->out.empty())) {
+              throw UsageError(
+                  "train --resume takes the env and settings from the run's config.json: give no "
+                  "id, --set, --wrap, --config or --out with it");
+            }
+            (void)train;
+            return run_train(*args);
+          }};
+}
+
+// --- eval ---
+
+struct EvalArguments {
+  std::string run;
+  std::int64_t episodes = 10;
+  std::uint64_t seed = 0;
+  std::string video;
+  bool stochastic = false;
+};
+
+int run_eval(const EvalArguments& args) {
+  const fs::path given(args.run);
+  fs::path checkpoint_path;
+  fs::path folder;
+  ppo::CheckpointBlobs blobs;
+  if (fs::is_directory(given)) {
+    folder = given;
+    const ppo::CheckpointSearch search = ppo::find_latest_checkpoint(folder);
+    for (const auto& skipped : search.skipped) {
+      std::cerr << "eval: skipping " << skipped.path.string() << ": " << skipped.reason << "\n";
+    }
+    if (!search.latest) throw std::runtime_error("eval: no valid checkpoint in " + args.run);
+    checkpoint_path = search.latest->path;
+    blobs = search.latest->blobs;
+  } else {
+    checkpoint_path = given;
+    folder = given.parent_path().empty() ? fs::path(".") : given.parent_path();
+    blobs = ppo::read_checkpoint(checkpoint_path);
+  }
+  std::ifstream config_file(folder / "config.json");
+  if (!config_file) {
+    throw std::runtime_error("eval: no config.json in " + folder.string() +
+                             " (the run folder the checkpoint belongs to)");
+  }
+  const RunSettings settings = settings_from_json(json::parse(config_file), folder / "config.json");
+  // The spaces come from one env built as the run's.
+  std::unique_ptr<Env> probe = wrappers::apply_wrappers(
+      make(settings.id, parse_sets(settings.id, settings.sets)), settings.wraps);
+  auto policy = std::make_shared<ppo::Policy>(probe->observation_space(), probe->action_space(),
+                                              settings.ppo.policy);
+  probe->close();
+  load_blob(blobs, "model", policy, checkpoint_path);
+  policy->eval();
+  std::optional<fs::path> video;
+  if (!args.video.empty()) video = fs::path(args.video);
+  const Evaluation evaluation =
+      evaluate(*policy, settings, args.episodes, args.seed, args.stochastic, video);
+  std::cout << checkpoint_path.string() << ": " << settings.id << ", " << args.episodes
+            << " episodes from seed " << args.seed
+            << (args.stochastic ? ", sampled actions" : ", deterministic actions") << "\n";
+  for (std::size_t e = 0; e < evaluation.returns.size(); ++e) {
+    std::cout << "episode " << e << ": return=" << evaluation.returns[e] << "\n";
+  }
+  std::cout << "return_mean=" << evaluation.mean << " return_std=" << evaluation.std << "\n";
+  if (video) std::cout << "wrote " << video->string() << "\n";
+  return 0;
+}
+
+Command add_eval(CLI::App& app) {
+  auto args = std::make_shared<EvalArguments>();
+  CLI::App* eval = app.add_subcommand(
+      "eval", "Evaluate a trained policy (a run folder's latest checkpoint, or a checkpoint "
+              "file) over seeded episodes: each return, then their mean and std");
+  eval->add_option("run", args->run, "Run folder or checkpoint file (.pgck)")->required();
+  eval->add_option("--episodes", args->episodes, "Episodes, seeded seed, seed + 1, ...")
+      ->capture_default_str()
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 20));
+  add_seed_option(*eval, args->seed, "Seed of the first episode");
+  eval->add_option("--video", args->video, "Record the first episode to this .mp4");
+  eval->add_flag("--stochastic", args->stochastic,
+                 "Sample actions from the policy instead of taking its mean / most likely one");
+  return {eval, [args] { return run_eval(*args); }};
+}
+
+}  // namespace
+
+std::vector<Command> add_train_commands(CLI::App& app) { return {add_train(app), add_eval(app)}; }
+
+}  // namespace pixelgym::cli

@@ -1,0 +1,542 @@
+#include "examples/ppo/ppo.h"
+
+#include <ATen/CPUGeneratorImpl.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <utility>
+
+#include "examples/ppo/gae.h"
+
+namespace pixelgym::ppo {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Rows `index` of every tensor of `obs` (dim 0).
+ObservationTensors select_rows(const ObservationTensors& obs, const torch::Tensor& index) {
+  ObservationTensors rows;
+  for (const auto& [key, tensor] : obs) rows.emplace(key, tensor.index_select(0, index));
+  return rows;
+}
+
+// from_json helpers: a member read into `field` with a clear error on a type mismatch.
+template <typename T>
+void read_member(const nlohmann::json& json, const char* name, T& field) {
+  auto found = json.find(name);
+  if (found == json.end()) return;
+  try {
+    field = found->get<T>();
+  } catch (const nlohmann::json::exception& error) {
+    throw std::invalid_argument(std::string("PpoConfig JSON: member \"") + name +
+                                "\" has the wrong type: " + error.what());
+  }
+}
+
+void require_known_members(const nlohmann::json& json, const std::vector<std::string>& known,
+                           const char* what) {
+  if (!json.is_object()) {
+    throw std::invalid_argument(std::string(what) + " JSON must be an object, got " +
+                                json.type_name());
+  }
+  for (const auto& item : json.items()) {
+    bool ok = false;
+    for (const std::string& name : known) ok = ok || item.key() == name;
+    if (!ok) {
+      std::string list;
+      for (const std::string& name : known) list += (list.empty() ? "" : ", ") + name;
+      throw std::invalid_argument(std::string(what) + " JSON: unknown member \"" + item.key() +
+                                  "\"; known: " + list);
+    }
+  }
+}
+
+}  // namespace
+
+// ---- PpoConfig -------------------------------------------------------------------------------
+
+void PpoConfig::validate() const {
+  auto fail = [](const std::string& what) { throw std::invalid_argument("PpoConfig: " + what); };
+  auto positive = [&](const char* name, double value) {
+    if (!(value > 0.0) || !std::isfinite(value)) {
+      fail(std::string(name) + " must be > 0 and finite, got " + std::to_string(value));
+    }
+  };
+  auto non_negative = [&](const char* name, double value) {
+    if (!(value >= 0.0) || !std::isfinite(value)) {
+      fail(std::string(name) + " must be >= 0 and finite, got " + std::to_string(value));
+    }
+  };
+  auto unit = [&](const char* name, double value) {
+    if (!(value >= 0.0 && value <= 1.0)) {
+      fail(std::string(name) + " must be in [0, 1], got " + std::to_string(value));
+    }
+  };
+  positive("num_envs", static_cast<double>(num_envs));
+  positive("num_steps", static_cast<double>(num_steps));
+  positive("total_env_steps", static_cast<double>(total_env_steps));
+  positive("learning_rate", learning_rate);
+  positive("adam_epsilon", adam_epsilon);
+  unit("gamma", gamma);
+  unit("gae_lambda", gae_lambda);
+  positive("update_epochs", static_cast<double>(update_epochs));
+  positive("num_minibatches", static_cast<double>(num_minibatches));
+  if (num_minibatches > 0 && (num_steps * num_envs) % num_minibatches != 0) {
+    fail("num_steps * num_envs (" + std::to_string(num_steps * num_envs) +
+         ") must be a multiple of num_minibatches (" + std::to_string(num_minibatches) + ")");
+  }
+  positive("clip_range", clip_range);
+  non_negative("entropy_coef", entropy_coef);
+  non_negative("value_coef", value_coef);
+  positive("max_grad_norm", max_grad_norm);
+  non_negative("target_kl", target_kl);
+  if (shift_pad < 0) fail("shift_pad must be >= 0, got " + std::to_string(shift_pad));
+  policy.validate();
+}
+
+void to_json(nlohmann::json& json, const PolicyConfig& config) {
+  json = nlohmann::json{{"cnn", to_string(config.cnn)},
+                        {"cnn_features", config.cnn_features},
+                        {"mlp_hidden", config.mlp_hidden},
+                        {"trunk_hidden", config.trunk_hidden},
+                        {"initial_log_std", config.initial_log_std},
+                        {"normalize_observations", config.normalize_observations},
+                        {"observation_clip", config.observation_clip}};
+}
+
+void from_json(const nlohmann::json& json, PolicyConfig& config) {
+  require_known_members(json,
+                        {"cnn", "cnn_features", "mlp_hidden", "trunk_hidden", "initial_log_std",
+                         "normalize_observations", "observation_clip"},
+                        "PolicyConfig");
+  std::string cnn = to_string(config.cnn);
+  read_member(json, "cnn", cnn);
+  config.cnn = parse_cnn_architecture(cnn);
+  read_member(json, "cnn_features", config.cnn_features);
+  read_member(json, "mlp_hidden", config.mlp_hidden);
+  read_member(json, "trunk_hidden", config.trunk_hidden);
+  read_member(json, "initial_log_std", config.initial_log_std);
+  read_member(json, "normalize_observations", config.normalize_observations);
+  read_member(json, "observation_clip", config.observation_clip);
+  config.validate();
+}
+
+void to_json(nlohmann::json& json, const PpoConfig& config) {
+  json = nlohmann::json{{"seed", config.seed},
+                        {"num_envs", config.num_envs},
+                        {"num_steps", config.num_steps},
+                        {"total_env_steps", config.total_env_steps},
+                        {"learning_rate", config.learning_rate},
+                        {"anneal_learning_rate", config.anneal_learning_rate},
+                        {"adam_epsilon", config.adam_epsilon},
+                        {"gamma", config.gamma},
+                        {"gae_lambda", config.gae_lambda},
+                        {"update_epochs", config.update_epochs},
+                        {"num_minibatches", config.num_minibatches},
+                        {"normalize_advantages", config.normalize_advantages},
+                        {"clip_range", config.clip_range},
+                        {"clip_value_loss", config.clip_value_loss},
+                        {"entropy_coef", config.entropy_coef},
+                        {"value_coef", config.value_coef},
+                        {"max_grad_norm", config.max_grad_norm},
+                        {"target_kl", config.target_kl},
+                        {"augment", config.augment},
+                        {"shift_pad", config.shift_pad},
+                        {"policy", config.policy}};
+}
+
+void from_json(const nlohmann::json& json, PpoConfig& config) {
+  require_known_members(json,
+                        {"seed",
+                         "num_envs",
+                         "num_steps",
+                         "total_env_steps",
+                         "learning_rate",
+                         "anneal_learning_rate",
+                         "adam_epsilon",
+                         "gamma",
+                         "gae_lambda",
+                         "update_epochs",
+                         "num_minibatches",
+                         "normalize_advantages",
+                         "clip_range",
+                         "clip_value_loss",
+                         "entropy_coef",
+                         "value_coef",
+                         "max_grad_norm",
+                         "target_kl",
+                         "augment",
+                         "shift_pad",
+                         "policy"},
+                        "PpoConfig");
+  read_member(json, "seed", config.seed);
+  read_member(json, "num_envs", config.num_envs);
+  read_member(json, "num_steps", config.num_steps);
+  read_member(json, "total_env_steps", config.total_env_steps);
+  read_member(json, "learning_rate", config.learning_rate);
+  read_member(json, "anneal_learning_rate", config.anneal_learning_rate);
+  read_member(json, "adam_epsilon", config.adam_epsilon);
+  read_member(json, "gamma", config.gamma);
+  read_member(json, "gae_lambda", config.gae_lambda);
+  read_member(json, "update_epochs", config.update_epochs);
+  read_member(json, "num_minibatches", config.num_minibatches);
+  read_member(json, "normalize_advantages", config.normalize_advantages);
+  read_member(json, "clip_range", config.clip_range);
+  read_member(json, "clip_value_loss", config.clip_value_loss);
+  read_member(json, "entropy_coef", config.entropy_coef);
+  read_member(json, "value_coef", config.value_coef);
+  read_member(json, "max_grad_norm", config.max_grad_norm);
+  read_member(json, "target_kl", config.target_kl);
+  read_member(json, "augment", config.augment);
+  read_member(json, "shift_pad", config.shift_pad);
+  if (auto found = json.find("policy"); found != json.end()) {
+    PolicyConfig policy = config.policy;
+    from_json(*found, policy);
+    config.policy = policy;
+  }
+  config.validate();
+}
+
+std::string config_to_json(const PpoConfig& config) { return nlohmann::json(config).dump(2); }
+
+PpoConfig config_from_json(const std::string& text) {
+  nlohmann::json json;
+  try {
+    json = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& error) {
+    throw std::invalid_argument(std::string("PpoConfig JSON: ") + error.what());
+  }
+  PpoConfig config;
+  from_json(json, config);
+  return config;
+}
+
+// ---- RolloutStorage --------------------------------------------------------------------------
+
+RolloutStorage::RolloutStorage(const Policy& policy, std::int64_t steps, std::int64_t envs)
+    : num_steps(steps), num_envs(envs) {
+  for (const PolicyInput& input : policy.inputs()) {
+    std::vector<std::int64_t> shape{steps, envs};
+    shape.insert(shape.end(), input.shape.begin(), input.shape.end());
+    observations.emplace(input.key, torch::zeros(shape, torch_dtype(input.dtype)));
+  }
+  if (policy.discrete()) {
+    actions = torch::zeros({steps, envs}, torch::kInt64);
+  } else {
+    std::vector<std::int64_t> shape{steps, envs};
+    shape.insert(shape.end(), policy.action_shape().begin(), policy.action_shape().end());
+    actions = torch::zeros(shape, torch::kFloat32);
+  }
+  log_probs = torch::zeros({steps, envs});
+  values = torch::zeros({steps, envs});
+  rewards = torch::zeros({steps, envs});
+  terminated = torch::zeros({steps, envs}, torch::kUInt8);
+  truncated = torch::zeros({steps, envs}, torch::kUInt8);
+  final_values = torch::zeros({steps, envs});
+  last_values = torch::zeros({envs});
+  advantages = torch::zeros({steps, envs});
+  returns = torch::zeros({steps, envs});
+}
+
+void RolloutStorage::insert_observations(std::int64_t t, const ObservationTensors& obs) {
+  for (auto& [key, stored] : observations) {
+    auto found = obs.find(key);
+    if (found == obs.end()) {
+      throw std::invalid_argument("RolloutStorage: the observation batch has no key \"" + key +
+                                  "\"");
+    }
+    stored[t].copy_(found->second);
+  }
+}
+
+void RolloutStorage::compute_advantages(double gamma, double lambda) {
+  const torch::Tensor r = rewards.contiguous();
+  const torch::Tensor v = values.contiguous();
+  const torch::Tensor term = terminated.contiguous();
+  const torch::Tensor trunc = truncated.contiguous();
+  const torch::Tensor fv = final_values.contiguous();
+  const torch::Tensor lv = last_values.contiguous();
+  GaeInputs in;
+  in.num_steps = num_steps;
+  in.num_envs = num_envs;
+  in.rewards = r.data_ptr<float>();
+  in.values = v.data_ptr<float>();
+  in.terminated = term.data_ptr<std::uint8_t>();
+  in.truncated = trunc.data_ptr<std::uint8_t>();
+  in.final_values = fv.data_ptr<float>();
+  in.last_values = lv.data_ptr<float>();
+  const GaeOutputs out = compute_gae(in, gamma, lambda);
+  std::memcpy(advantages.data_ptr<float>(), out.advantages.data(),
+              out.advantages.size() * sizeof(float));
+  std::memcpy(returns.data_ptr<float>(), out.returns.data(), out.returns.size() * sizeof(float));
+}
+
+ObservationTensors RolloutStorage::flat_observations() const {
+  ObservationTensors flat;
+  for (const auto& [key, stored] : observations) flat.emplace(key, stored.flatten(0, 1));
+  return flat;
+}
+
+// ---- Trainer ---------------------------------------------------------------------------------
+
+namespace {
+
+std::shared_ptr<Policy> make_policy(const vector::VectorEnv& env, const PpoConfig& config) {
+  config.validate();
+  if (env.autoreset_mode() != vector::AutoresetMode::kSameStep) {
+    throw std::invalid_argument(
+        std::string("Trainer: the vector env must autoreset in SameStep mode (truncated steps "
+                    "bootstrap from infos[\"final_obs\"]), got ") +
+        vector::autoreset_mode_name(env.autoreset_mode()));
+  }
+  if (env.num_envs() != config.num_envs) {
+    throw std::invalid_argument("Trainer: config.num_envs is " + std::to_string(config.num_envs) +
+                                " but the vector env has " + std::to_string(env.num_envs()));
+  }
+  torch::manual_seed(config.seed);
+  return std::make_shared<Policy>(env.single_observation_space(), env.single_action_space(),
+                                  config.policy);
+}
+
+}  // namespace
+
+Trainer::Trainer(vector::VectorEnv& env, PpoConfig config)
+    : env_(env),
+      config_(std::move(config)),
+      policy_(make_policy(env, config_)),
+      optimizer_(std::make_unique<torch::optim::Adam>(
+          policy_->parameters(),
+          torch::optim::AdamOptions(config_.learning_rate).eps(config_.adam_epsilon))),
+      storage_(*policy_, config_.num_steps, config_.num_envs),
+      sampling_(at::detail::createCPUGenerator(config_.seed)),
+      augmentation_(at::detail::createCPUGenerator(config_.seed + 1)),
+      actions_(env.action_space().zeros()),
+      episode_returns_(static_cast<std::size_t>(config_.num_envs), 0.0),
+      episode_lengths_(static_cast<std::size_t>(config_.num_envs), 0) {
+  if (!actions_.is_array()) {
+    throw std::invalid_argument("Trainer: the batched action space must be an array space, got " +
+                                env.action_space().to_string());
+  }
+}
+
+RolloutStats Trainer::collect() {
+  torch::NoGradGuard no_grad;
+  RolloutStats stats;
+  if (!started_) {
+    const auto start = Clock::now();
+    current_obs_ = observation_tensors(env_.reset(config_.seed).obs);
+    stats.env_seconds += seconds_since(start);
+    started_ = true;
+  }
+  Array& env_actions = actions_.array();
+  const std::int64_t envs = config_.num_envs;
+  for (std::int64_t t = 0; t < config_.num_steps; ++t) {
+    auto start = Clock::now();
+    const ActResult act = policy_->act(current_obs_, /*deterministic=*/false, sampling_);
+    stats.policy_seconds += seconds_since(start);
+    storage_.insert_observations(t, current_obs_);
+    storage_.actions[t].copy_(act.action);
+    storage_.log_probs[t].copy_(act.log_prob);
+    storage_.values[t].copy_(act.value);
+    const torch::Tensor env_action =
+        act.env_action.to(torch_dtype(env_actions.dtype())).contiguous();
+    if (static_cast<std::size_t>(env_action.nbytes()) != env_actions.nbytes()) {
+      throw std::logic_error("Trainer: the policy's actions do not match the action batch " +
+                             env_actions.to_string());
+    }
+    std::memcpy(env_actions.raw_data(), env_action.data_ptr(), env_actions.nbytes());
+
+    start = Clock::now();
+    const vector::VectorStepResult& step = env_.step(actions_);
+    stats.env_seconds += seconds_since(start);
+    const double* rewards = step.rewards.data<double>();
+    const bool* terminated = step.terminated.data<bool>();
+    const bool* truncated = step.truncated.data<bool>();
+    std::vector<std::int64_t> bootstrap;  // envs truncated (not terminated) in this step
+    for (std::int64_t n = 0; n < envs; ++n) {
+      const auto i = static_cast<std::size_t>(n);
+      storage_.rewards[t][n] = rewards[n];
+      storage_.terminated[t][n] = terminated[n] ? 1 : 0;
+      storage_.truncated[t][n] = truncated[n] ? 1 : 0;
+      storage_.final_values[t][n] = 0.0f;
+      episode_returns_[i] += rewards[n];
+      episode_lengths_[i] += 1;
+      if (terminated[n] || truncated[n]) {
+        stats.episodes.push_back({episode_returns_[i], episode_lengths_[i]});
+        episode_returns_[i] = 0.0;
+        episode_lengths_[i] = 0;
+        if (!terminated[n]) bootstrap.push_back(n);
+      }
+    }
+    if (!bootstrap.empty()) {
+      if (!step.infos.contains("final_obs")) {
+        throw std::logic_error("Trainer: a truncated step without infos[\"final_obs\"]");
+      }
+      start = Clock::now();
+      const torch::Tensor rows = torch::tensor(bootstrap, torch::kInt64);
+      const ObservationTensors final_obs =
+          select_rows(observation_tensors(step.infos.at("final_obs")), rows);
+      storage_.final_values[t].index_copy_(0, rows, policy_->value(final_obs));
+      stats.policy_seconds += seconds_since(start);
+    }
+    current_obs_ = observation_tensors(step.obs);
+  }
+  const auto start = Clock::now();
+  storage_.last_values.copy_(policy_->value(current_obs_));
+  stats.policy_seconds += seconds_since(start);
+  storage_.compute_advantages(config_.gamma, config_.gae_lambda);
+  env_steps_ += config_.num_steps * envs;
+  collected_ = true;
+  return stats;
+}
+
+double Trainer::learning_rate() const {
+  if (!config_.anneal_learning_rate) return config_.learning_rate;
+  // The steps done before the rollout being learned from: the first update uses the full rate.
+  const std::int64_t before =
+      collected_ ? env_steps_ - config_.num_steps * config_.num_envs : env_steps_;
+  const double remaining =
+      1.0 - static_cast<double>(before) / static_cast<double>(config_.total_env_steps);
+  return config_.learning_rate * std::max(remaining, 0.0);
+}
+
+UpdateStats Trainer::update() {
+  if (!collected_) throw std::logic_error("Trainer::update: no rollout collected since the last");
+  UpdateStats stats;
+  stats.learning_rate = learning_rate();
+  for (auto& group : optimizer_->param_groups()) {
+    static_cast<torch::optim::AdamOptions&>(group.options()).lr(stats.learning_rate);
+  }
+
+  const std::int64_t batch = config_.num_steps * config_.num_envs;
+  const std::int64_t minibatch = batch / config_.num_minibatches;
+  const ObservationTensors obs = storage_.flat_observations();
+  const torch::Tensor actions = storage_.actions.flatten(0, 1);
+  torch::Tensor old_log_probs = storage_.log_probs.flatten(0, 1);
+  torch::Tensor old_values = storage_.values.flatten(0, 1);
+  const torch::Tensor advantages = storage_.advantages.flatten(0, 1);
+  const torch::Tensor returns = storage_.returns.flatten(0, 1);
+
+  torch::Tensor shifts;
+  if (config_.augment) {
+    shifts = torch::randint(0, 2 * config_.shift_pad + 1, {batch, 2}, augmentation_, torch::kInt64);
+    // Old log-probs and values of the shifted images, so that the ratio starts at 1.
+    torch::NoGradGuard no_grad;
+    old_log_probs = torch::empty_like(old_log_probs);
+    old_values = torch::empty_like(old_values);
+    for (std::int64_t begin = 0; begin < batch; begin += minibatch) {
+      const torch::Tensor index = torch::arange(begin, begin + minibatch, torch::kInt64);
+      const Evaluation old =
+          policy_->evaluate(select_rows(obs, index), actions.index_select(0, index),
+                            shifts.index_select(0, index), config_.shift_pad);
+      old_log_probs.index_copy_(0, index, old.log_prob);
+      old_values.index_copy_(0, index, old.value);
+    }
+  }
+
+  const auto parameters = policy_->parameters();
+  bool stop = false;
+  for (std::int64_t epoch = 0; epoch < config_.update_epochs && !stop; ++epoch) {
+    const torch::Tensor order = torch::randperm(batch, sampling_, torch::kInt64);
+    for (std::int64_t m = 0; m < config_.num_minibatches; ++m) {
+      const torch::Tensor index = order.slice(0, m * minibatch, (m + 1) * minibatch);
+      const Evaluation now = policy_->evaluate(
+          select_rows(obs, index), actions.index_select(0, index),
+          shifts.defined() ? shifts.index_select(0, index) : torch::Tensor(), config_.shift_pad);
+      const torch::Tensor log_ratio = now.log_prob - old_log_probs.index_select(0, index);
+      const torch::Tensor ratio = log_ratio.exp();
+      torch::Tensor advantage = advantages.index_select(0, index);
+      if (config_.normalize_advantages && minibatch > 1) {
+        advantage = (advantage - advantage.mean()) / (advantage.std() + 1e-8);
+      }
+      const torch::Tensor policy_loss =
+          torch::max(-advantage * ratio,
+                     -advantage * ratio.clamp(1.0 - config_.clip_range, 1.0 + config_.clip_range))
+              .mean();
+      const torch::Tensor target = returns.index_select(0, index);
+      torch::Tensor value_loss;
+      if (config_.clip_value_loss) {
+        const torch::Tensor old = old_values.index_select(0, index);
+        const torch::Tensor clipped =
+            old + (now.value - old).clamp(-config_.clip_range, config_.clip_range);
+        value_loss =
+            0.5 * torch::max((now.value - target).pow(2), (clipped - target).pow(2)).mean();
+      } else {
+        value_loss = 0.5 * (now.value - target).pow(2).mean();
+      }
+      const torch::Tensor entropy = now.entropy.mean();
+      const torch::Tensor loss =
+          policy_loss - config_.entropy_coef * entropy + config_.value_coef * value_loss;
+
+      optimizer_->zero_grad();
+      loss.backward();
+      const double grad_norm = torch::nn::utils::clip_grad_norm_(parameters, config_.max_grad_norm);
+      optimizer_->step();
+
+      double approx_kl;
+      {
+        torch::NoGradGuard no_grad;
+        approx_kl = ((ratio - 1.0) - log_ratio).mean().item<double>();
+        stats.clip_fraction +=
+            ((ratio - 1.0).abs() > config_.clip_range).to(torch::kFloat32).mean().item<double>();
+      }
+      stats.policy_loss += policy_loss.item<double>();
+      stats.value_loss += value_loss.item<double>();
+      stats.entropy += entropy.item<double>();
+      stats.approx_kl += approx_kl;
+      stats.grad_norm += grad_norm;
+      stats.minibatches += 1;
+      if (config_.target_kl > 0.0 && approx_kl > config_.target_kl) {
+        stop = true;
+        break;
+      }
+    }
+    stats.epochs += 1;
+  }
+  const auto count = static_cast<double>(stats.minibatches);
+  stats.policy_loss /= count;
+  stats.value_loss /= count;
+  stats.entropy /= count;
+  stats.approx_kl /= count;
+  stats.clip_fraction /= count;
+  stats.grad_norm /= count;
+  {
+    const torch::Tensor values = storage_.values.flatten();
+    const torch::Tensor targets = storage_.returns.flatten();
+    const double variance = targets.var(/*unbiased=*/false).item<double>();
+    stats.explained_variance =
+        variance == 0.0
+            ? 0.0
+            : 1.0 - (targets - values).var(/*unbiased=*/false).item<double>() / variance;
+  }
+  policy_->update_observation_statistics(obs);
+  updates_ += 1;
+  collected_ = false;
+  return stats;
+}
+
+void Trainer::set_progress(std::int64_t env_steps, std::int64_t updates) {
+  if (env_steps < 0 || updates < 0) {
+    throw std::invalid_argument("Trainer::set_progress: counts must be >= 0");
+  }
+  env_steps_ = env_steps;
+  updates_ = updates;
+}
+
+TrainerRngState Trainer::rng_state() const {
+  return {sampling_.get_state(), augmentation_.get_state()};
+}
+
+void Trainer::set_rng_state(const TrainerRngState& state) {
+  sampling_.set_state(state.sampling);
+  augmentation_.set_state(state.augmentation);
+}
+
+}  // namespace pixelgym::ppo

@@ -1,0 +1,223 @@
+// PPO (Schulman et al. 2017) on a vector env: the config, the rollout storage, the clipped
+// update, and a Trainer that collects rollouts and updates a Policy.
+#pragma once
+
+#include <torch/torch.h>
+
+#include <cstdint>
+#include <memory>
+#include <nlohmann/json_fwd.hpp>
+#include <string>
+#include <vector>
+
+#include "envs/vector/vector_env.h"
+#include "examples/ppo/policy.h"
+
+namespace pixelgym::ppo {
+
+/// Every setting of a training run. Defaults follow CleanRL's PPO for pixel inputs (Atari)
+/// where they apply; `validate()` checks every field.
+struct PpoConfig {
+  /// Seeds torch (weights, action sampling, minibatch order), the augmentation generator, and
+  /// the envs (env i resets with seed + i).
+  std::uint64_t seed = 0;
+  /// Envs stepped together (must equal the vector env's num_envs) and steps per env per
+  /// rollout: a rollout is num_steps * num_envs transitions.
+  std::int64_t num_envs = 8;
+  std::int64_t num_steps = 128;
+  /// The run's length in env steps (summed over envs): the learning rate anneals to 0 over it.
+  std::int64_t total_env_steps = 1'000'000;
+  /// Adam's learning rate at the start, annealed linearly to 0 over total_env_steps when
+  /// anneal_learning_rate.
+  double learning_rate = 2.5e-4;
+  bool anneal_learning_rate = true;
+  /// Adam's epsilon.
+  double adam_epsilon = 1e-5;
+  /// Discount and GAE lambda.
+  double gamma = 0.99;
+  double gae_lambda = 0.95;
+  /// Passes over the rollout per update, and minibatches per pass (num_steps * num_envs must
+  /// be a multiple of it).
+  std::int64_t update_epochs = 4;
+  std::int64_t num_minibatches = 4;
+  /// Standardize advantages within each minibatch.
+  bool normalize_advantages = true;
+  /// The surrogate's clip range epsilon: the ratio is clipped to [1 - eps, 1 + eps].
+  double clip_range = 0.1;
+  /// Clip the value loss around the rollout's values with the same range (CleanRL's clip_vloss).
+  bool clip_value_loss = true;
+  /// Loss = policy loss - entropy_coef * entropy + value_coef * value loss.
+  double entropy_coef = 0.01;
+  double value_coef = 0.5;
+  /// Gradients are rescaled to this global L2 norm at most.
+  double max_grad_norm = 0.5;
+  /// Stop an update's epochs early once a minibatch's approximate KL exceeds it; 0: never.
+  double target_kl = 0.0;
+  /// DrQ's random shift of every image key during updates (see Trainer::update), by up to
+  /// shift_pad pixels each way.
+  bool augment = false;
+  std::int64_t shift_pad = 4;
+  /// The network, and the observation normalization of the vector keys
+  /// (policy.normalize_observations, policy.observation_clip).
+  PolicyConfig policy;
+
+  /// Throws std::invalid_argument naming the first field out of range and its value.
+  void validate() const;
+};
+
+/// JSON form of PpoConfig: an object with one member per field, named as the fields, the CNN as
+/// "nature" / "small", `policy` a nested object. from_json takes any subset of the members (the
+/// rest keep their defaults) and throws std::invalid_argument for an unknown member (listing
+/// the known ones), a member of the wrong type, or a config that fails validate().
+void to_json(nlohmann::json& json, const PpoConfig& config);
+void from_json(const nlohmann::json& json, PpoConfig& config);
+void to_json(nlohmann::json& json, const PolicyConfig& config);
+void from_json(const nlohmann::json& json, PolicyConfig& config);
+/// The config as JSON text (2-space indent) and back (throws as from_json, or for bad JSON).
+std::string config_to_json(const PpoConfig& config);
+PpoConfig config_from_json(const std::string& text);
+
+/// One rollout of num_steps x num_envs transitions, as tensors (step-major: [t][n]).
+///
+/// The rollout is collected under SameStep autoreset (see GaeInputs): observations[t] is what
+/// step t acted in; after a step that ended an episode, observations[t + 1] is the next
+/// episode's first observation.
+struct RolloutStorage {
+  /// Allocates everything for `policy`'s inputs and actions.
+  RolloutStorage(const Policy& policy, std::int64_t num_steps, std::int64_t num_envs);
+
+  std::int64_t num_steps;
+  std::int64_t num_envs;
+  /// Per key: (T, N, *shape) in the key's dtype (images stay uint8).
+  ObservationTensors observations;
+  /// ActResult::action: int64 (T, N) or float32 (T, N, *shape).
+  torch::Tensor actions;
+  /// float32 (T, N): log pi_old(a_t | s_t), V_old(s_t), r_t.
+  torch::Tensor log_probs;
+  torch::Tensor values;
+  torch::Tensor rewards;
+  /// uint8 (T, N): the step's flags.
+  torch::Tensor terminated;
+  torch::Tensor truncated;
+  /// float32 (T, N): V(final observation) where truncated and not terminated, else 0.
+  torch::Tensor final_values;
+  /// float32 (N,): V(s_T).
+  torch::Tensor last_values;
+  /// float32 (T, N), filled by compute_advantages.
+  torch::Tensor advantages;
+  torch::Tensor returns;
+
+  /// Copies a batch of N observations (as observation_tensors gives) into step t.
+  void insert_observations(std::int64_t t, const ObservationTensors& obs);
+  /// compute_gae over the stored rollout into advantages and returns.
+  void compute_advantages(double gamma, double lambda);
+  /// Every stored observation flattened to (T N, *shape), sharing memory.
+  ObservationTensors flat_observations() const;
+};
+
+/// What an update did, averaged over the minibatches it ran (CleanRL's logged quantities).
+struct UpdateStats {
+  double policy_loss = 0.0;         // the clipped surrogate loss (minimized)
+  double value_loss = 0.0;          // 0.5 (V - return)^2 (clipped form when clip_value_loss)
+  double entropy = 0.0;             // mean policy entropy
+  double approx_kl = 0.0;           // mean of (ratio - 1) - log ratio (Schulman's k3 estimator)
+  double clip_fraction = 0.0;       // fraction of samples with |ratio - 1| > clip_range
+  double explained_variance = 0.0;  // 1 - Var(returns - values) / Var(returns) of the rollout
+  double grad_norm = 0.0;           // mean global gradient norm before clipping
+  double learning_rate = 0.0;       // the learning rate used
+  std::int64_t epochs = 0;          // epochs run (fewer than update_epochs after a target_kl stop)
+  std::int64_t minibatches = 0;     // minibatches run
+};
+
+/// An episode that ended during a rollout: the sum of the env's raw rewards and its length.
+struct Episode {
+  double episode_return = 0.0;
+  std::int64_t length = 0;
+};
+
+/// What a rollout did.
+struct RolloutStats {
+  std::vector<Episode> episodes;  // in the order they ended (step, then env index)
+  double env_seconds = 0.0;       // in VectorEnv::step / reset
+  double policy_seconds = 0.0;    // in forward passes (act, final and last values)
+};
+
+/// The generator states a resume needs beside the model, the optimizer and the env: the
+/// generator of action sampling and minibatch order, and the augmentation generator (CPU
+/// generator states, as at::Generator::get_state gives).
+struct TrainerRngState {
+  torch::Tensor sampling;
+  torch::Tensor augmentation;
+};
+
+/// Trains a Policy with PPO on a vector env: `collect()` steps the env for one rollout,
+/// `update()` learns from it; `iterate()` does both.
+///
+/// The vector env must autoreset in SameStep mode (make_vec's VectorOptions::autoreset =
+/// AutoresetMode::kSameStep): a truncated step's final observation comes from
+/// infos["final_obs"], whose value bootstraps the step's return (see compute_gae). Its
+/// num_envs must equal config.num_envs. The trainer keeps a reference to the env; the env must
+/// outlive it, and nobody else may step it in between.
+///
+/// Determinism: the constructor calls torch::manual_seed(config.seed) before building the
+/// policy (its weights come from torch's default generator); action sampling and minibatch
+/// order draw from a generator of the trainer's own seeded with config.seed, augmentation
+/// from another seeded with config.seed + 1; the envs reset with config.seed on the first
+/// collect(). Same seed, same env, same torch thread count: same parameters.
+///
+/// Observation normalization: after each update the rollout's observations are merged into
+/// the policy's statistics (Policy::update_observation_statistics), so the next rollout acts
+/// and learns with the same statistics.
+class Trainer {
+ public:
+  /// Throws std::invalid_argument when config.validate() fails, when the env's autoreset mode
+  /// is not SameStep or its num_envs differs from config.num_envs, and as Policy's constructor.
+  Trainer(vector::VectorEnv& env, PpoConfig config);
+
+  /// Steps every env num_steps times with actions sampled from the policy (no gradients),
+  /// storing the transitions and the values GAE needs, then computes advantages and returns.
+  /// The first call resets the envs with config.seed.
+  RolloutStats collect();
+  /// config.update_epochs passes of minibatch PPO over the last rollout; then merges its
+  /// observations into the observation statistics. The learning rate is set first, from the
+  /// env steps done before the rollout (annealing). With augmentation, one random shift per
+  /// transition is drawn for the whole update and the rollout's old log-probs and values are
+  /// recomputed under it (no gradients), so the ratio starts at 1 on the shifted images.
+  /// Throws std::logic_error before any collect().
+  UpdateStats update();
+
+  Policy& policy() { return *policy_; }
+  const std::shared_ptr<Policy>& policy_ptr() const { return policy_; }
+  torch::optim::Adam& optimizer() { return *optimizer_; }
+  const RolloutStorage& storage() const { return storage_; }
+  const PpoConfig& config() const { return config_; }
+  /// Env steps collected so far (summed over envs) and updates done; set them on resume.
+  std::int64_t env_steps() const { return env_steps_; }
+  std::int64_t updates() const { return updates_; }
+  void set_progress(std::int64_t env_steps, std::int64_t updates);
+  /// The learning rate the next update uses.
+  double learning_rate() const;
+
+  TrainerRngState rng_state() const;
+  /// Throws std::invalid_argument (from torch) for a state that is not a CPU generator state.
+  void set_rng_state(const TrainerRngState& state);
+
+ private:
+  vector::VectorEnv& env_;
+  PpoConfig config_;
+  std::shared_ptr<Policy> policy_;
+  std::unique_ptr<torch::optim::Adam> optimizer_;
+  RolloutStorage storage_;
+  at::Generator sampling_;
+  at::Generator augmentation_;
+  Value actions_;                   // laid out as env_.action_space()
+  ObservationTensors current_obs_;  // views of the env's observation batch
+  std::vector<double> episode_returns_;
+  std::vector<std::int64_t> episode_lengths_;
+  bool started_ = false;
+  bool collected_ = false;
+  std::int64_t env_steps_ = 0;
+  std::int64_t updates_ = 0;
+};
+
+}  // namespace pixelgym::ppo

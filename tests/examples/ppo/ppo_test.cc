@@ -1,0 +1,375 @@
+// PpoConfig's JSON form, RolloutStorage as the Trainer fills it (truncation bootstrapping from
+// infos["final_obs"], episode boundaries), and the Trainer: it learns a bandit (Discrete and
+// Box), its first minibatch starts at ratio 1 (with and without augmentation), it is
+// deterministic under a seed, and its generator states resume its randomness.
+#include "examples/ppo/ppo.h"
+
+#include <ATen/CPUGeneratorImpl.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "envs/env.h"
+#include "envs/spaces/box.h"
+#include "envs/spaces/discrete.h"
+#include "envs/vector/sync_vector_env.h"
+#include "tests/wrappers/scripted_env.h"
+
+namespace pixelgym::ppo {
+namespace {
+
+using vector::AutoresetMode;
+using vector::SyncVectorEnv;
+
+// One-step episodes with a constant observation [0.5]. Discrete(2): reward 1 for action 1, 0
+// for action 0. Box [-1, 1]: reward -(a - 0.5)^2.
+class BanditEnv final : public Env {
+ public:
+  explicit BanditEnv(bool continuous)
+      : continuous_(continuous),
+        observation_space_(std::make_shared<spaces::Box>(-1.0, 1.0, Shape{1})),
+        action_space_(continuous ? SpacePtr(std::make_shared<spaces::Box>(-1.0, 1.0, Shape{1}))
+                                 : SpacePtr(std::make_shared<spaces::Discrete>(2))) {
+    metadata_.render_fps = 30.0;
+  }
+  const Space& observation_space() const override { return *observation_space_; }
+  const Space& action_space() const override { return *action_space_; }
+  const Metadata& metadata() const override { return metadata_; }
+
+ protected:
+  void do_reset(std::optional<std::uint64_t> /*seed*/, const Options& /*options*/,
+                ResetResult& out) override {
+    out.obs.array().data<float>()[0] = 0.5f;
+  }
+  void do_step(const Value& action, StepResult& out) override {
+    if (continuous_) {
+      const double a = action.array().data<float>()[0];
+      out.reward = -(a - 0.5) * (a - 0.5);
+    } else {
+      out.reward = action.array().item<std::int64_t>() == 1 ? 1.0 : 0.0;
+    }
+    out.obs.array().data<float>()[0] = 0.5f;
+    out.terminated = true;
+  }
+  Array do_render() override { return Array(DType::kUInt8, {4, 4, 3}); }
+
+ private:
+  bool continuous_;
+  SpacePtr observation_space_;
+  SpacePtr action_space_;
+  Metadata metadata_;
+};
+
+// Observation [t / 10] at step t of an episode of `length` steps, reward 1, ended by truncation
+// or termination.
+class CounterEnv final : public Env {
+ public:
+  CounterEnv(int length, bool truncate) : length_(length), truncate_(truncate) {
+    metadata_.render_fps = 30.0;
+  }
+  const Space& observation_space() const override { return observation_space_; }
+  const Space& action_space() const override { return action_space_; }
+  const Metadata& metadata() const override { return metadata_; }
+
+ protected:
+  void do_reset(std::optional<std::uint64_t> /*seed*/, const Options& /*options*/,
+                ResetResult& out) override {
+    t_ = 0;
+    out.obs.array().data<float>()[0] = 0.0f;
+  }
+  void do_step(const Value& /*action*/, StepResult& out) override {
+    ++t_;
+    out.obs.array().data<float>()[0] = static_cast<float>(t_) / 10.0f;
+    out.reward = 1.0;
+    out.terminated = t_ >= length_ && !truncate_;
+    out.truncated = t_ >= length_ && truncate_;
+  }
+  Array do_render() override { return Array(DType::kUInt8, {4, 4, 3}); }
+
+ private:
+  int length_;
+  bool truncate_;
+  int t_ = 0;
+  spaces::Box observation_space_{-1.0, 1.0, Shape{1}};
+  spaces::Discrete action_space_{2};
+  Metadata metadata_;
+};
+
+std::unique_ptr<SyncVectorEnv> bandit_envs(int n, bool continuous) {
+  return std::make_unique<SyncVectorEnv>(
+      n, [continuous](int) { return std::make_unique<BanditEnv>(continuous); },
+      AutoresetMode::kSameStep);
+}
+
+PpoConfig small_config(std::int64_t envs, std::int64_t steps) {
+  PpoConfig config;
+  config.num_envs = envs;
+  config.num_steps = steps;
+  config.num_minibatches = 2;
+  config.policy.mlp_hidden = {16};
+  config.policy.trunk_hidden = 16;
+  return config;
+}
+
+double probability_of_action_one(Policy& policy) {
+  torch::NoGradGuard no_grad;
+  const ObservationTensors obs{{"", torch::full({1, 1}, 0.5f)}};
+  return policy.evaluate(obs, torch::ones({1}, torch::kInt64)).log_prob.exp().item<double>();
+}
+
+std::vector<torch::Tensor> parameters_of(Policy& policy) {
+  std::vector<torch::Tensor> copies;
+  for (const auto& p : policy.parameters()) copies.push_back(p.detach().clone());
+  return copies;
+}
+
+bool same_parameters(const std::vector<torch::Tensor>& a, const std::vector<torch::Tensor>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (!torch::equal(a[i], b[i])) return false;
+  }
+  return true;
+}
+
+TEST(PpoConfig, JsonRoundTripKeepsEveryField) {
+  PpoConfig config;
+  config.seed = 12345678901234ULL;
+  config.num_envs = 3;
+  config.num_steps = 20;
+  config.total_env_steps = 7777;
+  config.learning_rate = 1e-3;
+  config.anneal_learning_rate = false;
+  config.adam_epsilon = 1e-7;
+  config.gamma = 0.95;
+  config.gae_lambda = 0.9;
+  config.update_epochs = 3;
+  config.num_minibatches = 5;
+  config.normalize_advantages = false;
+  config.clip_range = 0.3;
+  config.clip_value_loss = false;
+  config.entropy_coef = 0.02;
+  config.value_coef = 0.25;
+  config.max_grad_norm = 1.5;
+  config.target_kl = 0.05;
+  config.augment = true;
+  config.shift_pad = 2;
+  config.policy.cnn = CnnArchitecture::kNature;
+  config.policy.cnn_features = 128;
+  config.policy.mlp_hidden = {32, 16, 8};
+  config.policy.trunk_hidden = 0;
+  config.policy.initial_log_std = -0.5;
+  config.policy.normalize_observations = false;
+  config.policy.observation_clip = 5.0;
+  const std::string text = config_to_json(config);
+  const PpoConfig back = config_from_json(text);
+  EXPECT_EQ(config_to_json(back), text);
+  EXPECT_EQ(back.seed, config.seed);
+  EXPECT_EQ(back.policy.cnn, CnnArchitecture::kNature);
+  EXPECT_EQ(back.policy.mlp_hidden, config.policy.mlp_hidden);
+  EXPECT_DOUBLE_EQ(back.adam_epsilon, 1e-7);
+  // Every field is a member (one per field of the structs, policy nested).
+  const nlohmann::json json = nlohmann::json::parse(text);
+  EXPECT_EQ(json.size(), 21u);
+  EXPECT_EQ(json.at("policy").size(), 7u);
+  EXPECT_EQ(json.at("policy").at("cnn"), "nature");
+}
+
+TEST(PpoConfig, JsonTakesASubsetAndRefusesUnknownOrIllTypedMembers) {
+  const PpoConfig partial = config_from_json(R"({"gamma": 0.5, "policy": {"cnn": "nature"}})");
+  EXPECT_DOUBLE_EQ(partial.gamma, 0.5);
+  EXPECT_EQ(partial.num_steps, PpoConfig().num_steps);
+  EXPECT_EQ(partial.policy.cnn, CnnArchitecture::kNature);
+  EXPECT_EQ(partial.policy.cnn_features, PolicyConfig().cnn_features);
+  try {
+    config_from_json(R"({"gama": 0.5})");
+    FAIL() << "an unknown member was accepted";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("\"gama\""), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("gamma"), std::string::npos) << error.what();
+  }
+  EXPECT_THROW(config_from_json(R"({"gamma": "high"})"), std::invalid_argument);
+  EXPECT_THROW(config_from_json(R"({"policy": {"cnn": "resnet"}})"), std::invalid_argument);
+  EXPECT_THROW(config_from_json(R"({"gamma": 1.5})"), std::invalid_argument);
+  EXPECT_THROW(config_from_json(R"({"num_minibatches": 3})"), std::invalid_argument);  // 1024 % 3
+  EXPECT_THROW(config_from_json("{"), std::invalid_argument);
+}
+
+TEST(Trainer, RequiresSameStepAutoresetAndMatchingNumEnvs) {
+  SyncVectorEnv next_step(
+      2, [](int) { return std::make_unique<BanditEnv>(false); }, AutoresetMode::kNextStep);
+  EXPECT_THROW(Trainer(next_step, small_config(2, 4)), std::invalid_argument);
+  auto envs = bandit_envs(2, false);
+  EXPECT_THROW(Trainer(*envs, small_config(3, 4)), std::invalid_argument);
+  Trainer trainer(*envs, small_config(2, 4));
+  EXPECT_THROW(trainer.update(), std::logic_error);  // nothing collected yet
+}
+
+// Episodes of 3 steps, rollouts of 5 steps, 2 envs: steps 0-2 are episode 1 (ending at t = 2),
+// steps 3-4 begin episode 2.
+TEST(Trainer, TruncatedStepsBootstrapFromTheFinalObservationsValue) {
+  for (const bool truncate : {true, false}) {
+    SCOPED_TRACE(truncate ? "truncated" : "terminated");
+    SyncVectorEnv envs(
+        2, [truncate](int) { return std::make_unique<CounterEnv>(3, truncate); },
+        AutoresetMode::kSameStep);
+    PpoConfig config = small_config(2, 5);
+    config.num_minibatches = 1;
+    Trainer trainer(envs, config);
+    const RolloutStats stats = trainer.collect();
+    ASSERT_EQ(stats.episodes.size(), 2u);
+    EXPECT_DOUBLE_EQ(stats.episodes[0].episode_return, 3.0);
+    EXPECT_EQ(stats.episodes[0].length, 3);
+    const RolloutStorage& s = trainer.storage();
+    const torch::Tensor final_value =
+        trainer.policy().value({{"", torch::full({1, 1}, 0.3f)}});  // obs at t = 3
+    for (int t = 0; t < 5; ++t) {
+      for (int n = 0; n < 2; ++n) {
+        const bool end = t == 2;
+        EXPECT_EQ(s.truncated[t][n].item<int>(), end && truncate ? 1 : 0);
+        EXPECT_EQ(s.terminated[t][n].item<int>(), end && !truncate ? 1 : 0);
+        const float expected = end && truncate ? final_value.item<float>() : 0.0f;
+        EXPECT_FLOAT_EQ(s.final_values[t][n].item<float>(), expected) << t << " " << n;
+        // SameStep: the step after the end acts in the next episode's first observation.
+        EXPECT_FLOAT_EQ(s.observations.at("")[t][n][0].item<float>(),
+                        static_cast<float>(t % 3) / 10.0f);
+      }
+    }
+    // The episode's last advantage: r + gamma V(final) - V(s_2) (truncated) or r - V(s_2).
+    const double gamma = config.gamma;
+    const double v2 = s.values[2][0].item<double>();
+    const double expected = 1.0 + (truncate ? gamma * final_value.item<double>() : 0.0) - v2;
+    EXPECT_NEAR(s.advantages[2][0].item<double>(), expected, 1e-5);
+  }
+}
+
+TEST(Trainer, LearnsTheRewardedActionOfADiscreteBandit) {
+  auto envs = bandit_envs(4, false);
+  PpoConfig config = small_config(4, 16);
+  config.learning_rate = 1e-2;
+  config.entropy_coef = 0.0;
+  Trainer trainer(*envs, config);
+  const double before = probability_of_action_one(trainer.policy());
+  EXPECT_NEAR(before, 0.5, 0.05);
+  double mean_return = 0.0;
+  for (int i = 0; i < 12; ++i) {
+    const RolloutStats rollout = trainer.collect();
+    mean_return = 0.0;
+    for (const Episode& e : rollout.episodes) mean_return += e.episode_return;
+    mean_return /= static_cast<double>(rollout.episodes.size());
+    const UpdateStats stats = trainer.update();
+    EXPECT_TRUE(std::isfinite(stats.policy_loss));
+    EXPECT_EQ(stats.minibatches, config.update_epochs * config.num_minibatches);
+  }
+  EXPECT_GT(probability_of_action_one(trainer.policy()), 0.95);
+  EXPECT_GT(mean_return, 0.85);
+  EXPECT_EQ(trainer.env_steps(), 12 * 64);
+  EXPECT_EQ(trainer.updates(), 12);
+}
+
+TEST(Trainer, MovesTheGaussianMeanToTheBestActionOfAContinuousBandit) {
+  auto envs = bandit_envs(4, true);
+  PpoConfig config = small_config(4, 32);
+  config.learning_rate = 1e-2;
+  config.entropy_coef = 0.0;
+  config.policy.initial_log_std = -1.0;
+  Trainer trainer(*envs, config);
+  const ObservationTensors obs{{"", torch::full({1, 1}, 0.5f)}};
+  auto mean_action = [&] {
+    torch::NoGradGuard no_grad;
+    return trainer.policy().act(obs, true).action.item<double>();
+  };
+  EXPECT_NEAR(mean_action(), 0.0, 0.05);
+  for (int i = 0; i < 20; ++i) {
+    trainer.collect();
+    trainer.update();
+  }
+  EXPECT_NEAR(mean_action(), 0.5, 0.1);
+}
+
+TEST(Trainer, FirstMinibatchStartsAtRatioOneWithAndWithoutAugmentation) {
+  for (const bool augment : {false, true}) {
+    SCOPED_TRACE(augment ? "augment" : "no augmentation");
+    SyncVectorEnv envs(
+        2,
+        [](int) {
+          auto env = std::make_unique<testing::ScriptedEnv>(
+              testing::box(0, 255, {36, 36, 3}, DType::kUInt8),
+              std::make_shared<spaces::Discrete>(3), /*episode_length=*/3, /*truncate=*/true);
+          env->record = false;
+          return env;
+        },
+        AutoresetMode::kSameStep);
+    PpoConfig config = small_config(2, 4);
+    config.num_minibatches = 1;
+    config.update_epochs = 1;
+    config.augment = augment;
+    Trainer trainer(envs, config);
+    trainer.collect();
+    const UpdateStats stats = trainer.update();
+    EXPECT_NEAR(stats.approx_kl, 0.0, 1e-7);
+    EXPECT_DOUBLE_EQ(stats.clip_fraction, 0.0);
+    EXPECT_TRUE(std::isfinite(stats.value_loss));
+  }
+}
+
+TEST(Trainer, SameSeedSameParametersAndRngStateResumesTheRandomness) {
+  auto run = [](std::uint64_t seed) {
+    auto envs = bandit_envs(2, true);
+    PpoConfig config = small_config(2, 8);
+    config.seed = seed;
+    Trainer trainer(*envs, config);
+    for (int i = 0; i < 2; ++i) {
+      trainer.collect();
+      trainer.update();
+    }
+    return parameters_of(trainer.policy());
+  };
+  EXPECT_TRUE(same_parameters(run(3), run(3)));
+  EXPECT_FALSE(same_parameters(run(3), run(4)));
+
+  // The update's randomness (minibatch order) is the generator state's alone: a trainer whose
+  // generator drew differently and was then set to A's state updates as A does.
+  auto envs_a = bandit_envs(2, true);
+  auto envs_b = bandit_envs(2, true);
+  PpoConfig config = small_config(2, 8);
+  Trainer a(*envs_a, config);
+  Trainer b(*envs_b, config);
+  a.collect();
+  b.collect();
+  const TrainerRngState state = a.rng_state();
+  b.set_rng_state({at::detail::createCPUGenerator(99).get_state(), state.augmentation});
+  b.update();  // a different order
+  auto envs_d = bandit_envs(2, true);
+  Trainer d(*envs_d, config);
+  d.collect();
+  d.set_rng_state(state);
+  a.update();
+  d.update();
+  EXPECT_TRUE(same_parameters(parameters_of(a.policy()), parameters_of(d.policy())));
+  EXPECT_FALSE(same_parameters(parameters_of(a.policy()), parameters_of(b.policy())));
+}
+
+TEST(Trainer, LearningRateAnnealsLinearlyOverTheRun) {
+  auto envs = bandit_envs(2, false);
+  PpoConfig config = small_config(2, 8);
+  config.total_env_steps = 64;  // 4 rollouts of 16
+  Trainer trainer(*envs, config);
+  std::vector<double> rates;
+  for (int i = 0; i < 4; ++i) {
+    trainer.collect();
+    rates.push_back(trainer.update().learning_rate);
+  }
+  const double lr = config.learning_rate;
+  EXPECT_DOUBLE_EQ(rates[0], lr);
+  EXPECT_DOUBLE_EQ(rates[1], lr * 0.75);
+  EXPECT_DOUBLE_EQ(rates[3], lr * 0.25);
+  EXPECT_DOUBLE_EQ(trainer.optimizer().param_groups()[0].options().get_lr(), lr * 0.25);
+}
+
+}  // namespace
+}  // namespace pixelgym::ppo
