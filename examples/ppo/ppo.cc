@@ -288,7 +288,9 @@ ObservationTensors RolloutStorage::flat_observations() const {
 
 namespace {
 
-std::shared_ptr<Policy> make_policy(const vector::VectorEnv& env, const PpoConfig& config) {
+// A VectorEnv or a VectorWrapper: the same public methods, no common base.
+template <typename Env>
+std::shared_ptr<Policy> make_policy(const Env& env, const PpoConfig& config) {
   config.validate();
   if (env.autoreset_mode() != vector::AutoresetMode::kSameStep) {
     throw std::invalid_argument(
@@ -308,22 +310,38 @@ std::shared_ptr<Policy> make_policy(const vector::VectorEnv& env, const PpoConfi
 }  // namespace
 
 Trainer::Trainer(vector::VectorEnv& env, PpoConfig config)
+    : Trainer(&env, nullptr, std::move(config)) {}
+
+Trainer::Trainer(vector::VectorWrapper& env, PpoConfig config)
+    : Trainer(nullptr, &env, std::move(config)) {}
+
+Trainer::Trainer(vector::VectorEnv* env, vector::VectorWrapper* wrapper, PpoConfig config)
     : env_(env),
+      wrapper_(wrapper),
       config_(std::move(config)),
-      policy_(make_policy(env, config_)),
+      policy_(env != nullptr ? make_policy(*env, config_) : make_policy(*wrapper, config_)),
       optimizer_(std::make_unique<torch::optim::Adam>(
           policy_->parameters(),
           torch::optim::AdamOptions(config_.learning_rate).eps(config_.adam_epsilon))),
       storage_(*policy_, config_.num_steps, config_.num_envs),
       sampling_(at::detail::createCPUGenerator(config_.seed)),
       augmentation_(at::detail::createCPUGenerator(config_.seed + 1)),
-      actions_(env.action_space().zeros()),
+      actions_(env != nullptr ? env->action_space().zeros() : wrapper->action_space().zeros()),
       episode_returns_(static_cast<std::size_t>(config_.num_envs), 0.0),
       episode_lengths_(static_cast<std::size_t>(config_.num_envs), 0) {
   if (!actions_.is_array()) {
-    throw std::invalid_argument("Trainer: the batched action space must be an array space, got " +
-                                env.action_space().to_string());
+    throw std::invalid_argument(
+        "Trainer: the batched action space must be an array space, got " +
+        (env != nullptr ? env->action_space() : wrapper->action_space()).to_string());
   }
+}
+
+const vector::VectorResetResult& Trainer::reset_env(std::uint64_t seed) {
+  return env_ != nullptr ? env_->reset(seed) : wrapper_->reset(seed);
+}
+
+const vector::VectorStepResult& Trainer::step_env(const Value& actions) {
+  return env_ != nullptr ? env_->step(actions) : wrapper_->step(actions);
 }
 
 RolloutStats Trainer::collect() {
@@ -331,7 +349,7 @@ RolloutStats Trainer::collect() {
   RolloutStats stats;
   if (!started_) {
     const auto start = Clock::now();
-    current_obs_ = observation_tensors(env_.reset(config_.seed).obs);
+    current_obs_ = observation_tensors(reset_env(config_.seed).obs);
     stats.env_seconds += seconds_since(start);
     started_ = true;
   }
@@ -354,18 +372,23 @@ RolloutStats Trainer::collect() {
     std::memcpy(env_actions.raw_data(), env_action.data_ptr(), env_actions.nbytes());
 
     start = Clock::now();
-    const vector::VectorStepResult& step = env_.step(actions_);
+    const vector::VectorStepResult& step = step_env(actions_);
     stats.env_seconds += seconds_since(start);
     const double* rewards = step.rewards.data<double>();
     const bool* terminated = step.terminated.data<bool>();
     const bool* truncated = step.truncated.data<bool>();
+    // The storage tensors are contiguous (T, N): row t starts at t * N.
+    float* stored_rewards = storage_.rewards.data_ptr<float>() + t * envs;
+    std::uint8_t* stored_terminated = storage_.terminated.data_ptr<std::uint8_t>() + t * envs;
+    std::uint8_t* stored_truncated = storage_.truncated.data_ptr<std::uint8_t>() + t * envs;
+    float* stored_final_values = storage_.final_values.data_ptr<float>() + t * envs;
     std::vector<std::int64_t> bootstrap;  // envs truncated (not terminated) in this step
     for (std::int64_t n = 0; n < envs; ++n) {
       const auto i = static_cast<std::size_t>(n);
-      storage_.rewards[t][n] = rewards[n];
-      storage_.terminated[t][n] = terminated[n] ? 1 : 0;
-      storage_.truncated[t][n] = truncated[n] ? 1 : 0;
-      storage_.final_values[t][n] = 0.0f;
+      stored_rewards[n] = static_cast<float>(rewards[n]);
+      stored_terminated[n] = terminated[n] ? 1 : 0;
+      stored_truncated[n] = truncated[n] ? 1 : 0;
+      stored_final_values[n] = 0.0f;
       episode_returns_[i] += rewards[n];
       episode_lengths_[i] += 1;
       if (terminated[n] || truncated[n]) {

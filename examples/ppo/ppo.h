@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "envs/vector/vector_env.h"
+#include "envs/vector/wrappers/vector_wrapper.h"
 #include "examples/ppo/policy.h"
 
 namespace pixelgym::ppo {
@@ -129,7 +130,8 @@ struct UpdateStats {
   std::int64_t minibatches = 0;     // minibatches run
 };
 
-/// An episode that ended during a rollout: the sum of the env's raw rewards and its length.
+/// An episode that ended during a rollout: the sum of the rewards the trainer was given (after
+/// any reward wrapper) and its length.
 struct Episode {
   double episode_return = 0.0;
   std::int64_t length = 0;
@@ -153,7 +155,9 @@ struct TrainerRngState {
 /// Trains a Policy with PPO on a vector env: `collect()` steps the env for one rollout,
 /// `update()` learns from it; `iterate()` does both.
 ///
-/// The vector env must autoreset in SameStep mode (make_vec's VectorOptions::autoreset =
+/// The env is a VectorEnv or a VectorWrapper over one (RecordEpisodeStatistics, NormalizeReward:
+/// the trainer learns from the rewards it is given, and its Episode records sum those). It must
+/// autoreset in SameStep mode (make_vec's VectorOptions::autoreset =
 /// AutoresetMode::kSameStep): a truncated step's final observation comes from
 /// infos["final_obs"], whose value bootstraps the step's return (see compute_gae). Its
 /// num_envs must equal config.num_envs. The trainer keeps a reference to the env; the env must
@@ -173,6 +177,7 @@ class Trainer {
   /// Throws std::invalid_argument when config.validate() fails, when the env's autoreset mode
   /// is not SameStep or its num_envs differs from config.num_envs, and as Policy's constructor.
   Trainer(vector::VectorEnv& env, PpoConfig config);
+  Trainer(vector::VectorWrapper& env, PpoConfig config);
 
   /// Steps every env num_steps times with actions sampled from the policy (no gradients),
   /// storing the transitions and the values GAE needs, then computes advantages and returns.
@@ -203,7 +208,12 @@ class Trainer {
   void set_rng_state(const TrainerRngState& state);
 
  private:
-  vector::VectorEnv& env_;
+  Trainer(vector::VectorEnv* env, vector::VectorWrapper* wrapper, PpoConfig config);
+  const vector::VectorResetResult& reset_env(std::uint64_t seed);
+  const vector::VectorStepResult& step_env(const Value& actions);
+
+  vector::VectorEnv* env_;  // exactly one of env_ and wrapper_ is set
+  vector::VectorWrapper* wrapper_;
   PpoConfig config_;
   std::shared_ptr<Policy> policy_;
   std::unique_ptr<torch::optim::Adam> optimizer_;

@@ -18,6 +18,7 @@
 #include "envs/spaces/box.h"
 #include "envs/spaces/discrete.h"
 #include "envs/vector/sync_vector_env.h"
+#include "envs/vector/wrappers/record_episode_statistics.h"
 #include "tests/wrappers/scripted_env.h"
 
 namespace pixelgym::ppo {
@@ -269,6 +270,19 @@ TEST(Trainer, LearnsTheRewardedActionOfADiscreteBandit) {
   EXPECT_GT(mean_return, 0.85);
   EXPECT_EQ(trainer.env_steps(), 12 * 64);
   EXPECT_EQ(trainer.updates(), 12);
+}
+
+TEST(Trainer, TrainsThroughAVectorWrapper) {
+  vector::RecordEpisodeStatistics envs(bandit_envs(4, false));
+  PpoConfig config = small_config(4, 16);
+  config.learning_rate = 1e-2;
+  config.entropy_coef = 0.0;
+  Trainer trainer(envs, config);
+  for (int i = 0; i < 12; ++i) {
+    EXPECT_EQ(trainer.collect().episodes.size(), 64u);  // one-step episodes
+    trainer.update();
+  }
+  EXPECT_GT(probability_of_action_one(trainer.policy()), 0.95);
 }
 
 TEST(Trainer, MovesTheGaussianMeanToTheBestActionOfAContinuousBandit) {
