@@ -338,8 +338,12 @@ int run_train(const TrainArguments& args) {
     run->append_progress(row);
     run->write_curve(title);
     if (trainer.updates() % settings.checkpoint_every == 0) save_checkpoint();
-    status = {trainer.env_steps(), settings.ppo.total_env_steps, elapsed() - wall_before,
-              time_limit_s, row.fps, row.episode_return_mean};
+    status = {trainer.env_steps(),
+              settings.ppo.total_env_steps,
+              elapsed() - wall_before,
+              time_limit_s,
+              row.fps,
+              row.episode_return_mean};
     progress.update(status);
   }
   progress.finish(status);
@@ -406,8 +410,9 @@ Command add_train(CLI::App& app) {
   train->add_option("--checkpoint-every", args->checkpoint_every, "Updates between checkpoints")
       ->capture_default_str()
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 40));
-  train->add_option("--eval-episodes", args->eval_episodes,
-                    "Seeded episodes of the final evaluation (deterministic actions)")
+  train
+      ->add_option("--eval-episodes", args->eval_episodes,
+                   "Seeded episodes of the final evaluation (deterministic actions)")
       ->capture_default_str()
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 20));
   return {train, [args, train] {
@@ -487,8 +492,9 @@ int run_eval(const EvalArguments& args) {
 Command add_eval(CLI::App& app) {
   auto args = std::make_shared<EvalArguments>();
   CLI::App* eval = app.add_subcommand(
-      "eval", "Evaluate a trained policy (a run folder's latest checkpoint, or a checkpoint "
-              "file) over seeded episodes: each return, then their mean and std");
+      "eval",
+      "Evaluate a trained policy (a run folder's latest checkpoint, or a checkpoint "
+      "file) over seeded episodes: each return, then their mean and std");
   eval->add_option("run", args->run, "Run folder or checkpoint file (.pgck)")->required();
   eval->add_option("--episodes", args->episodes, "Episodes, seeded seed, seed + 1, ...")
       ->capture_default_str()

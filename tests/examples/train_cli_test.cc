@@ -1,0 +1,195 @@
+// `pixelgym train` and `pixelgym eval` as a user runs them: a short pixel run writes a complete
+// run folder, a run killed with SIGKILL resumes from its last checkpoint, and a truncated or
+// corrupt checkpoint is refused, never loaded. Tiny settings (32x32 pixels, 2 envs, 16-step
+// rollouts) keep it to seconds; learning itself is measured in bench/, not here.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include "examples/ppo/run/checkpoint_file.h"
+#include "examples/ppo/run/progress_csv.h"
+#include "tests/examples/cli_run.h"
+
+namespace pixelgym::testing {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// A fresh folder for one test.
+fs::path fresh_folder(const std::string& name) {
+  const fs::path folder =
+      fs::temp_directory_path() / ("pixelgym_train_cli_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  return folder;
+}
+
+// The settings every run here uses, then `more`.
+std::string train_arguments(const fs::path& folder, const std::string& more) {
+  const fs::path config = folder / "tiny.json";
+  std::ofstream(config) << R"({"num_steps": 16, "num_minibatches": 2, "update_epochs": 1})";
+  return "train CartPoleBalance-v0 --set obs_mode=pixels --set width=32 --set height=32 "
+         "--set max_episode_steps=24 --wrap frame_stack=2 --num-envs 2 --threads 2 --config " +
+         config.string() + " --eval-episodes 1 --quiet " + more;
+}
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+TEST(TrainCliTest, AShortRunWritesACompleteRunFolder) {
+  const fs::path folder = fresh_folder("complete");
+  const fs::path run = folder / "run";
+  const CliRun trained =
+      run_cli(train_arguments(folder, "--steps 96 --checkpoint-every 2 --out " + run.string()));
+  ASSERT_EQ(trained.exit_code, 0) << trained.output;
+  EXPECT_NE(trained.output.find("evaluation: return"), std::string::npos) << trained.output;
+
+  const json config = json::parse(read_text(run / "config.json"));
+  EXPECT_EQ(config.at("env_id"), "CartPoleBalance-v0");
+  EXPECT_EQ(config.at("wrap"), json::array({"frame_stack=2"}));
+  EXPECT_EQ(config.at("ppo").at("num_steps"), 16);
+  EXPECT_TRUE(config.contains("code_version"));
+
+  // 96 steps of 2 envs x 16: 3 updates, one row each.
+  const ppo::ProgressTable progress = ppo::read_progress_csv(run / "progress.csv");
+  ASSERT_EQ(progress.rows.size(), 3U);
+  EXPECT_EQ(progress.column("steps").back(), 96.0);
+  EXPECT_GT(progress.column("fps").back(), 0.0);
+  EXPECT_TRUE(std::isfinite(progress.column("entropy").back()));
+
+  // Checkpoints after update 2 (every 2) and at the end (3), both loadable.
+  for (const char* name : {"ckpt-000002.pgck", "ckpt-000003.pgck"}) {
+    const ppo::CheckpointBlobs blobs = ppo::read_checkpoint(run / name);
+    EXPECT_EQ(blobs.count("model"), 1U) << name;
+    EXPECT_EQ(blobs.count("optimizer"), 1U) << name;
+  }
+  const std::string png = read_text(run / "curve.png");
+  ASSERT_GT(png.size(), 8U);
+  EXPECT_EQ(png.substr(1, 3), "PNG");
+  EXPECT_GT(fs::file_size(run / "final.mp4"), 0U);
+  const json summary = json::parse(read_text(run / "summary.json"));
+  EXPECT_EQ(summary.at("env_steps"), 96);
+  EXPECT_EQ(summary.at("evaluation").at("episodes"), 1);
+
+  // The run evaluates again from its folder, the same as at the end of training (same seed).
+  const CliRun evaluated = run_cli("eval " + run.string() + " --episodes 1 --seed 1000000");
+  ASSERT_EQ(evaluated.exit_code, 0) << evaluated.output;
+  std::ostringstream expected;
+  expected << "return_mean=" << summary.at("evaluation").at("return_mean").get<double>();
+  EXPECT_NE(evaluated.output.find(expected.str()), std::string::npos) << evaluated.output;
+  // A second run into the same folder is refused; the run is left as it was.
+  const CliRun again = run_cli(train_arguments(folder, "--steps 32 --out " + run.string()));
+  EXPECT_EQ(again.exit_code, 1) << again.output;
+  EXPECT_EQ(ppo::read_progress_csv(run / "progress.csv").rows.size(), 3U);
+  fs::remove_all(folder);
+}
+
+TEST(TrainCliTest, ARunKilledMidTrainingResumesFromItsLastCheckpoint) {
+  const fs::path folder = fresh_folder("killed");
+  const fs::path run = folder / "run";
+  // A long run, killed with SIGKILL once its second checkpoint exists.
+  const std::string command =
+      std::string(PIXELGYM_CLI) + " " +
+      train_arguments(folder, "--steps 100000 --checkpoint-every 2 --out " + run.string()) + " > " +
+      (folder / "log.txt").string() + " 2>&1";
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    execl("/bin/sh", "sh", "-c", ("exec " + command).c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (!fs::exists(run / "ckpt-000004.pgck") && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ::kill(child, SIGKILL);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  ASSERT_TRUE(fs::exists(run / "ckpt-000004.pgck")) << read_text(folder / "log.txt");
+  ASSERT_TRUE(WIFSIGNALED(status));
+
+  const ppo::CheckpointSearch latest = ppo::find_latest_checkpoint(run);
+  ASSERT_TRUE(latest.latest.has_value());
+  const std::int64_t resumed_update = latest.latest->update;
+  EXPECT_GE(resumed_update, 4);
+  const CliRun resumed =
+      run_cli("train --resume " + run.string() + " --steps " +
+              std::to_string((resumed_update + 2) * 32) + " --quiet --checkpoint-every 2");
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  EXPECT_NE(resumed.output.find("resuming " + run.string() + " from ckpt-" +
+                                std::string(resumed_update < 10 ? "00000" : "0000") +
+                                std::to_string(resumed_update)),
+            std::string::npos)
+      << resumed.output;
+  // ... and continues from its step count, doing only the 2 updates left.
+  EXPECT_NE(resumed.output.find("(" + std::to_string(resumed_update * 32) + " env steps, " +
+                                std::to_string(resumed_update) + " updates)"),
+            std::string::npos)
+      << resumed.output;
+  const json summary = json::parse(read_text(run / "summary.json"));
+  EXPECT_EQ(summary.at("updates"), resumed_update + 2);
+  // Rows logged after that checkpoint were dropped and logged again: one row per update, in
+  // order, to the end.
+  const ppo::ProgressTable progress = ppo::read_progress_csv(run / "progress.csv");
+  ASSERT_EQ(progress.rows.size(), static_cast<std::size_t>(resumed_update + 2));
+  const std::vector<double> steps = progress.column("steps");
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    EXPECT_EQ(steps[i], static_cast<double>(i + 1) * 32) << "row " << i;
+  }
+  fs::remove_all(folder);
+}
+
+TEST(TrainCliTest, TruncatedAndCorruptCheckpointsAreRefused) {
+  const fs::path folder = fresh_folder("corrupt");
+  const fs::path run = folder / "run";
+  const CliRun trained =
+      run_cli(train_arguments(folder, "--steps 64 --checkpoint-every 1 --out " + run.string()));
+  ASSERT_EQ(trained.exit_code, 0) << trained.output;
+  const fs::path second = run / "ckpt-000002.pgck";
+  const std::string bytes = read_text(second);
+
+  // Truncated: eval of the file refuses it; of the folder, skips it for the one before.
+  fs::resize_file(second, bytes.size() / 2);
+  CliRun evaluated = run_cli("eval " + second.string() + " --episodes 1");
+  EXPECT_EQ(evaluated.exit_code, 1) << evaluated.output;
+  EXPECT_NE(evaluated.output.find("truncated"), std::string::npos) << evaluated.output;
+  EXPECT_NE(evaluated.output.find("refusing to load it"), std::string::npos) << evaluated.output;
+  evaluated = run_cli("eval " + run.string() + " --episodes 1");
+  EXPECT_EQ(evaluated.exit_code, 0) << evaluated.output;
+  EXPECT_NE(evaluated.output.find("skipping " + second.string()), std::string::npos)
+      << evaluated.output;
+  EXPECT_NE(evaluated.output.find("ckpt-000001.pgck: CartPoleBalance-v0"), std::string::npos)
+      << evaluated.output;
+
+  // Corrupt (one byte flipped in the middle, size intact): refused as well.
+  std::string flipped = bytes;
+  flipped[flipped.size() / 2] = static_cast<char>(flipped[flipped.size() / 2] ^ 0x10);
+  std::ofstream(second, std::ios::binary | std::ios::trunc) << flipped;
+  evaluated = run_cli("eval " + second.string() + " --episodes 1");
+  EXPECT_EQ(evaluated.exit_code, 1) << evaluated.output;
+  EXPECT_NE(evaluated.output.find("checksum"), std::string::npos) << evaluated.output;
+  // --resume takes the valid one before it.
+  const CliRun resumed = run_cli("train --resume " + run.string() + " --steps 96 --quiet");
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  EXPECT_NE(resumed.output.find("skipping " + second.string()), std::string::npos)
+      << resumed.output;
+  EXPECT_NE(resumed.output.find("from ckpt-000001.pgck"), std::string::npos) << resumed.output;
+  fs::remove_all(folder);
+}
+
+}  // namespace
+}  // namespace pixelgym::testing
