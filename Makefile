@@ -26,8 +26,13 @@ build: configure
 
 # The main job until the trainer lands: a random policy on GridWorld-v0, returns printed and a
 # snapshot written to runs/demo/.
+# The main job: PPO from pixels only (64x64, 3 stacked frames) on CartPoleBalance-v0 for 10
+# minutes of wall time, into a fresh runs/demo/ (the previous demo run is replaced).
+DEMO_TRAIN := train CartPoleBalance-v0 --set obs_mode=pixels --set width=64 --set height=64 \
+  --wrap frame_stack=3 --minutes 10 --out runs/demo
 demo: build
-	$(PIXELGYM) rollout GridWorld-v0 --episodes 5 --seed 0 --snapshot runs/demo/gridworld.png
+	rm -rf runs/demo
+	$(PIXELGYM) $(DEMO_TRAIN)
 
 test: build
 	ctest --test-dir $(BUILD_DIR) --output-on-failure --parallel $(JOBS)
