@@ -29,6 +29,11 @@ void CartPoleTask::build(engine::World& world) {
 }
 
 render::Camera CartPoleTask::camera(const std::string& name, const engine::World& world) const {
+  if (name == "close") {
+    render::Camera camera = render::Camera::look_at({0.0F, -2.4F, 1.2F}, {0.0F, 0.0F, 1.35F});
+    camera.fov_y_deg = 50.0F;
+    return camera;
+  }
   const float x = name == "tracking" ? static_cast<float>(cart_position(world)) : 0.0F;
   render::Camera camera = render::Camera::look_at({x, -4.0F, 0.9F}, {x, 0.0F, 1.3F});
   camera.fov_y_deg = 50.0F;

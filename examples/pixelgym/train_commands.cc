@@ -101,6 +101,12 @@ RunSettings settings_from_json(const json& in, const fs::path& where) {
   }
 }
 
+// progress.csv's columns after the base ones: more of the update's figures, and where the
+// update's time went: env_s in the vector env's step/reset, act_s in the policy's forward passes
+// while collecting, update_s in the PPO epochs.
+const std::vector<std::string> kExtraColumns = {
+    "explained_variance", "grad_norm", "learning_rate", "env_s", "act_s", "update_s"};
+
 // The training env: num_envs copies, SameStep autoreset (the trainer bootstraps truncated
 // steps from infos["final_obs"]).
 std::unique_ptr<vector::VectorEnv> make_training_env(const RunSettings& settings) {
@@ -131,6 +137,12 @@ ppo::CheckpointBlobs checkpoint_blobs(ppo::Trainer& trainer, const std::deque<do
   meta["updates"] = trainer.updates();
   meta["wall_time_s"] = wall_time_s;
   meta["recent_returns"] = std::vector<double>(returns.begin(), returns.end());
+  const ppo::RewardScaling& scaling = trainer.reward_scaling();
+  // JSON numbers keep a double exactly (17 significant digits).
+  meta["reward_scaling"] = {{"mean", scaling.statistics.mean[0]},
+                            {"var", scaling.statistics.var[0]},
+                            {"count", scaling.statistics.count},
+                            {"returns", scaling.returns}};
   blobs["meta"] = meta.dump();
   return blobs;
 }
@@ -314,12 +326,19 @@ int run_train(const TrainArguments& args) {
     for (const double r : meta.at("recent_returns").get<std::vector<double>>()) {
       returns.push_back(r);
     }
+    const json& scaling_json = meta.at("reward_scaling");
+    ppo::RewardScaling scaling;
+    scaling.statistics.mean = {scaling_json.at("mean").get<double>()};
+    scaling.statistics.var = {scaling_json.at("var").get<double>()};
+    scaling.statistics.count = scaling_json.at("count").get<double>();
+    scaling.returns = scaling_json.at("returns").get<std::vector<double>>();
+    trainer.set_reward_scaling(std::move(scaling));
     run.emplace(ppo::RunFolder::resume(folder, trainer.env_steps()));
     std::cout << "resuming " << folder.string() << " from " << checkpoint->path.filename().string()
               << " (" << trainer.env_steps() << " env steps, " << trainer.updates()
               << " updates)\n";
   } else {
-    run.emplace(ppo::RunFolder::create(folder, settings_to_json(settings)));
+    run.emplace(ppo::RunFolder::create(folder, settings_to_json(settings), kExtraColumns));
   }
 
   const std::string title = settings.id + " (" + folder.filename().string() + ")";
@@ -341,7 +360,10 @@ int run_train(const TrainArguments& args) {
     const auto update_start = std::chrono::steady_clock::now();
     const std::int64_t steps_before = trainer.env_steps();
     const ppo::RolloutStats rollout = trainer.collect();
+    const auto learn_start = std::chrono::steady_clock::now();
     const ppo::UpdateStats update = trainer.update();
+    const double update_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - learn_start).count();
     for (const ppo::Episode& episode : rollout.episodes) {
       returns.push_back(episode.episode_return);
       if (returns.size() > kReturnWindow) returns.pop_front();
@@ -359,6 +381,12 @@ int run_train(const TrainArguments& args) {
     row.entropy = update.entropy;
     row.approx_kl = update.approx_kl;
     row.clip_fraction = update.clip_fraction;
+    row.extra = {{"explained_variance", update.explained_variance},
+                 {"grad_norm", update.grad_norm},
+                 {"learning_rate", update.learning_rate},
+                 {"env_s", rollout.env_seconds},
+                 {"act_s", rollout.policy_seconds},
+                 {"update_s", update_s}};
     run->append_progress(row);
     run->write_curve(title);
     if (trainer.updates() % settings.checkpoint_every == 0) save_checkpoint();

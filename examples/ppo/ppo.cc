@@ -16,6 +16,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// vector::NormalizeReward's default epsilon: rewards are divided by sqrt(var + epsilon).
+constexpr double kRewardEpsilon = 1e-8;
+
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -141,6 +144,7 @@ void to_json(nlohmann::json& json, const PpoConfig& config) {
                         {"update_epochs", config.update_epochs},
                         {"num_minibatches", config.num_minibatches},
                         {"normalize_advantages", config.normalize_advantages},
+                        {"normalize_rewards", config.normalize_rewards},
                         {"clip_range", config.clip_range},
                         {"clip_value_loss", config.clip_value_loss},
                         {"entropy_coef", config.entropy_coef},
@@ -166,6 +170,7 @@ void from_json(const nlohmann::json& json, PpoConfig& config) {
                          "update_epochs",
                          "num_minibatches",
                          "normalize_advantages",
+                         "normalize_rewards",
                          "clip_range",
                          "clip_value_loss",
                          "entropy_coef",
@@ -188,6 +193,7 @@ void from_json(const nlohmann::json& json, PpoConfig& config) {
   read_member(json, "update_epochs", config.update_epochs);
   read_member(json, "num_minibatches", config.num_minibatches);
   read_member(json, "normalize_advantages", config.normalize_advantages);
+  read_member(json, "normalize_rewards", config.normalize_rewards);
   read_member(json, "clip_range", config.clip_range);
   read_member(json, "clip_value_loss", config.clip_value_loss);
   read_member(json, "entropy_coef", config.entropy_coef);
@@ -329,6 +335,7 @@ Trainer::Trainer(vector::VectorEnv* env, vector::VectorWrapper* wrapper, PpoConf
       actions_(env != nullptr ? env->action_space().zeros() : wrapper->action_space().zeros()),
       episode_returns_(static_cast<std::size_t>(config_.num_envs), 0.0),
       episode_lengths_(static_cast<std::size_t>(config_.num_envs), 0) {
+  reward_scaling_.returns.assign(static_cast<std::size_t>(config_.num_envs), 0.0);
   if (!actions_.is_array()) {
     throw std::invalid_argument(
         "Trainer: the batched action space must be an array space, got " +
@@ -382,10 +389,20 @@ RolloutStats Trainer::collect() {
     std::uint8_t* stored_terminated = storage_.terminated.data_ptr<std::uint8_t>() + t * envs;
     std::uint8_t* stored_truncated = storage_.truncated.data_ptr<std::uint8_t>() + t * envs;
     float* stored_final_values = storage_.final_values.data_ptr<float>() + t * envs;
+    double reward_scale = 1.0;
+    if (config_.normalize_rewards) {
+      std::vector<double>& returns = reward_scaling_.returns;
+      for (std::size_t i = 0; i < returns.size(); ++i) {
+        returns[i] = config_.gamma * returns[i] + rewards[i];
+      }
+      reward_scaling_.statistics.update_batch(
+          returns.size(), [&](std::size_t row, std::size_t) { return returns[row]; });
+      reward_scale = 1.0 / std::sqrt(reward_scaling_.statistics.var[0] + kRewardEpsilon);
+    }
     std::vector<std::int64_t> bootstrap;  // envs truncated (not terminated) in this step
     for (std::int64_t n = 0; n < envs; ++n) {
       const auto i = static_cast<std::size_t>(n);
-      stored_rewards[n] = static_cast<float>(rewards[n]);
+      stored_rewards[n] = static_cast<float>(rewards[n] * reward_scale);
       stored_terminated[n] = terminated[n] ? 1 : 0;
       stored_truncated[n] = truncated[n] ? 1 : 0;
       stored_final_values[n] = 0.0f;
@@ -395,6 +412,7 @@ RolloutStats Trainer::collect() {
         stats.episodes.push_back({episode_returns_[i], episode_lengths_[i]});
         episode_returns_[i] = 0.0;
         episode_lengths_[i] = 0;
+        reward_scaling_.returns[i] = 0.0;
         if (!terminated[n]) bootstrap.push_back(n);
       }
     }
@@ -551,6 +569,25 @@ void Trainer::set_progress(std::int64_t env_steps, std::int64_t updates) {
   }
   env_steps_ = env_steps;
   updates_ = updates;
+}
+
+void Trainer::set_reward_scaling(RewardScaling scaling) {
+  const std::string invalid = scaling.statistics.invalid_reason(1);
+  if (!invalid.empty()) {
+    throw std::invalid_argument("Trainer::set_reward_scaling: invalid statistics: " + invalid);
+  }
+  if (static_cast<std::int64_t>(scaling.returns.size()) != config_.num_envs) {
+    throw std::invalid_argument("Trainer::set_reward_scaling: " + std::to_string(config_.num_envs) +
+                                " discounted returns expected (num_envs), got " +
+                                std::to_string(scaling.returns.size()));
+  }
+  for (const double r : scaling.returns) {
+    if (!std::isfinite(r)) {
+      throw std::invalid_argument("Trainer::set_reward_scaling: a discounted return is " +
+                                  std::to_string(r));
+    }
+  }
+  reward_scaling_ = std::move(scaling);
 }
 
 TrainerRngState Trainer::rng_state() const {

@@ -98,7 +98,7 @@ TEST(DescribeTest, FollowsKwargs) {
   EXPECT_EQ(space.at("pixels").shape(), (Shape{48, 64, 3}));
   // 1000 control steps in env steps of 3: ceil(1000 / 3).
   EXPECT_EQ(description.max_episode_steps, 334);
-  EXPECT_THAT(description.cameras, ::testing::ElementsAre("fixed", "tracking"));
+  EXPECT_THAT(description.cameras, ::testing::ElementsAre("fixed", "tracking", "close"));
   EXPECT_DOUBLE_EQ(description.metadata.render_fps, 1.0 / 0.03);
   EXPECT_EQ(describe("CartPoleSwingup-v0", {{"max_episode_steps", 0}}).max_episode_steps,
             std::nullopt);

@@ -18,6 +18,7 @@
 #include "envs/spaces/box.h"
 #include "envs/spaces/discrete.h"
 #include "envs/vector/sync_vector_env.h"
+#include "envs/vector/wrappers/normalize_reward.h"
 #include "envs/vector/wrappers/record_episode_statistics.h"
 #include "tests/wrappers/scripted_env.h"
 
@@ -151,6 +152,7 @@ TEST(PpoConfig, JsonRoundTripKeepsEveryField) {
   config.update_epochs = 3;
   config.num_minibatches = 5;
   config.normalize_advantages = false;
+  config.normalize_rewards = false;
   config.clip_range = 0.3;
   config.clip_value_loss = false;
   config.entropy_coef = 0.02;
@@ -175,7 +177,7 @@ TEST(PpoConfig, JsonRoundTripKeepsEveryField) {
   EXPECT_DOUBLE_EQ(back.adam_epsilon, 1e-7);
   // Every field is a member (one per field of the structs, policy nested).
   const nlohmann::json json = nlohmann::json::parse(text);
-  EXPECT_EQ(json.size(), 21u);
+  EXPECT_EQ(json.size(), 22u);
   EXPECT_EQ(json.at("policy").size(), 7u);
   EXPECT_EQ(json.at("policy").at("cnn"), "nature");
 }
@@ -220,6 +222,7 @@ TEST(Trainer, TruncatedStepsBootstrapFromTheFinalObservationsValue) {
         AutoresetMode::kSameStep);
     PpoConfig config = small_config(2, 5);
     config.num_minibatches = 1;
+    config.normalize_rewards = false;  // the advantage below is checked with the raw reward
     Trainer trainer(envs, config);
     const RolloutStats stats = trainer.collect();
     ASSERT_EQ(stats.episodes.size(), 2u);
@@ -246,6 +249,54 @@ TEST(Trainer, TruncatedStepsBootstrapFromTheFinalObservationsValue) {
     const double expected = 1.0 + (truncate ? gamma * final_value.item<double>() : 0.0) - v2;
     EXPECT_NEAR(s.advantages[2][0].item<double>(), expected, 1e-5);
   }
+}
+
+// normalize_rewards: the rollout holds exactly the rewards vector::NormalizeReward gives for the
+// same steps (envs of different episode lengths, so that the returns differ), across rollouts;
+// the Episode records keep the env's own returns; set_reward_scaling restores the state and
+// refuses a bad one.
+TEST(Trainer, NormalizedRewardsAreNormalizeRewardsAndEpisodesKeepTheEnvsReturns) {
+  const auto counters = [](int n) { return std::make_unique<CounterEnv>(2 + n, n % 2 == 0); };
+  SyncVectorEnv envs(3, counters, AutoresetMode::kSameStep);
+  PpoConfig config = small_config(3, 4);
+  config.num_minibatches = 1;
+  ASSERT_TRUE(config.normalize_rewards);  // the default
+  Trainer trainer(envs, config);
+  vector::NormalizeReward reference(
+      std::make_unique<SyncVectorEnv>(3, counters, AutoresetMode::kSameStep), config.gamma);
+  reference.reset(config.seed);
+  const Value actions = reference.action_space().zeros();  // CounterEnv ignores its action
+  std::vector<double> episode_returns;
+  for (int rollout = 0; rollout < 3; ++rollout) {
+    const RolloutStats stats = trainer.collect();
+    for (const Episode& episode : stats.episodes) episode_returns.push_back(episode.episode_return);
+    for (int t = 0; t < 4; ++t) {
+      const vector::VectorStepResult& step = reference.step(actions);
+      for (int n = 0; n < 3; ++n) {
+        EXPECT_FLOAT_EQ(trainer.storage().rewards[t][n].item<float>(),
+                        static_cast<float>(step.rewards.data<double>()[n]))
+            << "rollout " << rollout << " step " << t << " env " << n;
+      }
+    }
+    trainer.update();
+  }
+  EXPECT_NE(trainer.storage().rewards[0][0].item<float>(), 1.0f);  // they were scaled
+  // Episodes of 2, 3 and 4 steps of reward 1: returns are the lengths.
+  ASSERT_FALSE(episode_returns.empty());
+  for (const double r : episode_returns) EXPECT_TRUE(r == 2.0 || r == 3.0 || r == 4.0) << r;
+  EXPECT_EQ(trainer.reward_scaling().statistics.var, reference.statistics().var);
+  EXPECT_EQ(trainer.reward_scaling().returns, reference.discounted_returns());
+
+  RewardScaling scaling = trainer.reward_scaling();
+  scaling.returns.pop_back();
+  EXPECT_THROW(trainer.set_reward_scaling(scaling), std::invalid_argument);
+  scaling = trainer.reward_scaling();
+  scaling.statistics.var[0] = -1.0;
+  EXPECT_THROW(trainer.set_reward_scaling(scaling), std::invalid_argument);
+  scaling = trainer.reward_scaling();
+  scaling.returns[1] = 7.5;
+  trainer.set_reward_scaling(scaling);
+  EXPECT_EQ(trainer.reward_scaling().returns[1], 7.5);
 }
 
 TEST(Trainer, LearnsTheRewardedActionOfADiscreteBandit) {
