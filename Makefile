@@ -24,12 +24,11 @@ configure: deps
 build: configure
 	cmake --build $(BUILD_DIR) --parallel $(JOBS)
 
-# The main job until the trainer lands: a random policy on GridWorld-v0, returns printed and a
-# snapshot written to runs/demo/.
-# The main job: PPO from pixels only (64x64, 3 stacked frames) on CartPoleBalance-v0 for 10
-# minutes of wall time, into a fresh runs/demo/ (the previous demo run is replaced).
+# The main job: PPO from pixels only (64x64, 3 stacked frames, each action held for 8 control
+# steps as dm_control's pixel benchmarks do) on CartPoleBalance-v0 for 10 minutes of wall time,
+# into a fresh runs/demo/ (the previous demo run is replaced).
 DEMO_TRAIN := train CartPoleBalance-v0 --set obs_mode=pixels --set width=64 --set height=64 \
-  --wrap frame_stack=3 --minutes 10 --out runs/demo
+  --set action_repeat=8 --wrap frame_stack=3 --minutes 10 --out runs/demo
 demo: build
 	rm -rf runs/demo
 	$(PIXELGYM) $(DEMO_TRAIN)
