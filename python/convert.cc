@@ -40,8 +40,9 @@ py::module_& numpy() {
 // `array`'s elements in an Array of `dtype` (its own dtype, or one it converts to exactly): a
 // C-contiguous, native-order numpy copy first, then its bytes.
 Array copy_to_array(const py::array& array, DType dtype) {
+  // (np.asarray with order "C", not np.ascontiguousarray, which turns a 0-d array into a 1-d one.)
   py::array contiguous =
-      numpy().attr("ascontiguousarray")(array, py::arg("dtype") = numpy_dtype(dtype));
+      numpy().attr("asarray")(array, py::arg("dtype") = numpy_dtype(dtype), py::arg("order") = "C");
   Shape shape(contiguous.shape(), contiguous.shape() + contiguous.ndim());
   Array out(dtype, std::move(shape));
   if (out.nbytes() > 0) std::memcpy(out.raw_data(), contiguous.data(), out.nbytes());
@@ -109,9 +110,10 @@ py::array to_numpy(const Array& array) {
                    strides, array.raw_data(), base);
 }
 
-py::object to_python(const Value& value, bool copy) {
+py::object to_python(const Value& value, bool copy, bool scalars) {
   if (value.is_array()) {
     py::array array = to_numpy(value.array());
+    if (scalars && array.ndim() == 0) return array[py::tuple()];
     if (copy) return array.attr("copy")();
     return std::move(array);
   }
@@ -119,13 +121,13 @@ py::object to_python(const Value& value, bool copy) {
     py::dict dict;
     const ValueDict& entries = value.dict();
     for (std::size_t i = 0; i < entries.size(); ++i) {
-      dict[py::str(entries.keys()[i])] = to_python(entries.values()[i], copy);
+      dict[py::str(entries.keys()[i])] = to_python(entries.values()[i], copy, scalars);
     }
     return std::move(dict);
   }
   const ValueTuple& items = value.tuple();
   py::tuple tuple(items.size());
-  for (std::size_t i = 0; i < items.size(); ++i) tuple[i] = to_python(items.at(i), copy);
+  for (std::size_t i = 0; i < items.size(); ++i) tuple[i] = to_python(items.at(i), copy, scalars);
   return std::move(tuple);
 }
 

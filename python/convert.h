@@ -23,8 +23,9 @@ py::array to_numpy(const Array& array);
 
 /// An Array as a numpy view (to_numpy), a ValueDict as a dict (keys in order), a ValueTuple as a
 /// tuple. With `copy`, every array is a numpy copy instead: for results whose buffers pixelgym
-/// reuses (batched infos).
-py::object to_python(const Value& value, bool copy = false);
+/// reuses (batched infos). With `scalars`, 0-d arrays become numpy scalars (np.int64(3), as
+/// Gymnasium's envs return a Discrete observation).
+py::object to_python(const Value& value, bool copy = false, bool scalars = false);
 
 /// How far `value_from_python` converts a leaf whose dtype differs from its space's.
 enum class Cast {

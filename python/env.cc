@@ -75,24 +75,14 @@ py::dict metadata_to_python(const Metadata& metadata) {
 
 // A single env's info: arrays copied (an env may reuse its info buffers), 0-d ones as numpy
 // scalars, as Gymnasium's envs report numbers.
-py::object info_to_python(const Value& value) {
-  if (value.is_array()) {
-    py::array array = to_numpy(value.array()).attr("copy")();
-    if (array.ndim() == 0) return array[py::tuple()];
-    return std::move(array);
-  }
-  if (value.is_dict()) {
-    py::dict dict;
-    for (std::size_t i = 0; i < value.dict().size(); ++i) {
-      dict[py::str(value.dict().keys()[i])] = info_to_python(value.dict().values()[i]);
-    }
-    return std::move(dict);
-  }
-  py::tuple tuple(value.tuple().size());
-  for (std::size_t i = 0; i < value.tuple().size(); ++i) {
-    tuple[i] = info_to_python(value.tuple().at(i));
-  }
-  return std::move(tuple);
+py::object info_to_python(const Info& info) {
+  return to_python(Value(info), /*copy=*/true, /*scalars=*/true);
+}
+
+// A single env's observation: views of the arrays the step allocated (zero copy), but a 0-d
+// array (a Discrete observation) as a numpy scalar, as Gymnasium's envs return it.
+py::object observation_to_python(const Value& obs) {
+  return to_python(obs, /*copy=*/false, /*scalars=*/true);
 }
 
 // One env made from the registry (with a wrapper stack), as the Python class _core.Env. Calls
@@ -125,7 +115,7 @@ class EnvHandle {
       std::lock_guard<std::mutex> lock(mutex_);
       result = env_->reset(seed_value, options_value);
     }
-    return py::make_tuple(to_python(result.obs), info_to_python(result.info));
+    return py::make_tuple(observation_to_python(result.obs), info_to_python(result.info));
   }
 
   py::tuple step(const py::handle& action) {
@@ -137,7 +127,7 @@ class EnvHandle {
       std::lock_guard<std::mutex> lock(mutex_);
       result = env_->step(action_value);
     }
-    return py::make_tuple(to_python(result.obs), result.reward, result.terminated, result.truncated,
+    return py::make_tuple(observation_to_python(result.obs), result.reward, result.terminated, result.truncated,
                           info_to_python(result.info));
   }
 
