@@ -127,8 +127,8 @@ class EnvHandle {
       std::lock_guard<std::mutex> lock(mutex_);
       result = env_->step(action_value);
     }
-    return py::make_tuple(observation_to_python(result.obs), result.reward, result.terminated, result.truncated,
-                          info_to_python(result.info));
+    return py::make_tuple(observation_to_python(result.obs), result.reward, result.terminated,
+                          result.truncated, info_to_python(result.info));
   }
 
   py::object render() {

@@ -164,9 +164,8 @@ class VectorHandle {
       observations_ = to_python(obs);
       observed_data_ = obs.leaves().front().raw_data();
     }
-    if (py::isinstance<py::dict>(observations_)) return py::dict(observations_);
-    if (py::isinstance<py::tuple>(observations_)) return py::tuple(observations_);
-    return observations_;
+    if (py::isinstance<py::dict>(observations_)) return observations_.attr("copy")();
+    return observations_;  // an array, or a tuple (immutable)
   }
 
   py::tuple step_tuple(const vector::VectorStepResult& result) {
