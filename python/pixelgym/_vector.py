@@ -166,7 +166,8 @@ class VectorEnv(_Base):
         return (_copy_obs(obs) if self.copy else obs), rewards, terminations, truncations, infos
 
     def close(self, **kwargs):
-        if getattr(self, "closed", True):
+        # Also called by __del__ on an object whose __init__ raised (no _core then).
+        if getattr(self, "closed", True) or "_core" not in self.__dict__:
             return
         self._core.close()
         self.closed = True
