@@ -4,10 +4,10 @@ importable)."""
 import dataclasses
 import types
 
-import numpy as np
 
 from . import _core
 from . import _gymnasium as gymnasium
+from ._random import NumpyRandom, seed_np_random
 from ._spaces import to_gymnasium
 
 _RENDER_MODES = (None, "rgb_array")
@@ -15,7 +15,7 @@ _RENDER_MODES = (None, "rgb_array")
 if gymnasium is not None:
     _Base = gymnasium.Env
 else:
-    _Base = object
+    _Base = NumpyRandom
 
 
 def _gymnasium_spec(env_id, kwargs, max_episode_steps):
@@ -79,9 +79,6 @@ class Env(_Base):
             spec_kwargs["render_mode"] = render_mode
         self._spec = _gymnasium_spec(id, spec_kwargs, self._core.max_episode_steps)
         self._cpp_seeded = False
-        if gymnasium is None:
-            self._np_random = None
-            self._np_random_seed = None
 
     # gymnasium.make sets env.unwrapped.spec to its own EnvSpec without max_episode_steps (it is
     # registered without one: the C++ env truncates itself); this keeps the real limit in it.
@@ -102,11 +99,7 @@ class Env(_Base):
         obs, info = self._core.reset(cpp_seed, options)
         self._cpp_seeded = True
         if seed is not None:
-            if gymnasium is not None:
-                super().reset(seed=seed)
-            else:
-                self._np_random = np.random.default_rng(seed)
-                self._np_random_seed = seed
+            seed_np_random(self, seed)
         return obs, info
 
     def step(self, action):
@@ -124,29 +117,6 @@ class Env(_Base):
 
     def close(self):
         self._core.close()
-
-    if gymnasium is None:
-
-        @property
-        def np_random(self):
-            """A numpy Generator for the caller's own randomness, seeded by reset(seed=...)."""
-            if self._np_random is None:
-                seed = int(np.random.SeedSequence().generate_state(1)[0])
-                self._np_random, self._np_random_seed = np.random.default_rng(seed), seed
-            return self._np_random
-
-        @np_random.setter
-        def np_random(self, value):
-            self._np_random, self._np_random_seed = value, -1
-
-        @property
-        def np_random_seed(self):
-            self.np_random  # noqa: B018 (creates it)
-            return self._np_random_seed
-
-        @property
-        def unwrapped(self):
-            return self
 
     @property
     def closed(self):

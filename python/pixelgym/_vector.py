@@ -5,6 +5,7 @@ import numpy as np
 
 from . import _core
 from . import _gymnasium as gymnasium
+from ._random import NumpyRandom, seed_np_random
 from ._spaces import to_gymnasium
 
 _MODE_NAMES = {"nextstep": "NextStep", "next_step": "NextStep", "samestep": "SameStep",
@@ -14,7 +15,7 @@ if gymnasium is not None:
     _Base = gymnasium.vector.VectorEnv
     _AutoresetMode = getattr(gymnasium.vector, "AutoresetMode", None)  # Gymnasium >= 1.1
 else:
-    _Base = object
+    _Base = NumpyRandom
     _AutoresetMode = None
 
 
@@ -99,9 +100,6 @@ class VectorEnv(_Base):
             self.action_space = self._core.action_space
         self.closed = False
         self.spec = None
-        if gymnasium is None:
-            self._np_random = None
-            self._np_random_seed = None
 
     def reset(self, *, seed=None, options=None):
         options = dict(options or {})
@@ -111,11 +109,7 @@ class VectorEnv(_Base):
         else:
             obs, infos = self._core.reset(seed, options, mask)
         if seed is not None and not isinstance(seed, (list, tuple)):
-            if gymnasium is not None:
-                super().reset(seed=seed)
-            else:
-                self._np_random = np.random.default_rng(seed)
-                self._np_random_seed = seed
+            seed_np_random(self, seed)
         return (_copy_obs(obs) if self.copy else obs), infos
 
     def _reset_each(self, seeds, options, mask):
@@ -173,17 +167,6 @@ class VectorEnv(_Base):
         self.closed = True
 
     if gymnasium is None:
-
-        @property
-        def np_random(self):
-            if self._np_random is None:
-                seed = int(np.random.SeedSequence().generate_state(1)[0])
-                self._np_random, self._np_random_seed = np.random.default_rng(seed), seed
-            return self._np_random
-
-        @property
-        def unwrapped(self):
-            return self
 
         def __del__(self):
             if not getattr(self, "closed", True):
