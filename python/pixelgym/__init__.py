@@ -63,6 +63,7 @@ else:
 
 _core._set_reset_needed_type(ResetNeeded)
 
+from . import _env, _vector  # noqa: E402
 from ._env import Env, make  # noqa: E402
 from ._vector import VectorEnv, make_vec  # noqa: E402
 
@@ -94,12 +95,13 @@ def register_gymnasium_envs():
         if name in _gymnasium.registry:
             continue
         # No max_episode_steps here: the C++ env truncates at its own limit (which kwargs such as
-        # action_repeat change), and env.spec reports that limit.
+        # action_repeat change), and env.spec reports that limit. The pixelgym id travels as the
+        # kwarg pixelgym_id (gymnasium.make's own first argument is named id).
         _gymnasium.register(
             id=name,
-            entry_point="pixelgym._env:make",
-            vector_entry_point="pixelgym._vector:make_vec",
-            kwargs={"id": env_id},
+            entry_point=_env.ENTRY_POINT,
+            vector_entry_point=_vector.VECTOR_ENTRY_POINT,
+            kwargs={"pixelgym_id": env_id},
         )
 
 

@@ -12,6 +12,9 @@ from ._spaces import to_gymnasium
 
 _RENDER_MODES = (None, "rgb_array")
 
+#: What gymnasium's registry calls to make pixelgym/<ID> (see make_registered).
+ENTRY_POINT = "pixelgym._env:make_registered"
+
 if gymnasium is not None:
     _Base = gymnasium.Env
 else:
@@ -23,10 +26,10 @@ def _gymnasium_spec(env_id, kwargs, max_episode_steps):
     namespace with the same fields."""
     fields = dict(
         id="pixelgym/" + env_id,
-        entry_point="pixelgym._env:make",
+        entry_point=ENTRY_POINT,
         kwargs=kwargs,
         max_episode_steps=max_episode_steps,
-        vector_entry_point="pixelgym._vector:make_vec",
+        vector_entry_point="pixelgym._vector:make_vec_registered",  # _vector.VECTOR_ENTRY_POINT
     )
     if gymnasium is not None:
         return gymnasium.envs.registration.EnvSpec(**fields)
@@ -72,7 +75,7 @@ class Env(_Base):
         }
         self.observation_space = to_gymnasium(self._core.observation_space, gymnasium)
         self.action_space = to_gymnasium(self._core.action_space, gymnasium)
-        spec_kwargs = {"id": id, **self._kwargs}
+        spec_kwargs = {"pixelgym_id": id, **self._kwargs}
         if self._wrap:
             spec_kwargs["wrap"] = list(self._wrap)
         if render_mode != "rgb_array":
@@ -148,3 +151,14 @@ def make(id, render_mode="rgb_array", wrap=(), **kwargs):
     "grayscale", "frame_stack=3"]``, the first innermost). ``max_episode_steps`` sets the time
     limit (0: none)."""
     return Env(id, render_mode=render_mode, wrap=wrap, **kwargs)
+
+
+def make_registered(pixelgym_id, **kwargs):
+    """gymnasium's entry point for pixelgym/<ID>: ``make(pixelgym_id, **kwargs)`` (the id is not
+    passed as ``id``, which gymnasium.make and make_vec take for their own)."""
+    return make(pixelgym_id, **kwargs)
+
+
+# gymnasium.make reads the entry point's render modes to serve render_mode="rgb_array_list"
+# (Gymnasium's RenderCollection over "rgb_array"); every pixelgym env renders rgb_array.
+make_registered.metadata = {"render_modes": ["rgb_array"]}

@@ -11,6 +11,10 @@ from ._spaces import to_gymnasium
 _MODE_NAMES = {"nextstep": "NextStep", "next_step": "NextStep", "samestep": "SameStep",
                "same_step": "SameStep", "disabled": "Disabled"}
 
+#: What gymnasium's registry calls for make_vec(pixelgym/<ID>, vectorization_mode=
+#: "vector_entry_point").
+VECTOR_ENTRY_POINT = "pixelgym._vector:make_vec_registered"
+
 if gymnasium is not None:
     _Base = gymnasium.vector.VectorEnv
     _AutoresetMode = getattr(gymnasium.vector, "AutoresetMode", None)  # Gymnasium >= 1.1
@@ -226,3 +230,9 @@ def make_vec(id, num_envs=1, *, num_threads=0, autoreset_mode="NextStep", wrap=(
     return VectorEnv(id, num_envs, num_threads=num_threads, autoreset_mode=autoreset_mode,
                      wrap=wrap, mode=mode, share_gl_contexts=share_gl_contexts, copy=copy,
                      render_mode=render_mode, **kwargs)
+
+
+def make_vec_registered(pixelgym_id, num_envs=1, **kwargs):
+    """gymnasium's vector entry point for pixelgym/<ID>: ``make_vec(pixelgym_id, num_envs,
+    **kwargs)``."""
+    return make_vec(pixelgym_id, num_envs, **kwargs)

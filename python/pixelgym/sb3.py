@@ -60,7 +60,10 @@ class SB3VecEnv(_VecEnv):
                 seed = list(seeds)
         elif any(s is not None for s in seeds):
             seed = list(seeds)
-        options = self._options[0] if all(o == self._options[0] for o in self._options) else {}
+        if any(options != self._options[0] for options in self._options):
+            raise ValueError("SB3VecEnv: the C++ vector env resets every env with the same options; "
+                             f"got different ones per env: {self._options}")
+        options = self._options[0]
         obs, infos = self.venv.reset(seed=seed, options=options or None)
         self.reset_infos = [self._env_info(infos, i) for i in range(self.num_envs)]
         self._reset_seeds()

@@ -1,7 +1,11 @@
 """One env from Python: seeding, byte-identical determinism, time limits, rendering, copies."""
 
 import copy
+import importlib
+import os
 import pickle
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -118,3 +122,24 @@ def test_deepcopy_and_pickle_make_a_new_env_from_the_same_spec():
 def test_the_core_objects_refuse_pickling_with_a_type_error():
     with pytest.raises(TypeError):
         pickle.dumps(pixelgym._core.Env("GridWorld-v0"))
+
+
+def test_the_registered_entry_points_make_envs_from_the_spec_kwargs():
+    env = pixelgym.make("GridWorld-v0", max_episode_steps=7, obs_mode="pixels", width=16, height=16)
+    assert env.spec.kwargs["pixelgym_id"] == "GridWorld-v0"
+    module, name = env.spec.entry_point.split(":")
+    made = getattr(importlib.import_module(module), name)(**env.spec.kwargs)
+    assert made.spec.max_episode_steps == 7 and made.observation_space["pixels"].shape == (16, 16, 3)
+    module, name = env.spec.vector_entry_point.split(":")
+    envs = getattr(importlib.import_module(module), name)(num_envs=2, **env.spec.kwargs)
+    assert envs.num_envs == 2 and envs.max_episode_steps == 7
+
+
+def test_without_gymnasium_one_warning_says_how_to_get_it():
+    script = ("import pixelgym, pixelgym._env; "
+              "print(pixelgym.HAVE_GYMNASIUM, type(pixelgym.make('GridWorld-v0')).__mro__[1].__name__)")
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                         env=dict(os.environ, PIXELGYM_NO_GYMNASIUM="1"), check=True)
+    assert out.stdout.strip() == "False NumpyRandom"
+    assert out.stderr.count("GymnasiumMissingWarning") == 1
+    assert "pip install gymnasium" in out.stderr
