@@ -133,9 +133,10 @@ class VectorEnv(_Base):
                 continue
             one = np.zeros(self.num_envs, dtype=bool)
             one[i] = True
-            shifted = None if env_seed is None else (int(env_seed) - i) % 2**64
-            if env_seed is not None and int(env_seed) < 0:
-                shifted = env_seed  # let the C++ side refuse it with its message
+            shifted = env_seed  # None, or what the C++ side refuses with its message
+            if isinstance(env_seed, (int, np.integer)) and not isinstance(env_seed, bool) \
+                    and env_seed >= 0:
+                shifted = (int(env_seed) - i) % 2**64
             obs, env_infos = self._core.reset(shifted, options, one)
             _merge_infos(infos, env_infos)
         return obs, infos

@@ -122,3 +122,7 @@ def test_bad_seeds():
     with pytest.raises(ValueError, match="3 seeds given for 2 envs"):
         pixelgym.make_vec("GridWorld-v0", 2).reset(seed=[1, 2, 3])
     env.reset(seed=2**64 - 1)
+    with pytest.raises(TypeError, match="seed must be None or an int"):
+        pixelgym.make_vec("GridWorld-v0", 2).reset(seed=[1, 2.5])
+    with pytest.raises(ValueError, match=r"seed must be in \[0, 2\*\*64\), got -3"):
+        pixelgym.make_vec("GridWorld-v0", 2).reset(seed=[1, -3])
