@@ -44,24 +44,23 @@ bool first_kwarg_problem_is_type(const std::string& id, const Params& kwargs) {
   return false;
 }
 
+py::object param_to_python(const Param& value) {
+  switch (value.type()) {
+    case ParamType::kBool:
+      return py::bool_(value.as_bool());
+    case ParamType::kInt:
+      return py::int_(value.as_int());
+    case ParamType::kFloat:
+      return py::float_(value.as_float());
+    case ParamType::kString:
+      return py::str(value.as_string());
+  }
+  return py::none();
+}
+
 py::dict params_to_python(const Params& params) {
   py::dict out;
-  for (const auto& [key, value] : params) {
-    switch (value.type()) {
-      case ParamType::kBool:
-        out[py::str(key)] = value.as_bool();
-        break;
-      case ParamType::kInt:
-        out[py::str(key)] = value.as_int();
-        break;
-      case ParamType::kFloat:
-        out[py::str(key)] = value.as_float();
-        break;
-      case ParamType::kString:
-        out[py::str(key)] = value.as_string();
-        break;
-    }
-  }
+  for (const auto& [key, value] : params) out[py::str(key)] = param_to_python(value);
   return out;
 }
 
@@ -191,17 +190,24 @@ void bind_env(py::module_& module) {
       .def(py::init<const std::string&, const py::dict&, std::vector<std::string>>(), py::arg("id"),
            py::arg("kwargs") = py::dict(), py::arg("wrappers") = std::vector<std::string>{})
       .def("reset", &EnvHandle::reset, py::arg("seed") = py::none(),
-           py::arg("options") = py::none())
-      .def("step", &EnvHandle::step, py::arg("action"))
-      .def("render", &EnvHandle::render)
-      .def("close", &EnvHandle::close)
-      .def_property_readonly("observation_space", &EnvHandle::observation_space)
+           py::arg("options") = py::none(),
+           "Starts an episode: (obs, info). The GIL is released while C++ runs.")
+      .def("step", &EnvHandle::step, py::arg("action"),
+           "(obs, reward, terminated, truncated, info); the action is converted and checked "
+           "against the action space")
+      .def("render", &EnvHandle::render, "The current frame, (H, W, 3) uint8.")
+      .def("close", &EnvHandle::close, "Releases the env; calling it again does nothing.")
+      .def_property_readonly("observation_space", &EnvHandle::observation_space,
+                             "The env's observation space (it keeps the env's memory alive).")
       .def_property_readonly("action_space", &EnvHandle::action_space)
       .def_property_readonly("metadata", &EnvHandle::metadata)
       .def_property_readonly("id", &EnvHandle::id)
       .def_property_readonly("name", &EnvHandle::name)
-      .def_property_readonly("max_episode_steps", &EnvHandle::max_episode_steps)
-      .def_property_readonly("kwargs", &EnvHandle::kwargs)
+      .def_property_readonly("max_episode_steps", &EnvHandle::max_episode_steps,
+                             "The step at which the env truncates; None for no limit.")
+      .def_property_readonly("kwargs", &EnvHandle::kwargs,
+                             "The kwargs the env was made with, every declared one (defaults "
+                             "filled in), max_episode_steps excluded.")
       .def_property_readonly("wrappers", &EnvHandle::wrappers)
       .def_property_readonly("closed", &EnvHandle::closed);
 
@@ -229,8 +235,7 @@ void bind_env(py::module_& module) {
           py::dict entry;
           entry["name"] = param.name;
           entry["type"] = param_type_name(param.type());
-          entry["default"] =
-              params_to_python({{param.name, param.default_value}})[py::str(param.name)];
+          entry["default"] = param_to_python(param.default_value);
           entry["doc"] = param.doc;
           accepted.append(entry);
         }

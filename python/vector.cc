@@ -196,22 +196,30 @@ void bind_vector(py::module_& module) {
            py::arg("num_threads") = 0, py::arg("autoreset_mode") = "NextStep",
            py::arg("share_gl_contexts") = true)
       .def("reset", &VectorHandle::reset, py::arg("seed") = py::none(),
-           py::arg("options") = py::none(), py::arg("reset_mask") = py::none())
-      .def("step", &VectorHandle::step, py::arg("actions"))
-      .def("step_async", &VectorHandle::step_async, py::arg("actions"))
-      .def("step_wait", &VectorHandle::step_wait)
-      .def("close", &VectorHandle::close)
+           py::arg("options") = py::none(), py::arg("reset_mask") = py::none(),
+           "Resets every env (env i with seed + i), or those of reset_mask: (obs, infos).")
+      .def("step", &VectorHandle::step, py::arg("actions"),
+           "(obs, rewards, terminated, truncated, infos); obs are the vector env's buffers")
+      .def("step_async", &VectorHandle::step_async, py::arg("actions"),
+           "Starts a step on the thread pool and returns.")
+      .def("step_wait", &VectorHandle::step_wait, "The results of the step begun by step_async.")
+      .def("close", &VectorHandle::close, "Closes every env; calling it again does nothing.")
       .def_property_readonly("num_envs", &VectorHandle::num_envs)
-      .def_property_readonly("num_threads", &VectorHandle::num_threads)
-      .def_property_readonly("autoreset_mode", &VectorHandle::autoreset_mode)
+      .def_property_readonly("num_threads", &VectorHandle::num_threads,
+                             "Threads that run envs, the caller's included (1 for mode sync).")
+      .def_property_readonly("autoreset_mode", &VectorHandle::autoreset_mode,
+                             "\"NextStep\", \"SameStep\" or \"Disabled\".")
       .def_property_readonly("single_observation_space", &VectorHandle::single_observation_space)
       .def_property_readonly("single_action_space", &VectorHandle::single_action_space)
-      .def_property_readonly("observation_space", &VectorHandle::observation_space)
+      .def_property_readonly("observation_space", &VectorHandle::observation_space,
+                             "The batched observation space (a leading num_envs axis).")
       .def_property_readonly("action_space", &VectorHandle::action_space)
       .def_property_readonly("id", &VectorHandle::id)
       .def_property_readonly("name", &VectorHandle::name)
-      .def_property_readonly("max_episode_steps", &VectorHandle::max_episode_steps)
-      .def_property_readonly("wrappers", &VectorHandle::wrappers)
+      .def_property_readonly("max_episode_steps", &VectorHandle::max_episode_steps,
+                             "The step at which each env truncates; None for no limit.")
+      .def_property_readonly("wrappers", &VectorHandle::wrappers,
+                             "The --wrap specs applied to every env, innermost first.")
       .def_property_readonly("closed", &VectorHandle::closed)
       .def_property_readonly("is_async", &VectorHandle::is_async)
       .def_property_readonly("metadata", [](const VectorHandle& handle) {

@@ -7,6 +7,7 @@ import types
 
 from . import _core
 from . import _gymnasium as gymnasium
+from ._core_backed import CoreBacked
 from ._random import NumpyRandom, seed_np_random
 from ._spaces import to_gymnasium
 
@@ -36,7 +37,7 @@ def _gymnasium_spec(env_id, kwargs, max_episode_steps):
     return types.SimpleNamespace(**fields)
 
 
-class Env(_Base):
+class Env(CoreBacked, _Base):
     """One pixelgym env (made in C++ from the registry), with Gymnasium's API.
 
     ``reset(seed=None, options=None) -> (obs, info)``; ``step(action) -> (obs, reward,
@@ -125,19 +126,8 @@ class Env(_Base):
     def closed(self):
         return self._core.closed
 
-    @property
-    def max_episode_steps(self):
-        """The step at which the env truncates (None: no limit)."""
-        return self._core.max_episode_steps
-
     def __reduce__(self):
         return (_remake, (self._id, self.render_mode, self._wrap, self._kwargs))
-
-    def __repr__(self):
-        return f"<pixelgym.Env {self._core.name}>"
-
-    def __str__(self):
-        return self.__repr__()
 
 
 def _remake(env_id, render_mode, wrap, kwargs):

@@ -5,6 +5,7 @@ import numpy as np
 
 from . import _core
 from . import _gymnasium as gymnasium
+from ._core_backed import CoreBacked
 from ._random import NumpyRandom, seed_np_random
 from ._spaces import to_gymnasium
 
@@ -45,7 +46,7 @@ def _row(obs, i):
     return obs[i].copy()
 
 
-class VectorEnv(_Base):
+class VectorEnv(CoreBacked, _Base):
     """``num_envs`` copies of a pixelgym env stepped as one by the C++ vector env: a thread pool
     (``mode="async"``, ``num_threads`` workers, 0 for one per core) or a loop on the calling
     thread (``mode="sync"``). The GIL is released while C++ steps, so other Python threads run.
@@ -187,18 +188,8 @@ class VectorEnv(_Base):
         """"NextStep", "SameStep" or "Disabled"."""
         return self._core.autoreset_mode
 
-    @property
-    def max_episode_steps(self):
-        return self._core.max_episode_steps
-
     def __reduce__(self):
         return (_remake, (self._id, self._args))
-
-    def __repr__(self):
-        return f"<pixelgym.VectorEnv {self._core.name}>"
-
-    def __str__(self):
-        return self.__repr__()
 
 
 def _merge_infos(total, infos):
