@@ -22,6 +22,8 @@ PACKAGES=(
   libtorch-dev libopenblas0-pthread
   # command line, JSON
   libcli11-dev nlohmann-json3-dev
+  # the Python binding (python/) and its pytest suite (tests/python/), for Debian's python3
+  python3-dev pybind11-dev python3-numpy python3-pytest
   # tests and benchmarks; ffmpeg for ffprobe, which the RecordVideo tests read clips back with
   libgtest-dev libgmock-dev libbenchmark-dev ffmpeg
 )

@@ -1,0 +1,15 @@
+// pixelgym._core: the C++ side of the Python package pixelgym (python/pixelgym/ wraps it into
+// gymnasium classes when gymnasium is importable).
+#include <pybind11/pybind11.h>
+
+#include "python/bindings.h"
+
+PYBIND11_MODULE(_core, module) {
+  module.doc() =
+      "pixelgym's C++ envs, spaces and vector envs. Use the package pixelgym, which wraps them "
+      "into gymnasium classes when gymnasium is importable.";
+  pixelgym::python::bind_buffer_and_errors(module);
+  pixelgym::python::bind_spaces(module);
+  pixelgym::python::bind_env(module);
+  pixelgym::python::bind_vector(module);
+}

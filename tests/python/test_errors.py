@@ -1,0 +1,128 @@
+"""Errors are Python exceptions with pixelgym's messages, never a crash."""
+
+import numpy as np
+import pytest
+
+import pixelgym
+
+
+def made(env_id="CartPoleSwingup-v0", **kwargs):
+    env = pixelgym.make(env_id, **kwargs)
+    env.reset(seed=0)
+    return env
+
+
+def test_unknown_id_suggests_the_closest():
+    with pytest.raises(ValueError, match=r'unknown env id "CartPoleSwingUp-v0"; did you mean '
+                                         r"CartPoleSwingup-v0"):
+        pixelgym.make("CartPoleSwingUp-v0")
+    with pytest.raises(ValueError, match="unknown env id"):
+        pixelgym.make_vec("Nope-v9", 2)
+
+
+def test_unknown_kwarg_is_a_value_error_listing_the_valid_ones():
+    with pytest.raises(ValueError, match=r'CartPoleSwingup-v0: unknown kwarg "widht"; valid kwargs: '
+                                         r".*width \(int, default 84\)"):
+        pixelgym.make("CartPoleSwingup-v0", widht=64)
+
+
+def test_kwarg_of_the_wrong_type_is_a_type_error_with_the_registry_message():
+    with pytest.raises(TypeError) as error:
+        pixelgym.make("CartPoleSwingup-v0", width="64")
+    assert str(error.value) == 'CartPoleSwingup-v0: kwarg "width" must be an int, got string "64"'
+    with pytest.raises(TypeError, match='kwarg "shadows" must be a bool, got int 1'):
+        pixelgym.make_vec("CartPoleSwingup-v0", 2, shadows=1)
+    with pytest.raises(TypeError, match=r'kwarg "width" must be a bool, int, float or str, got list'):
+        pixelgym.make("CartPoleSwingup-v0", width=[64])
+    # An int where a float is declared is converted, as Python would.
+    pixelgym.make("CartPoleSwingup-v0", obs_mode="state")
+
+
+def test_a_bad_kwarg_value_is_a_value_error():
+    with pytest.raises(ValueError, match='obs_mode'):
+        pixelgym.make("GridWorld-v0", obs_mode="rgb")
+    with pytest.raises(ValueError, match="max_episode_steps"):
+        pixelgym.make("GridWorld-v0", max_episode_steps=-1)
+    with pytest.raises(ValueError, match="render_mode"):
+        pixelgym.make("GridWorld-v0", render_mode="human")
+
+
+def test_bad_wrapper_specs_and_vector_options():
+    with pytest.raises(ValueError, match="resize"):
+        pixelgym.make("CartPoleSwingup-v0", wrap=["resize=64y64"])
+    with pytest.raises(ValueError, match="unknown wrapper|known"):
+        pixelgym.make_vec("CartPoleSwingup-v0", 2, wrap=["blur"])
+    with pytest.raises(ValueError, match="NextStep"):
+        pixelgym.make_vec("GridWorld-v0", 2, autoreset_mode="Sometimes")
+    with pytest.raises(ValueError, match="mode"):
+        pixelgym.make_vec("GridWorld-v0", 2, mode="processes")
+    with pytest.raises(ValueError, match="num_envs"):
+        pixelgym.make_vec("GridWorld-v0", 0)
+    with pytest.raises(TypeError, match="thread pool"):
+        pixelgym.make_vec("GridWorld-v0", 2, mode="sync").step_async(np.zeros(2, np.int64))
+
+
+def test_wrong_actions_raise_value_errors_naming_the_space():
+    env = made()
+    with pytest.raises(ValueError, match=r"not in Box\(-1.0, 1.0, \(1,\), float32\): shape \(2,\)"):
+        env.step(np.zeros(2, np.float32))
+    with pytest.raises(ValueError, match="not in Box"):
+        env.step(np.array([np.nan], np.float32))
+    with pytest.raises(ValueError, match="not in Box"):
+        env.step(np.array([1.5], np.float32))
+    with pytest.raises(ValueError, match="not in Box"):
+        env.step(0.5)  # a scalar for a (1,) Box
+    with pytest.raises(TypeError, match="expected a numeric array"):
+        env.step("left")
+    with pytest.raises(TypeError, match="expected a numeric array"):
+        env.step(None)
+    env.step(np.array([0.5]))  # float64 is cast to the float32 Box
+    discrete = made("GridWorld-v0")
+    with pytest.raises(ValueError, match=r"not in Discrete\(4\)"):
+        discrete.step(4)
+    with pytest.raises(ValueError, match=r"not in Discrete\(4\)"):
+        discrete.step(1.0)  # a float is not an action of a Discrete space
+    with pytest.raises(ValueError, match=r"not in Discrete\(4\)"):
+        discrete.step(np.array([1]))
+    discrete.step(np.int32(1))
+
+
+def test_calls_out_of_order_raise_reset_needed():
+    env = pixelgym.make("GridWorld-v0")
+    with pytest.raises(pixelgym.ResetNeeded, match="reset"):
+        env.step(0)
+    with pytest.raises(RuntimeError):  # ResetNeeded is a RuntimeError
+        env.render()
+    envs = pixelgym.make_vec("GridWorld-v0", 2)
+    with pytest.raises(pixelgym.ResetNeeded):
+        envs.step(np.zeros(2, np.int64))
+
+
+def test_vector_errors_name_the_env_and_a_full_reset_recovers():
+    envs = pixelgym.make_vec("CartPoleSwingup-v0", 4, num_threads=2, obs_mode="state")
+    envs.reset(seed=0)
+    with pytest.raises(ValueError, match="expected|layout|shape"):
+        envs.step(np.zeros((3, 1), np.float32))
+    actions = np.zeros((4, 1), np.float32)
+    actions[2] = np.nan
+    with pytest.raises(ValueError, match=r"env 2 .*not in Box"):
+        envs.step(actions)
+    with pytest.raises(pixelgym.ResetNeeded):
+        envs.step(np.zeros((4, 1), np.float32))
+    envs.reset(seed=0)
+    envs.step(np.zeros((4, 1), np.float32))
+
+
+def test_bad_seeds():
+    env = pixelgym.make("GridWorld-v0")
+    with pytest.raises(ValueError, match=r"seed must be in \[0, 2\*\*64\), got -1"):
+        env.reset(seed=-1)
+    with pytest.raises(TypeError, match="seed must be None or an int"):
+        env.reset(seed=1.5)
+    with pytest.raises(ValueError, match="3 seeds given for 2 envs"):
+        pixelgym.make_vec("GridWorld-v0", 2).reset(seed=[1, 2, 3])
+    env.reset(seed=2**64 - 1)
+    with pytest.raises(TypeError, match="seed must be None or an int"):
+        pixelgym.make_vec("GridWorld-v0", 2).reset(seed=[1, 2.5])
+    with pytest.raises(ValueError, match=r"seed must be in \[0, 2\*\*64\), got -3"):
+        pixelgym.make_vec("GridWorld-v0", 2).reset(seed=[1, -3])
