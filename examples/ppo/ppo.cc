@@ -519,6 +519,17 @@ UpdateStats Trainer::update() {
       optimizer_->zero_grad();
       loss.backward();
       const double grad_norm = torch::nn::utils::clip_grad_norm_(parameters, config_.max_grad_norm);
+      if (!std::isfinite(loss.item<double>()) || !std::isfinite(grad_norm)) {
+        // A step would write NaN or infinite weights; the next rollout would then act with NaN.
+        throw std::runtime_error(
+            "Trainer::update: update " + std::to_string(updates_ + 1) + ", epoch " +
+            std::to_string(epoch + 1) + ", minibatch " + std::to_string(m + 1) +
+            " diverged: loss " + std::to_string(loss.item<double>()) + " (policy " +
+            std::to_string(policy_loss.item<double>()) + ", value " +
+            std::to_string(value_loss.item<double>()) + "), gradient norm " +
+            std::to_string(grad_norm) +
+            "; the parameters are left as the previous minibatch made them, not stepped");
+      }
       optimizer_->step();
 
       double approx_kl;

@@ -212,7 +212,9 @@ class Trainer {
   /// env steps done before the rollout (annealing). With augmentation, one random shift per
   /// transition is drawn for the whole update and the rollout's old log-probs and values are
   /// recomputed under it (no gradients), so the ratio starts at 1 on the shifted images.
-  /// Throws std::logic_error before any collect().
+  /// Throws std::logic_error before any collect(), and std::runtime_error (naming the update,
+  /// epoch and minibatch, the losses and the gradient norm) when a minibatch's loss or gradient
+  /// norm is not finite; that minibatch's step is not taken.
   UpdateStats update();
 
   Policy& policy() { return *policy_; }

@@ -299,6 +299,33 @@ TEST(Trainer, NormalizedRewardsAreNormalizeRewardsAndEpisodesKeepTheEnvsReturns)
   EXPECT_EQ(trainer.reward_scaling().returns[1], 7.5);
 }
 
+// A non-finite loss stops the update with an error that names it, before the optimizer writes
+// NaN into the weights.
+TEST(Trainer, ANonFiniteLossIsAnErrorAndNoStepIsTaken) {
+  auto envs = bandit_envs(2, true);
+  Trainer trainer(*envs, small_config(2, 4));
+  trainer.collect();
+  {
+    torch::NoGradGuard no_grad;
+    trainer.policy().parameters()[0].view(-1)[0].fill_(std::nan(""));
+  }
+  const std::vector<torch::Tensor> parameters = parameters_of(trainer.policy());
+  try {
+    trainer.update();
+    FAIL() << "no error for a NaN loss";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("diverged"), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("epoch 1, minibatch 1"), std::string::npos)
+        << error.what();
+  }
+  // Nothing was stepped: every parameter is as before (the planted NaN included).
+  const std::vector<torch::Tensor> after = parameters_of(trainer.policy());
+  ASSERT_EQ(after.size(), parameters.size());
+  for (std::size_t i = 0; i < after.size(); ++i) {
+    EXPECT_TRUE(torch::equal(after[i].nan_to_num(), parameters[i].nan_to_num())) << i;
+  }
+}
+
 TEST(Trainer, LearnsTheRewardedActionOfADiscreteBandit) {
   auto envs = bandit_envs(4, false);
   PpoConfig config = small_config(4, 16);
