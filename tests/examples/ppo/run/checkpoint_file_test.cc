@@ -330,14 +330,28 @@ TEST(CheckpointFileTest, FullDiskKeepsThePreviousCheckpointAndLeavesNoTemporary)
   EXPECT_EQ(entries(folder), std::vector<std::string>{"ckpt-000001.pgck"});
 }
 
+// True once a temporary of `name` exists in `folder`: a write of it has started and not finished.
+bool temporary_exists(const fs::path& folder, const std::string& name) {
+  for (const std::string& entry : entries(folder)) {
+    if (entry.rfind(temporary_file_prefix(name), 0) == 0) return true;
+  }
+  return false;
+}
+
 // A child process rewrites one large checkpoint in a loop, alternating two contents, and is
-// killed with SIGKILL after a range of delays. Under the final name there is always a complete,
+// killed with SIGKILL at a range of points. Under the final name there is always a complete,
 // valid checkpoint: the one before the child started, or one the child finished; what a kill
 // mid-write leaves is a temporary file, which the latest-checkpoint lookup ignores.
+//
+// The kills are placed by events, not by a clock (fixed delays after fork() were flaky under
+// load: the child might not have started writing yet): the child reports on a pipe as it starts
+// each write, the parent waits for the 1st, 2nd or 3rd report and for the temporary of that write
+// to appear, then waits 0 to 20 ms more (into the write, its fsync or its rename) and kills.
 TEST(CheckpointFileTest, SigkillMidWriteLeavesTheOldOrTheNewCheckpointNeverAPartOne) {
   const fs::path folder = fresh_folder("ckpt_sigkill");
   const fs::path path = folder / checkpoint_file_name(1);
-  constexpr std::size_t kSize = 24 << 20;  // 24 MiB: writing it takes a while
+  const std::string name = path.filename().string();
+  constexpr std::size_t kSize = 24 << 20;  // 24 MiB: writing and syncing it takes a while
   const std::vector<CheckpointBlobs> contents = {
       {{"model", pattern(kSize, 10)}, {"meta", "first"}},
       {{"model", pattern(kSize, 11)}, {"meta", "second"}},
@@ -346,20 +360,47 @@ TEST(CheckpointFileTest, SigkillMidWriteLeavesTheOldOrTheNewCheckpointNeverAPart
 
   int killed_mid_write = 0;
   std::vector<int> seen(contents.size(), 0);
-  for (const int delay_ms : {1, 2, 5, 10, 20, 35, 50, 80, 120, 200, 300, 450}) {
+  const std::vector<int> extra_delays_ms = {0, 1, 5, 20};
+  for (int round = 0; round < 12; ++round) {
+    const int writes_started = 1 + round % 3;
+    const int extra_delay_ms = extra_delays_ms[static_cast<std::size_t>(round / 3)];
+    int report[2];
+    ASSERT_EQ(::pipe(report), 0);
     const pid_t child = ::fork();
     ASSERT_GE(child, 0);
     if (child == 0) {
+      ::close(report[0]);
       try {
-        for (std::size_t i = 1;; i = 3 - i) write_checkpoint(path, contents[i]);
+        for (std::size_t i = 1;; i = 3 - i) {
+          const char started = 's';
+          if (::write(report[1], &started, 1) != 1) ::_exit(4);
+          write_checkpoint(path, contents[i]);
+        }
       } catch (...) {
         ::_exit(3);
       }
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
+    ::close(report[1]);
+    for (int started = 0; started < writes_started; ++started) {
+      char byte = 0;
+      ASSERT_EQ(::read(report[0], &byte, 1), 1) << "the child stopped writing";
+    }
+    // The write reported last creates its temporary (the child writes forever, so one appears
+    // even if that write has already finished under load).
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    bool temporary_seen = false;
+    while (!(temporary_seen = temporary_exists(folder, name)) &&
+           std::chrono::steady_clock::now() < give_up) {
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+    if (temporary_seen) std::this_thread::sleep_for(std::chrono::milliseconds(extra_delay_ms));
     ASSERT_EQ(::kill(child, SIGKILL), 0);
     int status = 0;
     ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ::close(report[0]);  // only now: the child must not die of SIGPIPE before the kill
+    ASSERT_TRUE(temporary_seen) << "round " << round
+                                << ": no temporary file in 10 s; the checkpoint is not written "
+                                   "under a temporary name";
     ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << "the child exited itself";
 
     const CheckpointBlobs read = read_checkpoint(path);  // throws on a partial file
@@ -370,25 +411,30 @@ TEST(CheckpointFileTest, SigkillMidWriteLeavesTheOldOrTheNewCheckpointNeverAPart
         ++seen[i];
       }
     }
-    EXPECT_TRUE(known) << "after " << delay_ms << " ms: a checkpoint no one wrote";
+    EXPECT_TRUE(known) << "round " << round << ": a checkpoint no one wrote";
+    if (writes_started >= 2) {
+      EXPECT_NE(read, contents[0]) << "round " << round << ": a finished write is not in place";
+    }
     const CheckpointSearch search = find_latest_checkpoint(folder);
     ASSERT_TRUE(search.latest.has_value());
     EXPECT_EQ(search.latest->blobs, read);
     EXPECT_TRUE(search.skipped.empty());
     // Leftover temporaries: the kill landed mid-write. Remove them for the next round.
     bool temporary_left = false;
-    for (const std::string& name : entries(folder)) {
-      if (name != path.filename().string()) {
-        EXPECT_EQ(name.rfind(temporary_file_prefix(path.filename().string()), 0), 0U) << name;
-        fs::remove(folder / name);
+    for (const std::string& entry : entries(folder)) {
+      if (entry != name) {
+        EXPECT_EQ(entry.rfind(temporary_file_prefix(name), 0), 0U) << entry;
+        fs::remove(folder / entry);
         temporary_left = true;
       }
     }
     killed_mid_write += temporary_left ? 1 : 0;
   }
-  // The test tests something: some kills landed mid-write, and the child finished some writes.
+  // The test tests something: kills landed mid-write (the rounds without extra delay kill with a
+  // temporary present, unless the write finished in the microseconds between the look and the
+  // kill), and the child finished writes.
   EXPECT_GE(killed_mid_write, 3);
-  EXPECT_GE(seen[1] + seen[2], 1);
+  EXPECT_GE(seen[1] + seen[2], 8);
 }
 
 }  // namespace
