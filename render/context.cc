@@ -1,28 +1,15 @@
 #include "render/context.h"
 
-#include <GL/osmesa.h>
-
-#include <cstdlib>
-#include <mutex>
 #include <stdexcept>
 #include <vector>
 
 #include "render/gl.h"
+#include "render/gl_library.h"
 
 namespace pixelgym::render {
-namespace {
-
-void default_llvmpipe_threads() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    // Read by llvmpipe when it creates its screen, on the first context: see Context's comment.
-    if (std::getenv("LP_NUM_THREADS") == nullptr) setenv("LP_NUM_THREADS", "0", 0);
-  });
-}
-
-}  // namespace
 
 struct Context::Impl {
+  const GlLibrary* library = nullptr;
   OSMesaContext context = nullptr;
   // OSMesa needs a framebuffer to make a context current; rendering goes to framebuffer objects,
   // so this one is a single pixel.
@@ -30,7 +17,8 @@ struct Context::Impl {
 };
 
 Context::Context(GlBackend backend) : backend_(backend), impl_(std::make_unique<Impl>()) {
-  default_llvmpipe_threads();
+  impl_->library = &library_for_new_context();
+  prepare_thread(*impl_->library);
   const int attributes[] = {OSMESA_FORMAT,
                             OSMESA_RGBA,
                             OSMESA_DEPTH_BITS,
@@ -42,7 +30,7 @@ Context::Context(GlBackend backend) : backend_(backend), impl_(std::make_unique<
                             OSMESA_CONTEXT_MINOR_VERSION,
                             3,
                             0};
-  impl_->context = OSMesaCreateContextAttribs(attributes, nullptr);
+  impl_->context = impl_->library->create_context_attribs(attributes, nullptr);
   if (impl_->context == nullptr) {
     throw std::runtime_error(
         "Context: OSMesa could not create an OpenGL 3.3 core context (OSMesaCreateContextAttribs "
@@ -52,31 +40,42 @@ Context::Context(GlBackend backend) : backend_(backend), impl_(std::make_unique<
 }
 
 Context::~Context() {
-  if (impl_->context != nullptr) OSMesaDestroyContext(impl_->context);
+  if (impl_->context == nullptr) return;
+  prepare_thread(*impl_->library);
+  impl_->library->destroy_context(impl_->context);
 }
 
 void Context::make_current() {
-  if (is_current()) return;
-  if (!OSMesaMakeCurrent(impl_->context, impl_->dummy.data(), GL_UNSIGNED_BYTE, 1, 1)) {
+  prepare_thread(*impl_->library);
+  if (!is_current() &&
+      !impl_->library->make_current(impl_->context, impl_->dummy.data(), GL_UNSIGNED_BYTE, 1, 1)) {
     throw std::runtime_error("Context: OSMesaMakeCurrent failed");
   }
+  current_gl_functions = &impl_->library->gl;
 }
 
 void Context::release() {
   // OSMesa's way to unbind: no context and no buffer.
-  if (is_current()) OSMesaMakeCurrent(nullptr, nullptr, 0, 0, 0);
+  prepare_thread(*impl_->library);
+  if (is_current()) impl_->library->make_current(nullptr, nullptr, 0, 0, 0);
 }
 
-bool Context::is_current() const { return OSMesaGetCurrentContext() == impl_->context; }
+bool Context::is_current() const {
+  prepare_thread(*impl_->library);
+  return impl_->library->get_current_context() == impl_->context;
+}
 
-Context::Scope::Scope(Context& context) : context_(context), was_current_(context.is_current()) {
+int Context::mesa_copy() const { return impl_->library->copy; }
+
+Context::Scope::Scope(Context& context)
+    : context_(context), was_current_(context.is_current()), previous_gl_(current_gl_functions) {
   context_.make_current();
 }
 
 Context::Scope::~Scope() {
   if (!was_current_) context_.release();
+  current_gl_functions = static_cast<const GlFunctions*>(previous_gl_);
 }
-
 std::string Context::description() {
   const Scope scope(*this);
   const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));

@@ -23,6 +23,10 @@ enum class GlBackend {
 /// done with a context for now releases it, as `Scope` does; Renderer binds its context only
 /// for the length of each call.
 ///
+/// Copies of Mesa: a context is created in the copy of libOSMesa that MesaCopy::Use selects on
+/// the creating thread (copy 0, the linked library, by default). Contexts of different copies
+/// rasterize in parallel; those of one copy take turns (see render/mesa_copy.h).
+///
 /// llvmpipe threads: Mesa's software rasterizer starts LP_NUM_THREADS worker threads per context
 /// (by default one per core). For the small images of pixel observations they cost more than they
 /// give (measured in bench/render_bench), so the first context pixelgym creates in a process sets
@@ -56,10 +60,14 @@ class Context {
    private:
     Context& context_;
     bool was_current_;
+    const void* previous_gl_;  // the GL table in use before (render/gl.h)
   };
   /// True when this context is current on the calling thread.
   bool is_current() const;
   GlBackend backend() const { return backend_; }
+  /// The copy of Mesa the context is from (see MesaCopy): the one selected on the thread that
+  /// created it, or 0 when that one could not be loaded.
+  int mesa_copy() const;
   /// GL_RENDERER and GL_VERSION, e.g. "llvmpipe (LLVM 15.0.6, 256 bits), 4.5 (Core Profile)
   /// Mesa 22.3.6".
   std::string description();

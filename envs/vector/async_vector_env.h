@@ -38,12 +38,12 @@ namespace pixelgym::vector {
 /// Between the steps of a learner that computes for longer, each worker spins 200 microseconds and
 /// then sleeps.
 ///
-/// Speed-up. With pixel envs on OSMesa, a second thread adds 10-30 % (bench/vector_bench, the
-/// README's scaling table), not 2x: OSMesa has one llvmpipe screen per process and llvmpipe
-/// rasterizes every context's frames under that screen's one lock (with LP_NUM_THREADS=0, inside
-/// it), so threads take turns for most of a pixel step; physics, scene updates and wrappers still
-/// run in parallel. Threads pay off fully for state-only envs, and for overlapping env steps with
-/// the caller's own work (step_async, compute, step_wait).
+/// Speed-up. With pixel envs on OSMesa, two threads give about 1.75-1.8x one thread at 8 envs
+/// (bench/vector_bench, the README's scaling table). llvmpipe rasterizes the frames of all the
+/// contexts of one loaded libOSMesa under one lock, so threads drawing with one library take
+/// turns (a second thread added only 10-30 %); each worker w >= 1 therefore creates its contexts
+/// in private copy w of Mesa (render::MesaCopy; worker 0 uses the linked library, copy 0), and
+/// the workers rasterize in parallel.
 ///
 /// Threads: `num_threads` 0 means min(num_envs, std::thread::hardware_concurrency()); more
 /// threads than envs are clamped to num_envs (a thread without envs would only wait), not an
@@ -52,7 +52,8 @@ namespace pixelgym::vector {
 ///
 /// Results are byte-identical to SyncVectorEnv's for the same seeds and actions, for any number
 /// of threads: envs share nothing but GL contexts (and those only between envs that run one after
-/// another), and infos are batched on the calling thread in index order.
+/// another), every copy of Mesa draws the same bytes, and infos are batched on the calling thread
+/// in index order.
 class AsyncVectorEnv final : public VectorEnv {
  public:
   /// Starts the workers and builds env i with `make_env(i)` on its thread (several at once:

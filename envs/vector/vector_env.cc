@@ -120,6 +120,7 @@ const Space& VectorEnv::single_action_space() const { return envs_[0]->action_sp
 
 void VectorEnv::build(const EnvFactory& make_env, int context_groups) {
   const auto n = static_cast<std::size_t>(num_envs_);
+  context_groups_ = context_groups;
   if (share_gl_contexts_) {
     // Cheap: each creates its GL context when its first env renders.
     for (int g = 0; g < context_groups; ++g) {
@@ -205,6 +206,7 @@ void VectorEnv::run_phase(Phase phase) {
 
 void VectorEnv::run_env(int i) noexcept {
   const auto index = static_cast<std::size_t>(i);
+  const render::MesaCopy::Use mesa_copy(i % context_groups_);
   std::optional<render::SharedContext::Use> shared_context;
   if (!shared_contexts_.empty()) {
     shared_context.emplace(*shared_contexts_[index % shared_contexts_.size()]);

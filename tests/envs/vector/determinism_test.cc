@@ -4,7 +4,8 @@
 // that autoresets happen inside the 9 steps compared; renders are small to keep this quick.
 // The pools alternate step() (worker 0's envs run on the calling thread) with step_async() +
 // step_wait() (they run on worker thread 0), and the vector envs run with GL contexts shared per
-// thread (their default) and, sync and on 2 threads, with a context per env.
+// thread (their default) and, sync and on 2 threads, with a context per env. Workers 1-3 draw with
+// private copies of Mesa (render::MesaCopy), so their frames are compared with copy 0's too.
 #include <gtest/gtest.h>
 
 #include <ostream>
@@ -16,6 +17,7 @@
 #include "envs/vector/async_vector_env.h"
 #include "envs/vector/batch_space.h"
 #include "envs/vector/make_vec.h"
+#include "render/mesa_copy.h"
 #include "wrappers/wrapper_spec.h"
 
 namespace pixelgym::vector {
@@ -130,6 +132,11 @@ TEST_P(VectorDeterminismTest, SyncAndPoolsEqualSingleEnvsByteForByte) {
         }
       }
     }
+  }
+  // The pools of 2 and 4 threads drew with private copies 1-3 (each test runs in a process of
+  // its own): the frames compared above came from them.
+  for (const int copy : {1, 2, 3}) {
+    EXPECT_TRUE(render::MesaCopy::loaded(copy)) << copy << ": " << render::MesaCopy::why_not(copy);
   }
 }
 

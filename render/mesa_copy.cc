@@ -1,0 +1,212 @@
+#include "render/mesa_copy.h"
+
+#include <dlfcn.h>
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+
+#include "render/gl_library.h"
+
+namespace pixelgym::render {
+
+thread_local const GlFunctions* current_gl_functions = nullptr;
+
+namespace {
+
+// glibc's link namespaces (DL_NNS), the base one included.
+constexpr int kMostCopies = 16;
+constexpr int kDefaultCopies = 8;
+
+thread_local int copy_in_use = 0;
+thread_local unsigned copies_ready_here = 1U;  // bit k: init_thread of copy k ran on this thread
+
+void default_llvmpipe_threads() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    // Read by llvmpipe when it creates a screen (on a copy's first context), and by private
+    // copies from the environment they are loaded with: see Context's comment.
+    if (std::getenv("LP_NUM_THREADS") == nullptr) setenv("LP_NUM_THREADS", "0", 0);
+  });
+}
+
+// Fills `library.gl` with `get_proc_address`; returns the first name it lacks, or "".
+std::string load_gl_functions(GlLibrary& library, OSMESAproc (*get_proc_address)(const char*)) {
+#define PIXELGYM_GL_LOAD(name)                                                                 \
+  library.gl.name = reinterpret_cast<decltype(library.gl.name)>(get_proc_address("gl" #name)); \
+  if (library.gl.name == nullptr) return "gl" #name;
+  PIXELGYM_GL_FUNCTIONS(PIXELGYM_GL_LOAD)
+#undef PIXELGYM_GL_LOAD
+  return "";
+}
+
+// Copy 0: the linked library.
+std::unique_ptr<GlLibrary> load_linked() {
+  auto library = std::make_unique<GlLibrary>();
+  library->create_context_attribs = &::OSMesaCreateContextAttribs;
+  library->make_current = &::OSMesaMakeCurrent;
+  library->get_current_context = &::OSMesaGetCurrentContext;
+  library->destroy_context = &::OSMesaDestroyContext;
+  const std::string missing = load_gl_functions(*library, &::OSMesaGetProcAddress);
+  if (!missing.empty()) {
+    throw std::runtime_error("Context: libOSMesa has no " + missing +
+                             " (OSMesaGetProcAddress returned null)");
+  }
+  return library;
+}
+
+// The file copy 0 was loaded from (OSMesaGetProcAddress: a function no test interposes).
+std::string linked_library_file() {
+  Dl_info info{};
+  if (::dladdr(reinterpret_cast<void*>(&::OSMesaGetProcAddress), &info) == 0 ||
+      info.dli_fname == nullptr) {
+    return "";
+  }
+  return info.dli_fname;
+}
+
+// A private copy, or null with `why` set.
+std::unique_ptr<GlLibrary> load_private(int copy, std::string& why) {
+  const std::string file = linked_library_file();
+  if (file.empty()) {
+    why = "cannot find the file libOSMesa was loaded from (dladdr failed)";
+    return nullptr;
+  }
+  // Never closed: contexts of the copy may live until the process ends, and unloading LLVM is
+  // not something Mesa supports.
+  void* handle = ::dlmopen(LM_ID_NEWLM, file.c_str(), RTLD_NOW | RTLD_LOCAL);
+  if (handle == nullptr) {
+    const char* error = ::dlerror();
+    why = "dlmopen(" + file + ") failed: " + (error != nullptr ? error : "no reason given");
+    return nullptr;
+  }
+  auto library = std::make_unique<GlLibrary>();
+  library->copy = copy;
+  const auto symbol = [&](const char* name) {
+    void* address = ::dlsym(handle, name);
+    if (address == nullptr) why = std::string(file) + " has no " + name;
+    return address;
+  };
+  library->create_context_attribs = reinterpret_cast<decltype(library->create_context_attribs)>(
+      symbol("OSMesaCreateContextAttribs"));
+  library->make_current =
+      reinterpret_cast<decltype(library->make_current)>(symbol("OSMesaMakeCurrent"));
+  library->get_current_context =
+      reinterpret_cast<decltype(library->get_current_context)>(symbol("OSMesaGetCurrentContext"));
+  library->destroy_context =
+      reinterpret_cast<decltype(library->destroy_context)>(symbol("OSMesaDestroyContext"));
+  library->init_thread = reinterpret_cast<void (*)()>(symbol("__ctype_init"));
+  auto* get_proc_address =
+      reinterpret_cast<OSMESAproc (*)(const char*)>(symbol("OSMesaGetProcAddress"));
+  if (!why.empty()) return nullptr;
+  const std::string missing = load_gl_functions(*library, get_proc_address);
+  if (!missing.empty()) {
+    why = file + " has no " + missing;
+    return nullptr;
+  }
+  return library;
+}
+
+struct Copies {
+  std::mutex mutex;
+  std::array<std::unique_ptr<GlLibrary>, kMostCopies> loaded;
+  std::array<std::string, kMostCopies> why_not;
+  bool fallback_reported = false;
+};
+
+Copies& copies() {
+  static Copies* all = new Copies();  // never destroyed: contexts may outlive static destructors
+  return *all;
+}
+
+// The library of `copy` (already taken modulo max_copies()), loading it if need be; copy 0's on
+// failure.
+const GlLibrary& library(int copy) {
+  Copies& all = copies();
+  const std::lock_guard<std::mutex> lock(all.mutex);
+  const auto index = static_cast<std::size_t>(copy);
+  if (all.loaded[0] == nullptr) all.loaded[0] = load_linked();
+  if (all.loaded[index] == nullptr && all.why_not[index].empty()) {
+    std::string why;
+    all.loaded[index] = load_private(copy, why);
+    if (all.loaded[index] == nullptr) {
+      all.why_not[index] = why;
+      if (!all.fallback_reported) {
+        all.fallback_reported = true;
+        std::fprintf(stderr,
+                     "pixelgym: could not load private copy %d of libOSMesa (%s); contexts asking "
+                     "for it use copy 0: the same frames, drawn in turn with its other contexts\n",
+                     copy, why.c_str());
+      }
+    }
+  }
+  return all.loaded[index] != nullptr ? *all.loaded[index] : *all.loaded[0];
+}
+
+}  // namespace
+
+MesaCopy::Use::Use(int copy) : previous_(copy_in_use) {
+  if (copy < 0) {
+    throw std::invalid_argument("MesaCopy::Use: copy must be >= 0, got " + std::to_string(copy));
+  }
+  copy_in_use = copy;
+}
+
+MesaCopy::Use::~Use() { copy_in_use = previous_; }
+
+int MesaCopy::in_use() { return copy_in_use; }
+
+int MesaCopy::max_copies() {
+  const char* text = std::getenv("PIXELGYM_MESA_COPIES");
+  if (text == nullptr || *text == '\0') return kDefaultCopies;
+  char* end = nullptr;
+  const long value = std::strtol(text, &end, 10);
+  if (*end != '\0' || value < 1 || value > kMostCopies) {
+    throw std::invalid_argument(
+        "PIXELGYM_MESA_COPIES must be a whole number from 1 to " + std::to_string(kMostCopies) +
+        " (the most copies of Mesa, copy 0 included), got \"" + text + "\"");
+  }
+  return static_cast<int>(value);
+}
+
+int MesaCopy::resolve(int copy) {
+  if (copy < 0) {
+    throw std::invalid_argument("MesaCopy::resolve: copy must be >= 0, got " +
+                                std::to_string(copy));
+  }
+  default_llvmpipe_threads();
+  return library(copy % max_copies()).copy;
+}
+
+bool MesaCopy::loaded(int copy) {
+  if (copy < 0 || copy >= kMostCopies) return false;
+  Copies& all = copies();
+  const std::lock_guard<std::mutex> lock(all.mutex);
+  return all.loaded[static_cast<std::size_t>(copy)] != nullptr;
+}
+
+std::string MesaCopy::why_not(int copy) {
+  if (copy < 0 || copy >= kMostCopies) return "";
+  Copies& all = copies();
+  const std::lock_guard<std::mutex> lock(all.mutex);
+  return all.why_not[static_cast<std::size_t>(copy)];
+}
+
+void prepare_thread(const GlLibrary& library) {
+  const unsigned bit = 1U << static_cast<unsigned>(library.copy);
+  if ((copies_ready_here & bit) == 0) {
+    library.init_thread();
+    copies_ready_here |= bit;
+  }
+}
+
+const GlLibrary& library_for_new_context() {
+  default_llvmpipe_threads();
+  return library(MesaCopy::in_use() % MesaCopy::max_copies());
+}
+
+}  // namespace pixelgym::render

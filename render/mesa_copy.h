@@ -1,0 +1,59 @@
+// Copies of Mesa in one process: threads that draw with contexts of different copies rasterize
+// in parallel.
+#pragma once
+
+#include <string>
+
+namespace pixelgym::render {
+
+/// llvmpipe, Mesa's software rasterizer, has one screen per loaded library, and it rasterizes the
+/// frames of every context of that screen under one lock (with LP_NUM_THREADS=0 on the drawing
+/// thread itself). So threads drawing at once with contexts of one libOSMesa take turns: two
+/// threads rendering cart-pole frames got 1.0x the frames of one. A library loaded a second time
+/// in a link namespace of its own (dlmopen) is a separate copy, with its own screen and lock, and
+/// threads drawing with contexts of different copies run in parallel (1.96x with two).
+///
+/// Copy 0 is the libOSMesa the process links. Copies 1, 2, ... are private copies of the same
+/// file, loaded when a context first asks for them and kept until the process ends (about 70 ms
+/// and a few MiB each; the code pages are shared with copy 0). The copies run the same code on
+/// the same machine, so a scene drawn with any copy gives the same bytes.
+///
+/// A context uses the copy selected on the thread that creates it (`MesaCopy::Use`; copy 0 when
+/// none is). The vector envs give the envs of worker thread w copy w (see vector::VectorEnv).
+///
+/// Limits: glibc has 16 link namespaces per process, and copies loaded later share a small
+/// reserve of static thread-local storage, which in a plain process ran out at the 10th copy. So
+/// pixelgym loads at most `max_copies() - 1` private copies (7 by default; the environment
+/// variable PIXELGYM_MESA_COPIES=N sets the total N, and 1 disables private copies); copy
+/// numbers wrap around at that. A copy that fails to load is copy 0 instead: the same frames,
+/// drawn in turn with copy 0's other contexts; the first such fallback prints one line to stderr
+/// with the reason.
+class MesaCopy {
+ public:
+  /// While alive, contexts created on this thread (Context, and so Renderer and SharedContext)
+  /// use copy `copy` (taken modulo max_copies()). Nests: the previous selection is restored when
+  /// it ends. Throws std::invalid_argument for copy < 0.
+  class Use {
+   public:
+    explicit Use(int copy);
+    ~Use();
+    Use(const Use&) = delete;
+    Use& operator=(const Use&) = delete;
+
+   private:
+    int previous_;
+  };
+  /// The copy selected on this thread (0 when none is).
+  static int in_use();
+  /// The most copies, copy 0 included: PIXELGYM_MESA_COPIES when set (1 to 16), else 8.
+  static int max_copies();
+  /// The copy a context asking for `copy` gets: `copy` modulo max_copies(), loaded if need be,
+  /// or 0 when it could not be loaded (then `why_not(copy)` says why).
+  static int resolve(int copy);
+  /// Whether copy `copy` is loaded (copy 0: once any context was made).
+  static bool loaded(int copy);
+  /// Why `copy` could not be loaded, or "" when it was (or was never asked for).
+  static std::string why_not(int copy);
+};
+
+}  // namespace pixelgym::render
