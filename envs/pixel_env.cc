@@ -58,7 +58,9 @@ std::vector<ParamSpec> TaskConfig::params() {
           {"render_width", d.render_width, "render() frame width in pixels"},
           {"render_height", d.render_height, "render() frame height in pixels"},
           {"action_repeat", d.action_repeat, "control steps per env step (rewards are summed)"},
-          {"shadows", d.shadows, "draw shadows in observations and render()"}};
+          {"shadows", d.shadows, "draw shadows in observations and render()"},
+          {"msaa", d.msaa,
+           "anti-aliasing samples per observation pixel: 0 (off), 2, 4 or 8 (render() uses 4)"}};
 }
 
 TaskConfig TaskConfig::from_params(const Params& params, const std::vector<std::string>& cameras,
@@ -87,6 +89,11 @@ TaskConfig TaskConfig::from_params(const Params& params, const std::vector<std::
   }
   c.action_repeat = static_cast<int>(repeat);
   c.shadows = params.at("shadows").as_bool();
+  const std::int64_t msaa = params.at("msaa").as_int();
+  if (msaa != 0 && msaa != 2 && msaa != 4 && msaa != 8) {
+    throw std::invalid_argument(env + ": msaa must be 0, 2, 4 or 8, got " + std::to_string(msaa));
+  }
+  c.msaa = static_cast<int>(msaa);
   return c;
 }
 
@@ -169,7 +176,7 @@ void PixelEnv::observe(Value& obs) {
   // Entries in observation_space() order: "pixels" first when present, then the state arrays.
   std::vector<Value>& slots = obs.dict().values();
   std::size_t next = 0;
-  if (config_.has_pixels()) render_camera_into(camera_, 0, slots[next++].array());
+  if (config_.has_pixels()) render_camera_into(camera_, config_.msaa, slots[next++].array());
   if (config_.has_state()) {
     StateSlots state(state_specs_, slots.data() + next);
     task_->observe(*world_, state);

@@ -3,8 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdlib>
 #include <iostream>
+#include <vector>
 
 #include "envs/pixel_env.h"
 #include "envs/registry.h"
@@ -193,11 +197,85 @@ TEST(CartPoleTest, CloseCameraShowsTheCartAndPoleLarger) {
   EXPECT_GE(close, 2 * fixed) << "fixed " << fixed << ", close " << close;
 }
 
+// The rows of a 64 x 64 observation above the cart (rows 0-33 under the fixed camera) in which
+// the pole shows: a pixel that differs from its row's median (the sky is one colour along a
+// row) by more than 12 levels summed over R, G and B.
+struct PoleRows {
+  int first = -1;
+  int last = -1;
+  int missing = 0;  // rows between first and last without the pole
+};
+
+PoleRows pole_rows(const Array& frame) {
+  const std::uint8_t* p = frame.data<std::uint8_t>();
+  PoleRows rows;
+  int shown = 0;
+  for (int y = 0; y < 34; ++y) {
+    std::array<std::vector<int>, 3> channels;
+    for (int x = 0; x < 64; ++x) {
+      for (int c = 0; c < 3; ++c) channels[c].push_back(p[(y * 64 + x) * 3 + c]);
+    }
+    std::array<int, 3> median{};
+    for (int c = 0; c < 3; ++c) {
+      std::nth_element(channels[c].begin(), channels[c].begin() + 32, channels[c].end());
+      median[c] = channels[c][32];
+    }
+    bool pole = false;
+    for (int x = 0; x < 64 && !pole; ++x) {
+      int difference = 0;
+      for (int c = 0; c < 3; ++c) difference += std::abs(p[(y * 64 + x) * 3 + c] - median[c]);
+      pole = difference > 12;
+    }
+    if (!pole) continue;
+    if (rows.first < 0) rows.first = y;
+    rows.last = y;
+    ++shown;
+  }
+  if (rows.first >= 0) rows.missing = rows.last - rows.first + 1 - shown;
+  return rows;
+}
+
+// At 64 x 64 the pole is thinner than a pixel. Without anti-aliasing it covers a pixel only
+// where it crosses the pixel's centre: in some frames it breaks into pieces or loses its top,
+// depending on where the cart stands. With msaa=4 it is one unbroken line from the cart to its
+// tip in every frame.
+TEST(CartPoleTest, AntiAliasedObservationsShowTheWholePole) {
+  int aliased_frames_broken = 0;
+  for (const int msaa : {0, 4}) {
+    for (std::uint64_t seed = 0; seed < 4; ++seed) {
+      auto env = make(
+          "CartPoleBalance-v0",
+          {{"width", 64}, {"height", 64}, {"obs_mode", "pixels"}, {"msaa", std::int64_t{msaa}}});
+      env->reset(seed);
+      Rng rng(seed);
+      for (int step = 0; step < 8; ++step) {
+        const Value& obs = env->step(env->action_space().sample(rng)).obs;
+        const PoleRows rows = pole_rows(obs.dict().at("pixels").array());
+        if (msaa == 0) {
+          aliased_frames_broken += rows.missing > 0 || rows.first > 19 ? 1 : 0;
+          continue;
+        }
+        EXPECT_LE(rows.first, 19) << "seed " << seed << ", step " << step << ": top row";
+        EXPECT_GE(rows.last, 32) << "seed " << seed << ", step " << step << ": bottom row";
+        EXPECT_EQ(rows.missing, 0)
+            << "seed " << seed << ", step " << step << ": rows " << rows.first << "-" << rows.last;
+      }
+    }
+  }
+  EXPECT_GT(aliased_frames_broken, 0) << "the aliased pole was never broken: a weaker test";
+}
+
 TEST(CartPoleTest, ConfigKeysAreValidated) {
   EXPECT_THROW(make("CartPoleSwingup-v0", {{"camera", "top"}}), std::invalid_argument);
   EXPECT_THROW(make("CartPoleSwingup-v0", {{"obs_mode", "rgb"}}), std::invalid_argument);
   EXPECT_THROW(make("CartPoleSwingup-v0", {{"width", 8}}), std::invalid_argument);
   EXPECT_THROW(make("CartPoleSwingup-v0", {{"action_repeat", 0}}), std::invalid_argument);
+  try {
+    make("CartPoleSwingup-v0", {{"msaa", 3}});
+    ADD_FAILURE() << "msaa=3 was accepted";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_STREQ(error.what(), "CartPoleSwingup-v0: msaa must be 0, 2, 4 or 8, got 3");
+  }
   auto env = make("CartPoleSwingup-v0", {{"width", 64}, {"height", 48}, {"obs_mode", "pixels"}});
   EXPECT_EQ(env->reset(0).obs.dict().keys(), std::vector<std::string>{"pixels"});
   EXPECT_EQ(env->reset(0).obs.dict().at("pixels").array().shape(), (Shape{48, 64, 3}));
