@@ -8,6 +8,7 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -144,6 +145,8 @@ ppo::CheckpointBlobs checkpoint_blobs(ppo::Trainer& trainer, const std::deque<do
                             {"count", scaling.statistics.count},
                             {"returns", scaling.returns}};
   blobs["meta"] = meta.dump();
+  // The envs' state, as the actions that led to it (see Trainer::replay_env).
+  blobs["env_actions"] = trainer.env_action_log();
   return blobs;
 }
 
@@ -337,6 +340,21 @@ int run_train(const TrainArguments& args) {
     std::cout << "resuming " << folder.string() << " from " << checkpoint->path.filename().string()
               << " (" << trainer.env_steps() << " env steps, " << trainer.updates()
               << " updates)\n";
+    const auto actions = checkpoint->blobs.find("env_actions");
+    if (actions != checkpoint->blobs.end()) {
+      // The envs continue their episodes where the checkpoint left them, so the resumed run
+      // is the run that did not stop (same parameters, update for update).
+      const auto replay_start = std::chrono::steady_clock::now();
+      trainer.replay_env(actions->second);
+      std::cout
+          << "replayed the " << trainer.env_steps() << " env steps of the checkpoint in "
+          << std::fixed << std::setprecision(1)
+          << std::chrono::duration<double>(std::chrono::steady_clock::now() - replay_start).count()
+          << std::defaultfloat << " s: the envs continue their episodes\n";
+    } else {
+      std::cout << "the checkpoint has no env actions (written before they were kept): the envs "
+                   "start new episodes\n";
+    }
   } else {
     run.emplace(ppo::RunFolder::create(folder, settings_to_json(settings), kExtraColumns));
   }

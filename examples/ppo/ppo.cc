@@ -351,6 +351,49 @@ const vector::VectorStepResult& Trainer::step_env(const Value& actions) {
   return env_ != nullptr ? env_->step(actions) : wrapper_->step(actions);
 }
 
+void Trainer::count_episode_steps(const vector::VectorStepResult& step,
+                                  std::vector<Episode>& ended) {
+  const double* rewards = step.rewards.data<double>();
+  const bool* terminated = step.terminated.data<bool>();
+  const bool* truncated = step.truncated.data<bool>();
+  for (std::size_t i = 0; i < episode_returns_.size(); ++i) {
+    episode_returns_[i] += rewards[i];
+    episode_lengths_[i] += 1;
+    if (terminated[i] || truncated[i]) {
+      ended.push_back({episode_returns_[i], episode_lengths_[i]});
+      episode_returns_[i] = 0.0;
+      episode_lengths_[i] = 0;
+    }
+  }
+}
+
+void Trainer::replay_env(const std::string& env_action_log) {
+  if (started_) {
+    throw std::logic_error("Trainer::replay_env: the envs were already reset or stepped");
+  }
+  Array& env_actions = actions_.array();
+  const std::size_t batch_bytes = env_actions.nbytes();
+  const auto batches = static_cast<std::size_t>(env_steps_ / config_.num_envs);
+  if (env_action_log.size() != batches * batch_bytes) {
+    throw std::invalid_argument("Trainer::replay_env: an action log of " + std::to_string(batches) +
+                                " batches of " + std::to_string(batch_bytes) + " bytes (" +
+                                std::to_string(batches * batch_bytes) + " bytes, for " +
+                                std::to_string(env_steps_) + " env steps) expected, got " +
+                                std::to_string(env_action_log.size()) + " bytes");
+  }
+  torch::NoGradGuard no_grad;
+  current_obs_ = observation_tensors(reset_env(config_.seed).obs);
+  started_ = true;
+  std::vector<Episode> ended;
+  for (std::size_t b = 0; b < batches; ++b) {
+    std::memcpy(env_actions.raw_data(), env_action_log.data() + b * batch_bytes, batch_bytes);
+    const vector::VectorStepResult& step = step_env(actions_);
+    count_episode_steps(step, ended);
+    current_obs_ = observation_tensors(step.obs);
+  }
+  env_action_log_ = env_action_log;
+}
+
 RolloutStats Trainer::collect() {
   torch::NoGradGuard no_grad;
   RolloutStats stats;
@@ -377,6 +420,7 @@ RolloutStats Trainer::collect() {
                              env_actions.to_string());
     }
     std::memcpy(env_actions.raw_data(), env_action.data_ptr(), env_actions.nbytes());
+    env_action_log_.append(static_cast<const char*>(env_actions.raw_data()), env_actions.nbytes());
 
     start = Clock::now();
     const vector::VectorStepResult& step = step_env(actions_);
@@ -384,6 +428,7 @@ RolloutStats Trainer::collect() {
     const double* rewards = step.rewards.data<double>();
     const bool* terminated = step.terminated.data<bool>();
     const bool* truncated = step.truncated.data<bool>();
+    count_episode_steps(step, stats.episodes);
     // The storage tensors are contiguous (T, N): row t starts at t * N.
     float* stored_rewards = storage_.rewards.data_ptr<float>() + t * envs;
     std::uint8_t* stored_terminated = storage_.terminated.data_ptr<std::uint8_t>() + t * envs;
@@ -406,12 +451,7 @@ RolloutStats Trainer::collect() {
       stored_terminated[n] = terminated[n] ? 1 : 0;
       stored_truncated[n] = truncated[n] ? 1 : 0;
       stored_final_values[n] = 0.0f;
-      episode_returns_[i] += rewards[n];
-      episode_lengths_[i] += 1;
       if (terminated[n] || truncated[n]) {
-        stats.episodes.push_back({episode_returns_[i], episode_lengths_[i]});
-        episode_returns_[i] = 0.0;
-        episode_lengths_[i] = 0;
         reward_scaling_.returns[i] = 0.0;
         if (!terminated[n]) bootstrap.push_back(n);
       }

@@ -205,7 +205,7 @@ class Trainer {
 
   /// Steps every env num_steps times with actions sampled from the policy (no gradients),
   /// storing the transitions and the values GAE needs, then computes advantages and returns.
-  /// The first call resets the envs with config.seed.
+  /// The first call resets the envs with config.seed (unless replay_env did).
   RolloutStats collect();
   /// config.update_epochs passes of minibatch PPO over the last rollout; then merges its
   /// observations into the observation statistics. The learning rate is set first, from the
@@ -239,10 +239,28 @@ class Trainer {
   /// Throws std::invalid_argument (from torch) for a state that is not a CPU generator state.
   void set_rng_state(const TrainerRngState& state);
 
+  /// Every action batch the trainer has sent to the env since its first reset, in order: the
+  /// raw bytes of the env's batched action arrays (env_steps() / num_envs batches). With the
+  /// config's seed they determine the envs' state exactly (the envs are deterministic under a
+  /// seed and their actions), which is how a checkpoint carries the envs: see replay_env. Its
+  /// size is env_steps() x the bytes of one env's action (4 MB per million env steps of a
+  /// one-dimensional float32 action).
+  const std::string& env_action_log() const { return env_action_log_; }
+  /// Brings the envs to where they were when `env_action_log` was taken, for a resume: resets
+  /// them with config.seed, as the first collect() does, and steps them with the logged
+  /// batches (no policy, no gradients, no reward statistics: those come from the checkpoint),
+  /// so that the next collect() continues the episodes in progress and the run goes on exactly
+  /// as if it had not stopped. Call it after set_progress, before collect(). Throws
+  /// std::invalid_argument, naming both sizes, when the log is not env_steps() / num_envs
+  /// batches, and std::logic_error after a collect().
+  void replay_env(const std::string& env_action_log);
+
  private:
   Trainer(vector::VectorEnv* env, vector::VectorWrapper* wrapper, PpoConfig config);
   const vector::VectorResetResult& reset_env(std::uint64_t seed);
   const vector::VectorStepResult& step_env(const Value& actions);
+  // Adds a step's rewards to the episodes in progress; appends those that ended to `ended`.
+  void count_episode_steps(const vector::VectorStepResult& step, std::vector<Episode>& ended);
 
   vector::VectorEnv* env_;  // exactly one of env_ and wrapper_ is set
   vector::VectorWrapper* wrapper_;
@@ -257,6 +275,7 @@ class Trainer {
   std::vector<double> episode_returns_;
   std::vector<std::int64_t> episode_lengths_;
   RewardScaling reward_scaling_;
+  std::string env_action_log_;
   bool started_ = false;
   bool collected_ = false;
   std::int64_t env_steps_ = 0;

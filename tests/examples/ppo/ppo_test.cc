@@ -446,6 +446,51 @@ TEST(Trainer, SameSeedSameParametersAndRngStateResumesTheRandomness) {
   EXPECT_FALSE(same_parameters(parameters_of(a.policy()), parameters_of(b.policy())));
 }
 
+std::unique_ptr<SyncVectorEnv> counter_envs(int n) {
+  return std::make_unique<SyncVectorEnv>(
+      n, [](int) { return std::make_unique<CounterEnv>(5, true); }, AutoresetMode::kSameStep);
+}
+
+// replay_env brings fresh envs to where a trainer's envs are, from its action log: the next
+// rollout sees the same observations, episodes in progress continued (5-step episodes, 4-step
+// rollouts), and the same episode ends.
+TEST(Trainer, ReplayEnvContinuesTheEpisodesInProgress) {
+  const PpoConfig config = small_config(2, 4);
+  auto envs_a = counter_envs(2);
+  Trainer a(*envs_a, config);
+  a.collect();
+  a.update();
+  a.collect();
+  a.update();
+  const std::string log = a.env_action_log();
+  EXPECT_EQ(log.size(), 16U * sizeof(std::int64_t));  // 2 rollouts x 4 steps x 2 envs
+
+  auto envs_b = counter_envs(2);
+  Trainer b(*envs_b, config);
+  b.set_progress(a.env_steps(), a.updates());
+  try {
+    b.replay_env(log.substr(0, log.size() - 8));
+    ADD_FAILURE() << "a short log was replayed";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_STREQ(error.what(),
+                 "Trainer::replay_env: an action log of 8 batches of 16 bytes (128 bytes, for 16 "
+                 "env steps) expected, got 120 bytes");
+  }
+  b.replay_env(log);
+  EXPECT_EQ(b.env_action_log(), log);
+  const RolloutStats next_a = a.collect();
+  const RolloutStats next_b = b.collect();
+  // Step 8 of a 5-step episode cycle: observations 0.3, 0.4, then 0.0 after the truncation.
+  EXPECT_TRUE(torch::equal(a.storage().observations.at(""), b.storage().observations.at("")));
+  EXPECT_FLOAT_EQ(b.storage().observations.at("")[0][0][0].item<float>(), 0.3F);
+  ASSERT_EQ(next_b.episodes.size(), next_a.episodes.size());
+  for (std::size_t e = 0; e < next_a.episodes.size(); ++e) {
+    EXPECT_EQ(next_b.episodes[e].length, next_a.episodes[e].length);
+    EXPECT_EQ(next_b.episodes[e].episode_return, next_a.episodes[e].episode_return);
+  }
+  EXPECT_THROW(b.replay_env(log), std::logic_error);  // the envs already went on
+}
+
 TEST(Trainer, LearningRateAnnealsLinearlyOverTheRun) {
   auto envs = bandit_envs(2, false);
   PpoConfig config = small_config(2, 8);
