@@ -16,6 +16,7 @@
 #include "render/context.h"
 #include "render/mesh_data.h"
 #include "render/renderer.h"
+#include "tests/render/box_and_ball_scene.h"
 
 namespace pixelgym::render {
 namespace {
@@ -24,24 +25,9 @@ using ::testing::HasSubstr;
 
 constexpr int kSize = 40;
 
-// A box and a ball at `offset`, with the default light, floor and shadows.
 Scene scene_at(float offset) {
-  Scene scene;
-  Instance box;
-  box.mesh = make_box_mesh();
-  box.scale = Eigen::Vector3f(0.4F, 0.4F, 0.6F);
-  box.X_world_instance.translation() = Eigen::Vector3f(offset, 0, 0.3F);
-  box.material.base_color = {0.8F, 0.3F, 0.2F, 1};
-  box.segmentation_id = 7;
-  scene.instances.push_back(box);
-  Instance ball;
-  ball.mesh = make_sphere_mesh();
-  ball.scale = Eigen::Vector3f::Constant(0.25F);
-  ball.X_world_instance.translation() = Eigen::Vector3f(0.6F - offset, 0.4F, 0.25F);
-  ball.material.base_color = {0.2F, 0.5F, 0.9F, 1};
-  ball.segmentation_id = 9;
-  scene.instances.push_back(ball);
-  return scene;
+  return testing::box_and_ball_scene(offset, /*box_segmentation_id=*/7,
+                                     /*ball_segmentation_id=*/9);
 }
 
 struct Frame {

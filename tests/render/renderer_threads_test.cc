@@ -11,6 +11,7 @@
 
 #include "render/mesh_data.h"
 #include "render/renderer.h"
+#include "tests/render/box_and_ball_scene.h"
 #include "tests/worker_thread.h"
 
 namespace pixelgym::render {
@@ -21,23 +22,7 @@ using pixelgym::testing::WorkerThread;
 
 constexpr int kSize = 32;
 
-// A box and a ball, moved by `offset`, with the default light, floor and shadows.
-Scene scene_at(float offset) {
-  Scene scene;
-  Instance box;
-  box.mesh = make_box_mesh();
-  box.scale = Eigen::Vector3f(0.4F, 0.4F, 0.6F);
-  box.X_world_instance.translation() = Eigen::Vector3f(offset, 0, 0.3F);
-  box.material.base_color = {0.8F, 0.3F, 0.2F, 1};
-  scene.instances.push_back(box);
-  Instance ball;
-  ball.mesh = make_sphere_mesh();
-  ball.scale = Eigen::Vector3f::Constant(0.25F);
-  ball.X_world_instance.translation() = Eigen::Vector3f(0.6F - offset, 0.4F, 0.25F);
-  ball.material.base_color = {0.2F, 0.5F, 0.9F, 1};
-  scene.instances.push_back(ball);
-  return scene;
-}
+Scene scene_at(float offset) { return testing::box_and_ball_scene(offset); }
 
 Camera camera() {
   Camera camera = Camera::look_at({0, -3, 0.5F}, {0, 0, 0.5F});

@@ -9,6 +9,7 @@
 
 #include "render/mesh_data.h"
 #include "render/renderer.h"
+#include "tests/render/box_and_ball_scene.h"
 #include "tests/worker_thread.h"
 
 namespace pixelgym::render {
@@ -48,25 +49,13 @@ constexpr int kRenderers = 5;
 Scene scene(int r, int frame) {
   const Look& look = kLooks[r];
   const float offset = 0.1F * static_cast<float>(r) + 0.03F * static_cast<float>(frame);
-  Scene scene;
+  Scene scene =
+      testing::box_and_ball_scene(offset, /*box_segmentation_id=*/3, /*ball_segmentation_id=*/7);
   scene.shadows = look.shadows;
   scene.floor.enabled = look.floor;
-  Instance box;
-  box.mesh = make_box_mesh();
-  box.scale = Eigen::Vector3f(0.4F, 0.4F, 0.6F);
-  box.X_world_instance.translation() = Eigen::Vector3f(offset, 0, 0.3F);
-  box.material.base_color = {0.8F, 0.3F, 0.2F, 1};
-  box.material.specular = 0.1F + 0.2F * static_cast<float>(r);  // each renderer its own
-  box.segmentation_id = 3;
-  scene.instances.push_back(box);
-  Instance ball;
-  ball.mesh = make_sphere_mesh();
-  ball.scale = Eigen::Vector3f::Constant(0.25F);
-  ball.X_world_instance.translation() = Eigen::Vector3f(0.6F - offset, 0.4F, 0.25F);
-  ball.material.base_color = {0.2F, 0.5F, 0.9F, 1};
-  ball.material.specular = box.material.specular;
-  ball.segmentation_id = 7;
-  scene.instances.push_back(ball);
+  for (Instance& instance : scene.instances) {
+    instance.material.specular = 0.1F + 0.2F * static_cast<float>(r);  // each renderer its own
+  }
   return scene;
 }
 
