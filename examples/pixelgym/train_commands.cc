@@ -466,7 +466,9 @@ Command add_train(CLI::App& app) {
   train->add_option("--resume", args->resume,
                     "Continue the run in this folder from its latest valid checkpoint (its "
                     "config.json gives the env and the settings; --steps and --minutes may "
-                    "change the budget)");
+                    "change the budget). The envs replay the checkpoint's actions and go on "
+                    "with their episodes, so with the run's --steps (the learning rate anneals "
+                    "over it) the result is the run that did not stop");
   train->add_flag("--quiet", args->quiet,
                   "No progress bar: a plain line every 10 updates (also when stdout is not a "
                   "terminal)");
