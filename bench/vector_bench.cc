@@ -1,13 +1,17 @@
 // Vector-env scaling: total env steps per second of SyncVectorEnv and AsyncVectorEnv at 1, 2, 4,
 // 8 and 16 envs, each beside the single-env loop in the same run.
 //
-// For each env count the configurations are built, warmed up, and then stepped in turn, round
-// after round: the single-env loop (one Env, step_into with seeded random actions, reset when
-// done), N envs stepped one after the other in a plain loop (no vector env, each env with a GL
-// context of its own: what N separate envs cost by themselves), SyncVectorEnv, and
-// AsyncVectorEnv with 1 and 2 threads (the vector envs share one GL context per thread, their
-// default). Each block runs
-// for about `block_ms` of wall time. A configuration's ratio to the single-env loop is taken
+// For each env count N the configurations are built, warmed up, and then stepped in turn, round
+// after round: the single-env loop, N envs stepped one after the other in a plain loop (no vector
+// env, each env with a GL context of its own: what N separate envs cost by themselves),
+// SyncVectorEnv, and AsyncVectorEnv with 1 and 2 threads (the vector envs share one GL context per
+// thread, their default). Every configuration does the same work: env i is seeded i and steps
+// through row i of one pool of 64 seeded random batched actions, in a cycle (reset when done).
+// The single-env loop steps those same N envs, but one at a time: 64 steps of env 0 alone, then
+// 64 of env 1, and so on, so that it measures one env stepped alone (its caches warm) over the
+// states the batch visits. (A step's cost depends on the state: the arm's steps/s alone ranges
+// over 10% between seeds, so a baseline of one seed would compare different work.) Each block
+// runs for about `block_ms` of wall time. A configuration's ratio to the single-env loop is taken
 // within each round (so drift on a shared machine hits both alike) and the medians over rounds
 // are printed.
 //
@@ -29,16 +33,19 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "envs/registry.h"
 #include "envs/rng.h"
+#include "envs/vector/batch_space.h"
 #include "envs/vector/make_vec.h"
 
 namespace {
 
 using pixelgym::Env;
 using pixelgym::Rng;
+using pixelgym::SpacePtr;
 using pixelgym::Value;
 namespace vector = pixelgym::vector;
 
@@ -59,13 +66,20 @@ double median(std::vector<double> values) {
 }
 
 constexpr int kActionPool = 64;
+constexpr int kSoloChunk = 64;  // steps of one env before the single-env loop moves to the next
 
-// One env stepped with a fixed pool of seeded random actions, reset (unseeded) when done.
+// Row i of each batched action of the pool: what env i is sent, in a cycle.
+std::vector<Value> action_rows(const std::vector<Value>& pool, int i) {
+  std::vector<Value> rows;
+  for (const Value& batch : pool) rows.push_back(vector::batch_slot(batch, i));
+  return rows;
+}
+
+// One env stepped through a cycle of actions, reset (unseeded) when done.
 class LoopedEnv {
  public:
-  LoopedEnv(const std::string& id, std::uint64_t seed) : env_(pixelgym::make(id)) {
-    Rng rng(seed);
-    for (int k = 0; k < kActionPool; ++k) actions_.push_back(env_->action_space().sample(rng));
+  LoopedEnv(const std::string& id, std::uint64_t seed, std::vector<Value> actions)
+      : env_(pixelgym::make(id)), actions_(std::move(actions)) {
     reset_.obs = env_->observation_space().zeros();
     step_.obs = env_->observation_space().zeros();
     env_->reset_into(reset_, seed);
@@ -77,10 +91,32 @@ class LoopedEnv {
 
  private:
   std::unique_ptr<Env> env_;
-  std::vector<Value> actions_;
+  std::vector<Value> actions_;  // views into the pool (kept alive by the caller)
   std::size_t next_ = 0;
   pixelgym::ResetResult reset_;
   pixelgym::StepResult step_;
+};
+
+// The pool's N envs stepped one at a time: kSoloChunk steps of one, then the next.
+class SoloEnvs {
+ public:
+  SoloEnvs(const std::string& id, const std::vector<Value>& pool, int n) {
+    for (int i = 0; i < n; ++i) {
+      envs_.emplace_back(id, static_cast<std::uint64_t>(i), action_rows(pool, i));
+    }
+  }
+  void step() {
+    envs_[current_].step();
+    if (++steps_ == kSoloChunk) {
+      steps_ = 0;
+      current_ = (current_ + 1) % envs_.size();
+    }
+  }
+
+ private:
+  std::vector<LoopedEnv> envs_;
+  std::size_t current_ = 0;
+  int steps_ = 0;
 };
 
 // A configuration: `batch()` advances `envs_per_batch` env steps.
@@ -134,10 +170,17 @@ int main(int argc, char** argv) {
     std::vector<Row> rows;
     for (int n = 1; n <= max_envs; n *= 2) {
       std::vector<Config> configs;
-      auto single = std::make_shared<LoopedEnv>(id, 0);
-      configs.push_back({"single-env loop", 1, [single] { single->step(); }, {}, {}});
+      // The batched actions every configuration steps through (see the top of this file).
+      const SpacePtr batched_actions = vector::batch_space(pixelgym::make(id)->action_space(), n);
+      auto pool = std::make_shared<std::vector<Value>>();
+      Rng rng(0);
+      for (int k = 0; k < kActionPool; ++k) pool->push_back(batched_actions->sample(rng));
+      auto solo = std::make_shared<SoloEnvs>(id, *pool, n);
+      configs.push_back({"single-env loop", 1, [solo, pool] { solo->step(); }, {}, {}});
       auto plain = std::make_shared<std::vector<LoopedEnv>>();
-      for (int i = 0; i < n; ++i) plain->emplace_back(id, static_cast<std::uint64_t>(i));
+      for (int i = 0; i < n; ++i) {
+        plain->emplace_back(id, static_cast<std::uint64_t>(i), action_rows(*pool, i));
+      }
       configs.push_back({names[0],
                          n,
                          [plain] {
@@ -152,17 +195,13 @@ int main(int argc, char** argv) {
       };
       for (int m = 0; m < (cpu_time ? 1 : 3); ++m) {
         std::shared_ptr<vector::VectorEnv> env = vector::make_vec(id, n, {}, {}, modes[m]);
-        auto actions = std::make_shared<std::vector<Value>>();
-        Rng rng(0);
-        for (int k = 0; k < kActionPool; ++k) actions->push_back(env->action_space().sample(rng));
         env->reset(0);
         auto next = std::make_shared<std::size_t>(0);
-        configs.push_back(
-            {names[m + 1],
-             n,
-             [env, actions, next] { env->step((*actions)[(*next)++ % actions->size()]); },
-             {},
-             {}});
+        configs.push_back({names[m + 1],
+                           n,
+                           [env, pool, next] { env->step((*pool)[(*next)++ % pool->size()]); },
+                           {},
+                           {}});
       }
       for (Config& config : configs) time_block(config, 0.05);  // warm up: shaders, caches
       for (int round = 0; round < rounds; ++round) {
