@@ -173,6 +173,9 @@ struct Evaluation {
   double mean = 0.0;
   double std = 0.0;
   std::vector<double> returns;
+  // Box actions: the fraction of action elements the policy put outside the bounds (sent to
+  // the env clipped). Near 1, the policy acts bang-bang at the bounds; 0 for Discrete.
+  double clipped_fraction = 0.0;
 };
 
 // `episodes` episodes of `policy` on one env built as the run's (env i seeded seed + i), with
@@ -196,6 +199,8 @@ Evaluation evaluate(ppo::Policy& policy, const RunSettings& settings, std::int64
   Value actions = env.action_space().zeros();
   Array& action = actions.array();
   Evaluation result;
+  double clipped = 0.0;
+  double elements = 0.0;
   for (std::int64_t e = 0; e < episodes; ++e) {
     if (e == 0 && recorder != nullptr) recorder->start_recording(video->stem().string());
     const Value* obs = &env.reset(seed + static_cast<std::uint64_t>(e)).obs;
@@ -203,6 +208,10 @@ Evaluation evaluate(ppo::Policy& policy, const RunSettings& settings, std::int64
     for (;;) {
       const ppo::ActResult act = policy.act(ppo::observation_tensors(*obs), !stochastic);
       const torch::Tensor chosen = act.env_action.to(ppo::torch_dtype(action.dtype())).contiguous();
+      if (act.action.is_floating_point()) {
+        clipped += act.action.ne(act.env_action).sum().item<double>();
+        elements += static_cast<double>(act.action.numel());
+      }
       std::memcpy(action.raw_data(), chosen.data_ptr(), action.nbytes());
       const vector::VectorStepResult& step = env.step(actions);
       total += step.rewards.data<double>()[0];
@@ -218,6 +227,7 @@ Evaluation evaluate(ppo::Policy& policy, const RunSettings& settings, std::int64
   double squares = 0.0;
   for (const double r : result.returns) squares += (r - result.mean) * (r - result.mean);
   result.std = std::sqrt(squares / static_cast<double>(result.returns.size()));
+  if (elements > 0.0) result.clipped_fraction = clipped / elements;
   env.close();
   return result;
 }
@@ -230,6 +240,7 @@ json evaluation_json(const Evaluation& evaluation, std::uint64_t seed, bool stoc
   out["return_mean"] = evaluation.mean;
   out["return_std"] = evaluation.std;
   out["returns"] = evaluation.returns;
+  out["clipped_action_fraction"] = evaluation.clipped_fraction;
   return out;
 }
 
@@ -557,7 +568,8 @@ int run_eval(const EvalArguments& args) {
   for (std::size_t e = 0; e < evaluation.returns.size(); ++e) {
     std::cout << "episode " << e << ": return=" << evaluation.returns[e] << "\n";
   }
-  std::cout << "return_mean=" << evaluation.mean << " return_std=" << evaluation.std << "\n";
+  std::cout << "return_mean=" << evaluation.mean << " return_std=" << evaluation.std
+            << " clipped_action_fraction=" << evaluation.clipped_fraction << "\n";
   if (video) std::cout << "wrote " << video->string() << "\n";
   return 0;
 }
@@ -567,7 +579,9 @@ Command add_eval(CLI::App& app) {
   CLI::App* eval = app.add_subcommand(
       "eval",
       "Evaluate a trained policy (a run folder's latest checkpoint, or a checkpoint "
-      "file) over seeded episodes: each return, then their mean and std");
+      "file) over seeded episodes: each return, then their mean and std, and for Box actions "
+      "clipped_action_fraction= (the share of action elements the policy put outside the "
+      "bounds: near 1 is bang-bang control)");
   eval->add_option("run", args->run, "Run folder or checkpoint file (.pgck)")->required();
   eval->add_option("--episodes", args->episodes, "Episodes, seeded seed, seed + 1, ...")
       ->capture_default_str()

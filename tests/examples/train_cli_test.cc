@@ -91,6 +91,13 @@ TEST(TrainCliTest, AShortRunWritesACompleteRunFolder) {
   std::ostringstream expected;
   expected << "return_mean=" << summary.at("evaluation").at("return_mean").get<double>();
   EXPECT_NE(evaluated.output.find(expected.str()), std::string::npos) << evaluated.output;
+  // And the share of action elements the policy put outside the bounds, the same both times.
+  const double clipped = summary.at("evaluation").at("clipped_action_fraction").get<double>();
+  EXPECT_GE(clipped, 0.0);
+  EXPECT_LE(clipped, 1.0);
+  std::ostringstream expected_clipped;
+  expected_clipped << "clipped_action_fraction=" << clipped << "\n";
+  EXPECT_NE(evaluated.output.find(expected_clipped.str()), std::string::npos) << evaluated.output;
   // A second run into the same folder is refused; the run is left as it was.
   const CliRun again = run_cli(train_arguments(folder, "--steps 32 --out " + run.string()));
   EXPECT_EQ(again.exit_code, 1) << again.output;
