@@ -209,7 +209,7 @@ Evaluation evaluate(ppo::Policy& policy, const RunSettings& settings, std::int64
       const ppo::ActResult act = policy.act(ppo::observation_tensors(*obs), !stochastic);
       const torch::Tensor chosen = act.env_action.to(ppo::torch_dtype(action.dtype())).contiguous();
       if (act.action.is_floating_point()) {
-        clipped += act.action.ne(act.env_action).sum().item<double>();
+        clipped += static_cast<double>(act.clipped_elements());
         elements += static_cast<double>(act.action.numel());
       }
       std::memcpy(action.raw_data(), chosen.data_ptr(), action.nbytes());

@@ -504,4 +504,9 @@ torch::Tensor random_shift(const torch::Tensor& images, const torch::Tensor& shi
   return by_rows.gather(3, cols.view({b, 1, 1, w}).expand({b, c, h, w}));
 }
 
+std::int64_t ActResult::clipped_elements() const {
+  if (!action.is_floating_point()) return 0;
+  return action.ne(env_action).sum().item<std::int64_t>();
+}
+
 }  // namespace pixelgym::ppo

@@ -108,6 +108,10 @@ struct ActResult {
   torch::Tensor log_prob;
   /// V(obs), float32 (B,).
   torch::Tensor value;
+
+  /// Box: how many elements of `action` lie outside the bounds (sent to the env clipped);
+  /// Discrete: 0. Over all the elements, near 1 means bang-bang control at the bounds.
+  std::int64_t clipped_elements() const;
 };
 
 /// What `evaluate` returns for B observations and actions.

@@ -67,6 +67,21 @@ TEST(Policy, BoxActionsHaveTheRightShapesAndEnvActionsStayInBounds) {
   EXPECT_TRUE(torch::equal(mode1.action, mode2.action));
 }
 
+TEST(Policy, ClippedElementsCountsTheActionElementsOutsideTheBounds) {
+  const spaces::Box actions({-1.0, -2.0}, {1.0, 0.5}, {2});
+  Policy policy(*box(-5, 5, {3}), actions, PolicyConfig{});
+  const ObservationTensors obs{{"", torch::randn({16, 3})}};
+  set_constant_head(policy, {3.0F, 0.0F});  // the first element past its bound, the second in
+  EXPECT_EQ(policy.act(obs, /*deterministic=*/true).clipped_elements(), 16);
+  set_constant_head(policy, {-3.0F, 0.7F});  // both past a bound
+  EXPECT_EQ(policy.act(obs, true).clipped_elements(), 32);
+  set_constant_head(policy, {0.5F, -1.0F});
+  EXPECT_EQ(policy.act(obs, true).clipped_elements(), 0);
+  // Discrete actions are never clipped.
+  Policy discrete(*box(-5, 5, {3}), spaces::Discrete(3), PolicyConfig{});
+  EXPECT_EQ(discrete.act(obs, true).clipped_elements(), 0);
+}
+
 TEST(Policy, DiscreteActionsAreIndicesAndEnvActionsAddTheStart) {
   torch::manual_seed(2);
   Policy policy(*box(-1, 1, {4}), spaces::Discrete(3, /*start=*/2));
