@@ -24,9 +24,12 @@ long page_faults_on_this_thread() {
   return usage.ru_minflt;
 }
 
-// Minor page faults of `steps` steps of `id` drawn with Mesa copy `copy`, after `warmup`
-// uncounted ones (heaps grow at first; the same episode throughout, so no reset is counted).
-long page_faults_stepping(const std::string& id, int copy, int warmup, int steps) {
+// The fewest minor page faults in any of `windows` stretches of `steps` steps of `id` drawn with
+// Mesa copy `copy`, after `warmup` uncounted ones (heaps grow at first). The faults the bug made
+// come on every step, so they are in every stretch; a fault from outside (the kernel reclaiming a
+// page while other tests load the machine, say) comes now and then, and the fewest leaves it out.
+long fewest_page_faults_stepping(const std::string& id, int copy, int warmup, int steps,
+                                 int windows) {
   const render::MesaCopy::Use use(copy);
   std::unique_ptr<Env> env = make(id);
   Rng rng(3);
@@ -37,24 +40,32 @@ long page_faults_stepping(const std::string& id, int copy, int warmup, int steps
   reset.obs = env->observation_space().zeros();
   step.obs = env->observation_space().zeros();
   env->reset_into(reset, 0);
+  long fewest = -1;
   long before = 0;
-  for (int t = 0; t < warmup + steps; ++t) {
-    if (t == warmup) before = page_faults_on_this_thread();
+  for (int t = 0; t < warmup + steps * windows; ++t) {
+    if (t >= warmup && (t - warmup) % steps == 0) before = page_faults_on_this_thread();
     env->step_into(actions[static_cast<std::size_t>(t) % actions.size()], step);
     if (step.terminated || step.truncated) env->reset_into(reset);
+    if (t >= warmup && (t - warmup) % steps == steps - 1) {
+      const long faults = page_faults_on_this_thread() - before;
+      if (fewest < 0 || faults < fewest) fewest = faults;
+    }
   }
-  return page_faults_on_this_thread() - before;
+  return fewest;
 }
 
 TEST(MesaCopyPageFaults, APrivateCopyStepsWithoutPageFaultsPerStep) {
   constexpr int kWarmup = 2000;
   constexpr int kSteps = 400;
+  constexpr int kWindows = 3;
   for (const std::string id : {"CartPoleSwingup-v0", "ArmReach-v0"}) {
-    const long linked = page_faults_stepping(id, 0, kWarmup, kSteps);
-    const long copy = page_faults_stepping(id, 1, kWarmup, kSteps);
+    const long linked = fewest_page_faults_stepping(id, 0, kWarmup, kSteps, kWindows);
+    const long copy = fewest_page_faults_stepping(id, 1, kWarmup, kSteps, kWindows);
     ASSERT_TRUE(render::MesaCopy::loaded(1)) << render::MesaCopy::why_not(1);
-    EXPECT_LE(copy, linked + kSteps / 40) << id << ": page faults in " << kSteps
-                                          << " steps: copy 1 " << copy << ", copy 0 " << linked;
+    // Without the fix the arm made 257 faults in 400 steps; the bound allows 0.05 a step.
+    EXPECT_LE(copy, linked + kSteps / 20)
+        << id << ": the fewest page faults in " << kWindows << " stretches of " << kSteps
+        << " steps: copy 1 " << copy << ", copy 0 " << linked;
   }
 }
 
