@@ -20,6 +20,12 @@ namespace {
 
 constexpr double kHullMargin = 0.001;    // m; Bullet's 0.04 default inflates small parts
 constexpr double kUnboundedForce = 1e9;  // N or N m, for motors without a limit
+// Bullet's collision configuration preallocates pools of contact manifolds and collision
+// algorithms, 4096 of each by default: about 8 MB per world in double precision, written whole
+// on every build (so on every World::reset), where a task's few bodies use a dozen entries. A
+// pair past the pool is allocated from the heap instead (Bullet's dispatcher falls back to
+// btAlignedAlloc), so the size changes memory, not results.
+constexpr int kCollisionPoolSize = 128;
 
 btVector3 to_bt(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 Eigen::Vector3d from_bt(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
@@ -177,7 +183,10 @@ struct World::Impl {
   }
 
   void build() {
-    collision_config = std::make_unique<btDefaultCollisionConfiguration>();
+    btDefaultCollisionConstructionInfo pools;
+    pools.m_defaultMaxPersistentManifoldPoolSize = kCollisionPoolSize;
+    pools.m_defaultMaxCollisionAlgorithmPoolSize = kCollisionPoolSize;
+    collision_config = std::make_unique<btDefaultCollisionConfiguration>(pools);
     dispatcher = std::make_unique<btCollisionDispatcher>(collision_config.get());
     broadphase = std::make_unique<btDbvtBroadphase>();
     solver = std::make_unique<btMultiBodyConstraintSolver>();
