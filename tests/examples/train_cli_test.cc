@@ -3,6 +3,7 @@
 // corrupt checkpoint is refused, never loaded. Tiny settings (32x32 pixels, 2 envs, 16-step
 // rollouts) keep it to seconds; learning itself is measured in bench/, not here.
 #include <gtest/gtest.h>
+#include <sched.h>
 #include <signal.h>
 #include <unistd.h>
 
@@ -63,6 +64,14 @@ TEST(TrainCliTest, AShortRunWritesACompleteRunFolder) {
   EXPECT_EQ(config.at("wrap"), json::array({"frame_stack=2"}));
   EXPECT_EQ(config.at("ppo").at("num_steps"), 16);
   EXPECT_TRUE(config.contains("code_version"));
+  // LibTorch's threads default to one per core this process may run on (not OpenMP's default,
+  // which was 1 on a 2-core VM), and config.json records the count.
+  if (std::getenv("OMP_NUM_THREADS") == nullptr) {
+    cpu_set_t cpus;
+    CPU_ZERO(&cpus);
+    ASSERT_EQ(sched_getaffinity(0, sizeof(cpus), &cpus), 0);
+    EXPECT_EQ(config.at("torch_threads"), CPU_COUNT(&cpus));
+  }
 
   // 96 steps of 2 envs x 16: 3 updates, one row each.
   const ppo::ProgressTable progress = ppo::read_progress_csv(run / "progress.csv");
@@ -124,6 +133,21 @@ bool run_cli_until(const fs::path& folder, const std::string& arguments, const f
   int status = 0;
   ::waitpid(child, &status, 0);
   return WIFSIGNALED(status);
+}
+
+TEST(TrainCliTest, TorchThreadsAreRecordedAndKeptOnResume) {
+  const fs::path folder = fresh_folder("torch_threads");
+  const fs::path run = folder / "run";
+  const CliRun first = run_cli(train_arguments(
+      folder, "--steps 32 --torch-threads 1 --checkpoint-every 1 --out " + run.string()));
+  ASSERT_EQ(first.exit_code, 0) << first.output;
+  EXPECT_EQ(json::parse(read_text(run / "config.json")).at("torch_threads"), 1);
+  // --resume reads the count back from config.json (results depend on it).
+  const CliRun resumed = run_cli("train --resume " + run.string() + " --steps 64 --quiet");
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  EXPECT_NE(resumed.output.find("torch_threads=1 (as the run began)"), std::string::npos)
+      << resumed.output;
+  fs::remove_all(folder);
 }
 
 TEST(TrainCliTest, ARunKilledMidTrainingResumesFromItsLastCheckpoint) {
