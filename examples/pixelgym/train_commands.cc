@@ -89,6 +89,7 @@ struct RunSettings {
   int num_threads = 2;
   int torch_threads = 0;               // LibTorch intra-op threads (see set_torch_threads)
   std::int64_t checkpoint_every = 10;  // updates
+  std::int64_t keep_checkpoints = 3;   // the newest kept, 0: all
   double minutes = 0.0;                // 0: no time limit
   std::int64_t eval_episodes = 5;
   ppo::PpoConfig ppo;
@@ -102,6 +103,7 @@ json settings_to_json(const RunSettings& settings) {
   out["num_threads"] = settings.num_threads;
   out["torch_threads"] = settings.torch_threads;
   out["checkpoint_every"] = settings.checkpoint_every;
+  out["keep_checkpoints"] = settings.keep_checkpoints;
   out["minutes"] = settings.minutes;
   out["eval_episodes"] = settings.eval_episodes;
   out["ppo"] = json::parse(ppo::config_to_json(settings.ppo));
@@ -118,6 +120,8 @@ RunSettings settings_from_json(const json& in, const fs::path& where) {
     // Run folders from before the field: 0, the default count.
     settings.torch_threads = in.value("torch_threads", 0);
     settings.checkpoint_every = in.at("checkpoint_every").get<std::int64_t>();
+    // Run folders from before the field kept every checkpoint, and go on doing so.
+    settings.keep_checkpoints = in.value("keep_checkpoints", std::int64_t{0});
     settings.minutes = in.at("minutes").get<double>();
     settings.eval_episodes = in.at("eval_episodes").get<std::int64_t>();
     settings.ppo = ppo::config_from_json(in.at("ppo").dump());
@@ -287,6 +291,7 @@ struct TrainArguments {
   int threads = 2;
   int torch_threads = 0;
   std::int64_t checkpoint_every = 10;
+  std::int64_t keep_checkpoints = 3;
   std::int64_t eval_episodes = 5;
 };
 
@@ -341,6 +346,7 @@ int run_train(const TrainArguments& args) {
     settings.num_threads = args.threads;
     settings.torch_threads = args.torch_threads;
     settings.checkpoint_every = args.checkpoint_every;
+    settings.keep_checkpoints = args.keep_checkpoints;
     settings.eval_episodes = args.eval_episodes;
     folder = args.out.empty() ? fs::path("runs") / settings.id : fs::path(args.out);
   }
@@ -412,6 +418,7 @@ int run_train(const TrainArguments& args) {
   const auto save_checkpoint = [&] {
     ppo::write_checkpoint(run->checkpoint_path(trainer.updates()),
                           checkpoint_blobs(trainer, returns, elapsed()));
+    ppo::prune_checkpoints(run->path(), settings.keep_checkpoints);
   };
   while (trainer.env_steps() < settings.ppo.total_env_steps &&
          (time_limit_s <= 0.0 || elapsed() - wall_before < time_limit_s)) {
@@ -526,6 +533,13 @@ Command add_train(CLI::App& app) {
                    "records the count used and --resume keeps it")
       ->capture_default_str()
       ->check(integer_in(0));
+  train
+      ->add_option("--keep-checkpoints", args->keep_checkpoints,
+                   "The newest checkpoints kept in the run folder, older ones deleted after each "
+                   "new one is written (0: keep all; a checkpoint is about 5 MB at the demo's "
+                   "settings, written every --checkpoint-every updates)")
+      ->capture_default_str()
+      ->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 40));
   train->add_option("--checkpoint-every", args->checkpoint_every, "Updates between checkpoints")
       ->capture_default_str()
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 40));

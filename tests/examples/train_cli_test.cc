@@ -150,12 +150,36 @@ TEST(TrainCliTest, TorchThreadsAreRecordedAndKeptOnResume) {
   fs::remove_all(folder);
 }
 
+TEST(TrainCliTest, OnlyTheNewestCheckpointsAreKept) {
+  const fs::path folder = fresh_folder("keep");
+  const fs::path run = folder / "run";
+  // 7 updates, a checkpoint after each: the default keeps the newest 3.
+  const CliRun trained =
+      run_cli(train_arguments(folder, "--steps 224 --checkpoint-every 1 --out " + run.string()));
+  ASSERT_EQ(trained.exit_code, 0) << trained.output;
+  std::vector<std::string> names;
+  for (const fs::path& path : ppo::list_checkpoints(run)) names.push_back(path.filename());
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"ckpt-000005.pgck", "ckpt-000006.pgck", "ckpt-000007.pgck"}));
+  EXPECT_EQ(json::parse(read_text(run / "config.json")).at("keep_checkpoints"), 3);
+  // The resumed run keeps the run's setting: 2 more updates, still the newest 3.
+  const CliRun resumed = run_cli("train --resume " + run.string() + " --steps 288 --quiet");
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  names.clear();
+  for (const fs::path& path : ppo::list_checkpoints(run)) names.push_back(path.filename());
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"ckpt-000007.pgck", "ckpt-000008.pgck", "ckpt-000009.pgck"}));
+  fs::remove_all(folder);
+}
+
 TEST(TrainCliTest, ARunKilledMidTrainingResumesFromItsLastCheckpoint) {
   const fs::path folder = fresh_folder("killed");
   const fs::path run = folder / "run";
   // A long run, killed with SIGKILL once its second checkpoint exists.
   const bool killed = run_cli_until(
-      folder, train_arguments(folder, "--steps 100000 --checkpoint-every 2 --out " + run.string()),
+      folder,
+      train_arguments(
+          folder, "--steps 100000 --checkpoint-every 2 --keep-checkpoints 0 --out " + run.string()),
       run / "ckpt-000004.pgck");
   ASSERT_TRUE(fs::exists(run / "ckpt-000004.pgck")) << read_text(folder / "log.txt");
   ASSERT_TRUE(killed);
@@ -201,7 +225,8 @@ TEST(TrainCliTest, AResumedRunIsTheRunThatDidNotStop) {
   const fs::path folder = fresh_folder("equivalent");
   const fs::path straight = folder / "straight";
   const fs::path split = folder / "split";
-  const std::string settings = "--steps 320 --checkpoint-every 2 --out ";
+  // Every checkpoint kept: they are compared one by one below.
+  const std::string settings = "--steps 320 --checkpoint-every 2 --keep-checkpoints 0 --out ";
   const CliRun trained = run_cli(train_arguments(folder, settings + straight.string()));
   ASSERT_EQ(trained.exit_code, 0) << trained.output;
   ASSERT_TRUE(run_cli_until(folder, train_arguments(folder, settings + split.string()),

@@ -268,6 +268,25 @@ std::vector<fs::path> list_checkpoints(const fs::path& folder) {
   return paths;
 }
 
+std::vector<fs::path> prune_checkpoints(const fs::path& folder, std::int64_t keep) {
+  if (keep < 0) {
+    throw std::invalid_argument("prune_checkpoints: expected keep >= 0, got " +
+                                std::to_string(keep));
+  }
+  std::vector<fs::path> paths = list_checkpoints(folder);
+  if (keep == 0 || static_cast<std::int64_t>(paths.size()) <= keep) return {};
+  paths.resize(paths.size() - static_cast<std::size_t>(keep));
+  for (const fs::path& path : paths) {
+    std::error_code error;
+    fs::remove(path, error);
+    if (error) {
+      throw std::runtime_error("prune_checkpoints: cannot delete " + path.string() + ": " +
+                               error.message());
+    }
+  }
+  return paths;
+}
+
 CheckpointSearch find_latest_checkpoint(const fs::path& folder) {
   const std::vector<fs::path> paths = list_checkpoints(folder);
   CheckpointSearch search;

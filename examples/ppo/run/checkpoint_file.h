@@ -71,4 +71,13 @@ CheckpointSearch find_latest_checkpoint(const std::filesystem::path& folder);
 /// The checkpoint files of `folder` (by name only, not read), lowest update first.
 std::vector<std::filesystem::path> list_checkpoints(const std::filesystem::path& folder);
 
+/// Deletes the checkpoint files of `folder` but the `keep` with the highest update numbers (by
+/// name, not read; keep 0 deletes none) and returns the deleted paths, lowest update first. The
+/// trainer calls it right after writing a checkpoint, so the newest kept is that one, valid;
+/// keeping more than one leaves find_latest_checkpoint something older should a file be damaged
+/// later. Throws std::invalid_argument for a negative `keep`, std::runtime_error naming the folder
+/// or the file when it cannot be listed or a file cannot be deleted.
+std::vector<std::filesystem::path> prune_checkpoints(const std::filesystem::path& folder,
+                                                     std::int64_t keep);
+
 }  // namespace pixelgym::ppo

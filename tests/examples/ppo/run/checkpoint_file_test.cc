@@ -286,6 +286,28 @@ TEST(CheckpointFileTest, LatestSkipsAndReportsInvalidOnesAndIgnoresTemporaries) 
   EXPECT_EQ(list_checkpoints(folder).size(), 4U);
 }
 
+TEST(CheckpointFileTest, PruningKeepsTheNewestByUpdateNumberAndNothingElseIsTouched) {
+  const fs::path folder = fresh_folder("ckpt_prune");
+  // Written out of order: the update number decides, not the time of writing.
+  for (const int update : {30, 10, 200, 20}) {
+    write_checkpoint(folder / checkpoint_file_name(update), {{"meta", std::to_string(update)}});
+  }
+  write_bytes(folder / (temporary_file_prefix(checkpoint_file_name(300)) + "1.0"), "PGYMCK");
+  write_bytes(folder / "progress.csv", "steps\n");
+
+  EXPECT_TRUE(prune_checkpoints(folder, 0).empty());
+  EXPECT_EQ(list_checkpoints(folder).size(), 4U);
+  EXPECT_TRUE(prune_checkpoints(folder, 4).empty());
+  EXPECT_EQ(prune_checkpoints(folder, 2),
+            (std::vector<fs::path>{folder / "ckpt-000010.pgck", folder / "ckpt-000020.pgck"}));
+  EXPECT_EQ(list_checkpoints(folder),
+            (std::vector<fs::path>{folder / "ckpt-000030.pgck", folder / "ckpt-000200.pgck"}));
+  EXPECT_TRUE(fs::exists(folder / "progress.csv"));
+  EXPECT_TRUE(fs::exists(folder / (temporary_file_prefix(checkpoint_file_name(300)) + "1.0")));
+  EXPECT_EQ(read_checkpoint(folder / "ckpt-000200.pgck"), (CheckpointBlobs{{"meta", "200"}}));
+  EXPECT_THROW(prune_checkpoints(folder, -1), std::invalid_argument);
+}
+
 TEST(CheckpointFileTest, LatestInAFolderWithoutCheckpointsIsNone) {
   const fs::path folder = fresh_folder("ckpt_none");
   write_bytes(folder / (temporary_file_prefix(checkpoint_file_name(1)) + "1.0"), "");
