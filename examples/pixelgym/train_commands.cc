@@ -62,7 +62,8 @@ void tune_process_for_training() {
 // passes): `requested`, or when 0 one per core this process may run on. LibTorch's own default is
 // OpenMP's, which is not always the core count: on a 2-core Debian 12 VM it was 1, and the
 // updates ran on one core (a 64x64 9-channel minibatch of 128 through the small CNN, forward and
-// backward: 78 ms with 1 thread, 46 ms with 2; the demo's training 210 against 370 env steps/s).
+// backward: 78 ms with 1 thread, 46 ms with 2; bench/train_throughput.sh on the demo's settings:
+// 209 against 322 env steps/s).
 // OMP_NUM_THREADS, when the user set it, wins over the default (not over `requested`). Returns
 // the count in use.
 int set_torch_threads(int requested) {
