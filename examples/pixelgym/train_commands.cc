@@ -294,7 +294,37 @@ struct TrainArguments {
   std::int64_t checkpoint_every = 10;
   std::int64_t keep_checkpoints = 3;
   std::int64_t eval_episodes = 5;
+  std::vector<std::string> given;  // which of the run settings' flags were on the command line
 };
+
+// With --resume the run's own settings hold; a flag that asks for another value is refused
+// (naming both) rather than silently ignored. The same value is accepted.
+void check_resume_flags(const TrainArguments& args, const RunSettings& run) {
+  const auto given = [&](const char* flag) {
+    return std::find(args.given.begin(), args.given.end(), flag) != args.given.end();
+  };
+  std::string differ;
+  // Integers of one signedness each: compared and printed exactly.
+  const auto check = [&](const char* flag, bool asked, auto value, auto run_value) {
+    if (!asked || value == run_value) return;
+    differ += (differ.empty() ? "" : ", ") + std::string(flag) + " " + std::to_string(value) +
+              " (the run's: " + std::to_string(run_value) + ")";
+  };
+  check("--seed", args.seed_given, args.seed, run.ppo.seed);
+  check("--num-envs", args.num_envs > 0, std::int64_t{args.num_envs}, run.ppo.num_envs);
+  check("--threads", given("--threads"), args.threads, run.num_threads);
+  check("--torch-threads", given("--torch-threads"), args.torch_threads, run.torch_threads);
+  check("--checkpoint-every", given("--checkpoint-every"), args.checkpoint_every,
+        run.checkpoint_every);
+  check("--keep-checkpoints", given("--keep-checkpoints"), args.keep_checkpoints,
+        run.keep_checkpoints);
+  check("--eval-episodes", given("--eval-episodes"), args.eval_episodes, run.eval_episodes);
+  if (!differ.empty()) {
+    throw UsageError("train --resume continues with the settings in " + args.resume +
+                     "/config.json, and these differ from them: " + differ +
+                     " (only --steps and --minutes may change)");
+  }
+}
 
 double mean_of(const std::deque<double>& values) {
   if (values.empty()) return std::nan("");
@@ -323,6 +353,7 @@ int run_train(const TrainArguments& args) {
       throw std::runtime_error("--resume " + folder.string() + ": no config.json there");
     }
     settings = settings_from_json(json::parse(config_file), folder / "config.json");
+    check_resume_flags(args, settings);
     const ppo::CheckpointSearch search = ppo::find_latest_checkpoint(folder);
     for (const auto& skipped : search.skipped) {
       std::cerr << "train: skipping " << skipped.path.string() << ": " << skipped.reason << "\n";
@@ -514,7 +545,8 @@ Command add_train(CLI::App& app) {
   train->add_option("--resume", args->resume,
                     "Continue the run in this folder from its latest valid checkpoint (its "
                     "config.json gives the env and the settings; --steps and --minutes may "
-                    "change the budget). The envs replay the checkpoint's actions and go on "
+                    "change the budget, and a run setting such as --threads given with it must "
+                    "equal the run's). The envs replay the checkpoint's actions and go on "
                     "with their episodes, so with the run's --steps (the learning rate anneals "
                     "over it) the result is the run that did not stop");
   train->add_flag("--quiet", args->quiet,
@@ -560,7 +592,10 @@ Command add_train(CLI::App& app) {
                   "train --resume takes the env and settings from the run's config.json: give no "
                   "id, --set, --wrap, --config or --out with it");
             }
-            (void)train;
+            for (const char* flag : {"--threads", "--torch-threads", "--checkpoint-every",
+                                     "--keep-checkpoints", "--eval-episodes"}) {
+              if (train->count(flag) > 0) args->given.emplace_back(flag);
+            }
             return run_train(*args);
           }};
 }

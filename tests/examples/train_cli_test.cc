@@ -172,6 +172,30 @@ TEST(TrainCliTest, OnlyTheNewestCheckpointsAreKept) {
   fs::remove_all(folder);
 }
 
+TEST(TrainCliTest, ResumeRefusesSettingsThatDifferFromTheRunsAndAcceptsTheSame) {
+  const fs::path folder = fresh_folder("resume_flags");
+  const fs::path run = folder / "run";
+  const CliRun first = run_cli(train_arguments(folder, "--steps 32 --out " + run.string()));
+  ASSERT_EQ(first.exit_code, 0) << first.output;
+  // The run has --threads 2 and --keep-checkpoints 3 (the default); asking for others is an
+  // error naming each, and nothing is trained.
+  const CliRun refused = run_cli("train --resume " + run.string() +
+                                 " --steps 64 --threads 1 --keep-checkpoints 0 --seed 0 --quiet");
+  EXPECT_EQ(refused.exit_code, 2) << refused.output;
+  EXPECT_NE(refused.output.find("these differ from them: --threads 1 (the run's: 2), "
+                                "--keep-checkpoints 0 (the run's: 3) (only --steps and "
+                                "--minutes may change)"),
+            std::string::npos)
+      << refused.output;
+  EXPECT_EQ(ppo::read_progress_csv(run / "progress.csv").rows.size(), 1U);
+  // The run's own values (and --seed 0, its seed) are accepted.
+  const CliRun resumed = run_cli("train --resume " + run.string() +
+                                 " --steps 64 --threads 2 --keep-checkpoints 3 --seed 0 --quiet");
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  EXPECT_EQ(ppo::read_progress_csv(run / "progress.csv").rows.size(), 2U);
+  fs::remove_all(folder);
+}
+
 TEST(TrainCliTest, ARunKilledMidTrainingResumesFromItsLastCheckpoint) {
   const fs::path folder = fresh_folder("killed");
   const fs::path run = folder / "run";
