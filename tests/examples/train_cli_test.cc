@@ -150,6 +150,13 @@ TEST(TrainCliTest, TorchThreadsAreRecordedAndKeptOnResume) {
   fs::remove_all(folder);
 }
 
+// The checkpoint files of a run folder, lowest update first.
+std::vector<std::string> checkpoint_names(const fs::path& run) {
+  std::vector<std::string> names;
+  for (const fs::path& path : ppo::list_checkpoints(run)) names.push_back(path.filename());
+  return names;
+}
+
 TEST(TrainCliTest, OnlyTheNewestCheckpointsAreKept) {
   const fs::path folder = fresh_folder("keep");
   const fs::path run = folder / "run";
@@ -157,17 +164,13 @@ TEST(TrainCliTest, OnlyTheNewestCheckpointsAreKept) {
   const CliRun trained =
       run_cli(train_arguments(folder, "--steps 224 --checkpoint-every 1 --out " + run.string()));
   ASSERT_EQ(trained.exit_code, 0) << trained.output;
-  std::vector<std::string> names;
-  for (const fs::path& path : ppo::list_checkpoints(run)) names.push_back(path.filename());
-  EXPECT_EQ(names,
+  EXPECT_EQ(checkpoint_names(run),
             (std::vector<std::string>{"ckpt-000005.pgck", "ckpt-000006.pgck", "ckpt-000007.pgck"}));
   EXPECT_EQ(json::parse(read_text(run / "config.json")).at("keep_checkpoints"), 3);
   // The resumed run keeps the run's setting: 2 more updates, still the newest 3.
   const CliRun resumed = run_cli("train --resume " + run.string() + " --steps 288 --quiet");
   ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
-  names.clear();
-  for (const fs::path& path : ppo::list_checkpoints(run)) names.push_back(path.filename());
-  EXPECT_EQ(names,
+  EXPECT_EQ(checkpoint_names(run),
             (std::vector<std::string>{"ckpt-000007.pgck", "ckpt-000008.pgck", "ckpt-000009.pgck"}));
   fs::remove_all(folder);
 }
