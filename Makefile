@@ -24,13 +24,14 @@ configure: deps
 build: configure
 	cmake --build $(BUILD_DIR) --parallel $(JOBS)
 
-# The main job: PPO from pixels only (64x64 anti-aliased, 3 stacked frames, each action held for
-# 8 control steps as dm_control's pixel benchmarks do) on CartPoleBalance-v0 for 10 minutes of
-# wall time, into a fresh runs/demo/ (the previous demo run is replaced). The config sets
-# gamma 0.95 per env step, which with action_repeat 8 discounts like 0.994 per control step
-# (PPO's default 0.99 would be 0.9987: a horizon of 8 s, whose values the CNN learned too poorly).
-DEMO_TRAIN := train CartPoleBalance-v0 --set obs_mode=pixels --set width=64 --set height=64 \
-  --set msaa=4 --set action_repeat=8 --wrap frame_stack=3 \
+# The main job: PPO from pixels only (64x64 anti-aliased grey frames, 3 stacked, each action held
+# for 8 control steps as dm_control's pixel benchmarks do) on CartPoleBalance-v1 (the cart-pole
+# drawn with a thick, dark pole that shows in small grey frames) for 10 minutes of wall time, into
+# a fresh runs/demo/ (the previous demo run is replaced). The config sets gamma 0.95 per env step,
+# which with action_repeat 8 discounts like 0.994 per control step (PPO's default 0.99 would be
+# 0.9987: a horizon of 8 s, whose values the CNN learned too poorly).
+DEMO_TRAIN := train CartPoleBalance-v1 --set obs_mode=pixels --set width=64 --set height=64 \
+  --set msaa=4 --set action_repeat=8 --wrap grayscale --wrap frame_stack=3 \
   --config examples/ppo/configs/action_repeat_8.json --minutes 10 --out runs/demo
 demo: build
 	rm -rf runs/demo

@@ -11,9 +11,10 @@
 
 namespace pixelgym {
 
-CartPoleTask::CartPoleTask(bool swing_up, bool discrete)
+CartPoleTask::CartPoleTask(bool swing_up, bool discrete, int version)
     : swing_up_(swing_up),
       discrete_(discrete),
+      version_(version),
       action_space_(discrete ? SpacePtr(std::make_shared<spaces::Discrete>(3))
                              : SpacePtr(std::make_shared<spaces::Box>(-1.0, 1.0, Shape{1}))) {}
 
@@ -24,8 +25,8 @@ engine::WorldConfig CartPoleTask::world_config() const {
 }
 
 void CartPoleTask::build(engine::World& world) {
-  robot_ = world.add_robot(
-      engine::default_model_cache().load_urdf(engine::asset_path("cartpole/cartpole.urdf")));
+  const char* urdf = version_ == 0 ? "cartpole/cartpole.urdf" : "cartpole/cartpole_v1.urdf";
+  robot_ = world.add_robot(engine::default_model_cache().load_urdf(engine::asset_path(urdf)));
 }
 
 render::Camera CartPoleTask::camera(const std::string& name, const engine::World& world) const {
@@ -88,17 +89,21 @@ double CartPoleTask::reward(const engine::World& world) const {
 
 std::vector<EnvSpec> CartPoleTask::specs() {
   std::vector<EnvSpec> specs;
-  for (const bool swing_up : {false, true}) {
-    for (const bool discrete : {false, true}) {
-      const std::string id = std::string("CartPole") + (swing_up ? "Swingup" : "Balance") +
-                             (discrete ? "Discrete" : "") + "-v0";
-      const std::string description =
-          std::string(swing_up ? "swing the pole up from hanging and balance it"
-                               : "keep the pole upright") +
-          (discrete ? "; Discrete(3) pushes" : "; force in [-1, 1]");
-      specs.push_back(pixel_task_spec(id, description, [swing_up, discrete](const Params&) {
-        return std::make_unique<CartPoleTask>(swing_up, discrete);
-      }));
+  for (const int version : {0, 1}) {
+    for (const bool swing_up : {false, true}) {
+      for (const bool discrete : {false, true}) {
+        const std::string id = std::string("CartPole") + (swing_up ? "Swingup" : "Balance") +
+                               (discrete ? "Discrete" : "") + "-v" + std::to_string(version);
+        const std::string description =
+            std::string(swing_up ? "swing the pole up from hanging and balance it"
+                                 : "keep the pole upright") +
+            (discrete ? "; Discrete(3) pushes" : "; force in [-1, 1]") +
+            (version == 1 ? "; a thicker, dark pole (v0's physics)" : "");
+        specs.push_back(
+            pixel_task_spec(id, description, [swing_up, discrete, version](const Params&) {
+              return std::make_unique<CartPoleTask>(swing_up, discrete, version);
+            }));
+      }
     }
   }
   return specs;

@@ -1,4 +1,4 @@
-// CartPoleBalance-v0, CartPoleSwingup-v0 and their Discrete variants.
+// CartPoleBalance, CartPoleSwingup and their Discrete variants, -v0 and -v1.
 #pragma once
 
 #include "envs/registry.h"
@@ -13,13 +13,19 @@ namespace pixelgym {
 ///   small angular velocity, where upright = (cos(pole angle) + 1) / 2.
 /// - State: joint_pos = (cart position m, pole angle rad in [-pi, pi), 0 upright),
 ///   joint_vel = their rates. 1000 control steps of 0.01 s per episode; no termination.
+/// - Versions: -v1 has -v0's physics, rewards and cameras, drawn from
+/// assets/cartpole/cartpole_v1.urdf:
+///   a pole twice as thick (0.1 m) in dark red instead of pale yellow, and a larger cart. At 64 x
+///   64 the -v0 pole is under a pixel wide and only a little brighter than the sky (in grey frames
+///   a faint line); the -v1 pole is about 1.7 pixels wide and dark against the sky.
 /// - Cameras: "fixed" (front, the whole rail in view; the default), "tracking" (as fixed,
 ///   following the cart) and "close" (front, fixed, 2.4 m away instead of 4: x in about
 ///   [-1.1, 1.1] m, so the pole is about 1.7 times as long and wide in the image; the cart can
 ///   leave the view near the rail's ends).
 class CartPoleTask final : public Task {
  public:
-  CartPoleTask(bool swing_up, bool discrete);
+  /// `version` is the id's: 0 or 1 (the drawing; see above).
+  CartPoleTask(bool swing_up, bool discrete, int version);
 
   std::vector<std::string> camera_names() const override { return {"fixed", "tracking", "close"}; }
   SpacePtr action_space() const override { return action_space_; }
@@ -46,13 +52,14 @@ class CartPoleTask final : public Task {
 
   static constexpr double kMaxForceN = 10.0;
 
-  /// The registry entries: CartPoleBalance-v0, CartPoleSwingup-v0, CartPoleBalanceDiscrete-v0,
-  /// CartPoleSwingupDiscrete-v0.
+  /// The registry entries: CartPoleBalance, CartPoleSwingup, CartPoleBalanceDiscrete and
+  /// CartPoleSwingupDiscrete, each -v0 and -v1.
   static std::vector<EnvSpec> specs();
 
  private:
   bool swing_up_;
   bool discrete_;
+  int version_;
   SpacePtr action_space_;
   engine::RobotId robot_;
   double control_ = 0.0;

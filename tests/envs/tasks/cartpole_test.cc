@@ -12,6 +12,7 @@
 
 #include "envs/pixel_env.h"
 #include "envs/registry.h"
+#include "envs/rng.h"
 #include "tests/envs/tasks/scripted.h"
 
 namespace pixelgym {
@@ -179,7 +180,7 @@ TEST(CartPoleTest, DiscreteActionsPushLeftNothingRight) {
 int cart_and_pole_pixels(const std::string& camera) {
   auto env = make("CartPoleBalance-v0",
                   {{"width", 64}, {"height", 64}, {"obs_mode", "pixels"}, {"camera", camera}});
-  const Array& frame = env->reset(0).obs.dict().at("pixels").array();
+  const Array frame = env->reset(0).obs.dict().at("pixels").array();
   const std::uint8_t* p = frame.data<std::uint8_t>();
   int count = 0;
   for (std::int64_t i = 0; i < frame.size(); i += 3) {
@@ -206,20 +207,26 @@ struct PoleRows {
   int missing = 0;  // rows between first and last without the pole
 };
 
+// The median colour of row y of a 64-pixel-wide RGB frame: the sky's, above the cart.
+std::array<int, 3> row_median(const std::uint8_t* p, int y) {
+  std::array<std::vector<int>, 3> channels;
+  for (int x = 0; x < 64; ++x) {
+    for (int c = 0; c < 3; ++c) channels[c].push_back(p[(y * 64 + x) * 3 + c]);
+  }
+  std::array<int, 3> median{};
+  for (int c = 0; c < 3; ++c) {
+    std::nth_element(channels[c].begin(), channels[c].begin() + 32, channels[c].end());
+    median[c] = channels[c][32];
+  }
+  return median;
+}
+
 PoleRows pole_rows(const Array& frame) {
   const std::uint8_t* p = frame.data<std::uint8_t>();
   PoleRows rows;
   int shown = 0;
   for (int y = 0; y < 34; ++y) {
-    std::array<std::vector<int>, 3> channels;
-    for (int x = 0; x < 64; ++x) {
-      for (int c = 0; c < 3; ++c) channels[c].push_back(p[(y * 64 + x) * 3 + c]);
-    }
-    std::array<int, 3> median{};
-    for (int c = 0; c < 3; ++c) {
-      std::nth_element(channels[c].begin(), channels[c].begin() + 32, channels[c].end());
-      median[c] = channels[c][32];
-    }
+    const std::array<int, 3> median = row_median(p, y);
     bool pole = false;
     for (int x = 0; x < 64 && !pole; ++x) {
       int difference = 0;
@@ -265,21 +272,72 @@ TEST(CartPoleTest, AntiAliasedObservationsShowTheWholePole) {
   EXPECT_GT(aliased_frames_broken, 0) << "the aliased pole was never broken: a weaker test";
 }
 
-TEST(CartPoleTest, ConfigKeysAreValidated) {
-  EXPECT_THROW(make("CartPoleSwingup-v0", {{"camera", "top"}}), std::invalid_argument);
-  EXPECT_THROW(make("CartPoleSwingup-v0", {{"obs_mode", "rgb"}}), std::invalid_argument);
-  EXPECT_THROW(make("CartPoleSwingup-v0", {{"width", 8}}), std::invalid_argument);
-  EXPECT_THROW(make("CartPoleSwingup-v0", {{"action_repeat", 0}}), std::invalid_argument);
-  try {
-    make("CartPoleSwingup-v0", {{"msaa", 3}});
-    ADD_FAILURE() << "msaa=3 was accepted";
-  } catch (const std::invalid_argument& error) {
-    EXPECT_STREQ(error.what(), "CartPoleSwingup-v0: msaa must be 0, 2, 4 or 8, got 3");
+// -v1 draws the cart-pole of -v0 (same physics: the same states, rewards and flags for the same
+// seed and actions) with a thicker, darker pole.
+TEST(CartPoleTest, V1IsV0sPhysics) {
+  for (const char* name : {"CartPoleBalance", "CartPoleSwingup", "CartPoleBalanceDiscrete",
+                           "CartPoleSwingupDiscrete"}) {
+    auto v0 = make(std::string(name) + "-v0", {{"obs_mode", "state"}});
+    auto v1 = make(std::string(name) + "-v1", {{"obs_mode", "state"}});
+    EXPECT_TRUE(v0->reset(3).obs.equals(v1->reset(3).obs)) << name;
+    Rng rng(3);
+    for (int step = 0; step < 300; ++step) {
+      const Value action = v0->action_space().sample(rng);
+      const StepResult a = v0->step(action);
+      const StepResult b = v1->step(action);
+      ASSERT_TRUE(a.obs.equals(b.obs)) << name << ", step " << step;
+      ASSERT_EQ(a.reward, b.reward) << name << ", step " << step;
+      ASSERT_EQ(a.terminated, b.terminated);
+      ASSERT_EQ(a.truncated, b.truncated);
+    }
   }
-  auto env = make("CartPoleSwingup-v0", {{"width", 64}, {"height", 48}, {"obs_mode", "pixels"}});
-  EXPECT_EQ(env->reset(0).obs.dict().keys(), std::vector<std::string>{"pixels"});
-  EXPECT_EQ(env->reset(0).obs.dict().at("pixels").array().shape(), (Shape{48, 64, 3}));
-  EXPECT_DOUBLE_EQ(env->metadata().render_fps, 100.0);
+}
+
+// How the pole shows in a 64 x 64 anti-aliased frame after reset(seed) (rows 0-33, above the
+// cart): its pixels (those that differ from their row's median, the sky, by more than 12 levels
+// summed over R, G and B), and their summed difference from the median in grey level
+// (0.299 R + 0.587 G + 0.114 B), which grows with the pole's width and its contrast to the sky.
+struct PoleLook {
+  int pixels = 0;
+  double grey_contrast = 0.0;
+};
+
+PoleLook pole_look(const std::string& id, std::uint64_t seed) {
+  auto env = make(id, {{"width", 64}, {"height", 64}, {"obs_mode", "pixels"}, {"msaa", 4}});
+  const Array frame = env->reset(seed).obs.dict().at("pixels").array();
+  const std::uint8_t* p = frame.data<std::uint8_t>();
+  const auto grey = [](const auto& rgb) {
+    return 0.299 * rgb[0] + 0.587 * rgb[1] + 0.114 * rgb[2];
+  };
+  PoleLook look;
+  for (int y = 0; y < 34; ++y) {
+    const std::array<int, 3> median = row_median(p, y);
+    for (int x = 0; x < 64; ++x) {
+      const std::uint8_t* pixel = p + (y * 64 + x) * 3;
+      int difference = 0;
+      for (int c = 0; c < 3; ++c) difference += std::abs(pixel[c] - median[c]);
+      if (difference <= 12) continue;
+      ++look.pixels;
+      look.grey_contrast += std::abs(grey(pixel) - grey(median));
+    }
+  }
+  return look;
+}
+
+// v0's pale yellow pole is a little brighter than the sky (and under a pixel wide); v1's dark red
+// one is twice as wide and far darker, so that it stands out in grey frames as well.
+TEST(CartPoleTest, V1DrawsAThickerPoleThatStandsOutInGrey) {
+  for (std::uint64_t seed = 0; seed < 4; ++seed) {
+    const PoleLook v0 = pole_look("CartPoleBalance-v0", seed);
+    const PoleLook v1 = pole_look("CartPoleBalance-v1", seed);
+    const std::string figures = "seed " + std::to_string(seed) + ": pixels v0 " +
+                                std::to_string(v0.pixels) + ", v1 " + std::to_string(v1.pixels) +
+                                "; grey contrast v0 " + std::to_string(v0.grey_contrast) + ", v1 " +
+                                std::to_string(v1.grey_contrast);
+    EXPECT_GT(v0.pixels, 10) << figures;
+    EXPECT_GE(v1.pixels, v0.pixels) << figures;
+    EXPECT_GT(v1.grey_contrast, 2.8 * v0.grey_contrast) << figures;
+  }
 }
 
 }  // namespace
