@@ -7,9 +7,13 @@
 #include <ATen/CPUGeneratorImpl.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -200,6 +204,27 @@ TEST(PpoConfig, JsonTakesASubsetAndRefusesUnknownOrIllTypedMembers) {
   EXPECT_THROW(config_from_json(R"({"gamma": 1.5})"), std::invalid_argument);
   EXPECT_THROW(config_from_json(R"({"num_minibatches": 3})"), std::invalid_argument);  // 1024 % 3
   EXPECT_THROW(config_from_json("{"), std::invalid_argument);
+}
+
+// The configs shipped in examples/ppo/configs (the README's commands name them) parse and
+// validate: a misspelt member or an out-of-range value there would only fail a user's run.
+TEST(PpoConfig, EveryShippedConfigParses) {
+  const std::filesystem::path folder =
+      std::filesystem::path(PIXELGYM_SOURCE_DIR) / "examples" / "ppo" / "configs";
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+    if (entry.path().extension() != ".json") continue;
+    names.push_back(entry.path().filename().string());
+    std::ifstream file(entry.path());
+    std::stringstream text;
+    text << file.rdbuf();
+    EXPECT_NO_THROW(config_from_json(text.str())) << entry.path();
+  }
+  std::sort(names.begin(), names.end());
+  // The ones the README and `make demo` name.
+  for (const char* name : {"action_repeat_8.json", "reacher.json", "swingup.json"}) {
+    EXPECT_TRUE(std::binary_search(names.begin(), names.end(), std::string(name))) << name;
+  }
 }
 
 TEST(Trainer, RequiresSameStepAutoresetAndMatchingNumEnvs) {
