@@ -554,7 +554,10 @@ Command add_train(CLI::App& app) {
                   "terminal)");
   train->add_option("--seed", args->seed, "Seed for torch, the envs and augmentation (default 0)")
       ->each([args](const std::string&) { args->seed_given = true; });
-  train->add_option("--num-envs", args->num_envs, "Envs stepped together (default 8)")
+  train
+      ->add_option(
+          "--num-envs", args->num_envs,
+          "Envs stepped together (default: the config's num_envs, 8 unless --config sets it)")
       ->check(integer_in(1));
   train->add_option("--threads", args->threads, "Env threads (AsyncVectorEnv)")
       ->capture_default_str()
