@@ -3,6 +3,7 @@
 #include <cmath>
 #include <iterator>
 #include <stdexcept>
+#include <tuple>
 #include <utility>
 
 #include "envs/spaces/box.h"
@@ -217,50 +218,23 @@ Policy::Policy(const Space& observation_space, const Space& action_space, Policy
     inputs_.push_back(make_input("", observation_space));
   }
 
-  const double gain = std::sqrt(2.0);
-  std::int64_t fused = 0;
   for (std::size_t i = 0; i < inputs_.size(); ++i) {
-    const PolicyInput& input = inputs_[i];
-    if (input.image) {
-      cnns_.push_back(
-          register_module("cnn" + std::to_string(cnns_.size()), make_cnn(input, config_)));
-      fused += config_.cnn_features;
-    } else {
-      vector_inputs_.push_back(i);
-      vector_sizes_.push_back(shape_size(input.shape));
-    }
+    if (inputs_[i].image) continue;
+    vector_inputs_.push_back(i);
+    vector_sizes_.push_back(shape_size(inputs_[i].shape));
   }
-  if (!vector_inputs_.empty()) {
-    std::int64_t width = 0;
-    for (std::int64_t size : vector_sizes_) width += size;
-    mlp_ = nn::Sequential();
-    for (std::int64_t hidden : config_.mlp_hidden) {
-      nn::Linear linear(width, hidden);
-      orthogonal(linear, gain);
-      mlp_->push_back(linear);
-      mlp_->push_back(nn::Tanh());
-      width = hidden;
-    }
-    if (!config_.mlp_hidden.empty()) register_module("mlp", mlp_);
-    fused += width;
-    for (std::size_t v = 0; v < vector_inputs_.size(); ++v) {
-      const auto size = vector_sizes_[v];
-      const std::string suffix = std::to_string(v);
-      statistics_mean_.push_back(
-          register_buffer("observation_mean" + suffix, torch::zeros({size}, torch::kFloat64)));
-      statistics_var_.push_back(
-          register_buffer("observation_var" + suffix, torch::ones({size}, torch::kFloat64)));
-      statistics_count_.push_back(register_buffer(
-          "observation_count" + suffix,
-          torch::full({}, wrappers::RunningStatistics::kInitialCount, torch::kFloat64)));
-    }
-  }
-  std::int64_t features = fused;
-  if (config_.trunk_hidden > 0) {
-    nn::Linear linear(fused, config_.trunk_hidden);
-    orthogonal(linear, gain);
-    trunk_ = register_module("trunk", nn::Sequential(linear, nn::ReLU()));
-    features = config_.trunk_hidden;
+  std::int64_t features = 0;
+  std::tie(encoder_, features) = make_encoder("");
+  for (std::size_t v = 0; v < vector_inputs_.size(); ++v) {
+    const auto size = vector_sizes_[v];
+    const std::string suffix = std::to_string(v);
+    statistics_mean_.push_back(
+        register_buffer("observation_mean" + suffix, torch::zeros({size}, torch::kFloat64)));
+    statistics_var_.push_back(
+        register_buffer("observation_var" + suffix, torch::ones({size}, torch::kFloat64)));
+    statistics_count_.push_back(register_buffer(
+        "observation_count" + suffix,
+        torch::full({}, wrappers::RunningStatistics::kInitialCount, torch::kFloat64)));
   }
 
   if (const auto* discrete = dynamic_cast<const spaces::Discrete*>(&action_space)) {
@@ -283,8 +257,59 @@ Policy::Policy(const Space& observation_space, const Space& action_space, Policy
   }
   action_head_ = register_module("action_head", nn::Linear(features, action_size_));
   orthogonal(action_head_, 0.01);
-  value_head_ = register_module("value_head", nn::Linear(features, 1));
+  // Built last, so that the shared network's initial weights do not depend on the option.
+  std::int64_t value_features = features;
+  if (config_.separate_value_network) {
+    Encoder value_encoder;
+    std::tie(value_encoder, value_features) = make_encoder("value_");
+    value_encoder_ = std::move(value_encoder);
+  }
+  value_head_ = register_module("value_head", nn::Linear(value_features, 1));
   orthogonal(value_head_, 1.0);
+}
+
+std::pair<Policy::Encoder, std::int64_t> Policy::make_encoder(const std::string& prefix) {
+  const double gain = std::sqrt(2.0);
+  Encoder encoder;
+  std::int64_t fused = 0;
+  for (const PolicyInput& input : inputs_) {
+    if (!input.image) continue;
+    encoder.cnns.push_back(register_module(prefix + "cnn" + std::to_string(encoder.cnns.size()),
+                                           make_cnn(input, config_)));
+    fused += config_.cnn_features;
+  }
+  if (!vector_inputs_.empty()) {
+    std::int64_t width = 0;
+    for (std::int64_t size : vector_sizes_) width += size;
+    encoder.mlp = nn::Sequential();
+    for (std::int64_t hidden : config_.mlp_hidden) {
+      nn::Linear linear(width, hidden);
+      orthogonal(linear, gain);
+      encoder.mlp->push_back(linear);
+      encoder.mlp->push_back(nn::Tanh());
+      width = hidden;
+    }
+    if (!config_.mlp_hidden.empty()) register_module(prefix + "mlp", encoder.mlp);
+    fused += width;
+  }
+  if (config_.trunk_hidden == 0) return {encoder, fused};
+  nn::Linear linear(fused, config_.trunk_hidden);
+  orthogonal(linear, gain);
+  encoder.trunk = register_module(prefix + "trunk", nn::Sequential(linear, nn::ReLU()));
+  return {encoder, config_.trunk_hidden};
+}
+
+torch::Tensor Policy::encode(Encoder& encoder, const std::vector<torch::Tensor>& images,
+                             const torch::Tensor& vectors) {
+  std::vector<torch::Tensor> features;
+  features.reserve(images.size() + 1);
+  for (std::size_t i = 0; i < images.size(); ++i)
+    features.push_back(encoder.cnns[i]->forward(images[i]));
+  if (vectors.defined()) {
+    features.push_back(config_.mlp_hidden.empty() ? vectors : encoder.mlp->forward(vectors));
+  }
+  torch::Tensor fused = features.size() == 1 ? features[0] : torch::cat(features, 1);
+  return encoder.trunk ? encoder.trunk->forward(fused) : fused;
 }
 
 torch::Tensor Policy::image_input(const PolicyInput& input, const torch::Tensor& batch) const {
@@ -320,9 +345,8 @@ torch::Tensor Policy::vector_input(std::size_t v, const torch::Tensor& batch) co
 
 Policy::Heads Policy::forward(const ObservationTensors& obs, const torch::Tensor& shifts,
                               std::int64_t pad) {
-  std::vector<torch::Tensor> features;
+  std::vector<torch::Tensor> images;
   std::vector<torch::Tensor> vectors;
-  std::size_t cnn = 0;
   std::size_t vector = 0;
   std::int64_t batch_size = -1;
   for (const PolicyInput& input : inputs_) {
@@ -339,20 +363,19 @@ Policy::Heads Policy::forward(const ObservationTensors& obs, const torch::Tensor
     }
     batch_size = batch.size(0);
     if (input.image) {
-      torch::Tensor images = image_input(input, batch);
-      if (shifts.defined()) images = random_shift(images, shifts, pad);
-      features.push_back(cnns_[cnn++]->forward(images));
+      torch::Tensor image = image_input(input, batch);
+      if (shifts.defined()) image = random_shift(image, shifts, pad);
+      images.push_back(std::move(image));
     } else {
       vectors.push_back(vector_input(vector++, batch));
     }
   }
-  if (!vectors.empty()) {
-    torch::Tensor x = vectors.size() == 1 ? vectors[0] : torch::cat(vectors, 1);
-    features.push_back(config_.mlp_hidden.empty() ? x : mlp_->forward(x));
-  }
-  torch::Tensor fused = features.size() == 1 ? features[0] : torch::cat(features, 1);
-  if (trunk_) fused = trunk_->forward(fused);
-  return {action_head_->forward(fused), value_head_->forward(fused).squeeze(1)};
+  torch::Tensor vector_batch;
+  if (!vectors.empty()) vector_batch = vectors.size() == 1 ? vectors[0] : torch::cat(vectors, 1);
+  const torch::Tensor features = encode(encoder_, images, vector_batch);
+  const torch::Tensor value_features =
+      value_encoder_ ? encode(*value_encoder_, images, vector_batch) : features;
+  return {action_head_->forward(features), value_head_->forward(value_features).squeeze(1)};
 }
 
 ActResult Policy::act(const ObservationTensors& obs, bool deterministic,

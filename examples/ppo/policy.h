@@ -9,6 +9,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "envs/space.h"
@@ -61,6 +62,9 @@ struct PolicyConfig {
   /// The Gaussian head's log standard deviation at initialization (a parameter of its own,
   /// independent of the observation). Unused for Discrete actions.
   double initial_log_std = 0.0;
+  /// Give the value head an encoder of its own (CNNs, MLP and trunk as the policy's, with their
+  /// own weights) instead of sharing the policy's. Doubles the network's cost.
+  bool separate_value_network = false;
   /// Normalize the vector (state) keys with running statistics (see Policy); images are always
   /// scaled to [0, 1] instead.
   bool normalize_observations = true;
@@ -132,7 +136,10 @@ struct Evaluation {
 /// its own; its uint8 input is scaled to [0, 1] inside the network. Every other Box (any rank,
 /// any dtype) is a vector key: flattened, converted to float32, normalized (see below), and all
 /// vector keys are concatenated into one MLP. The encoders' outputs are concatenated (key
-/// order) into the trunk.
+/// order) into the trunk. The action and value heads read the trunk; with
+/// config.separate_value_network the value head reads a second copy of the CNNs, MLP and trunk
+/// (its parameters named with a "value_" prefix) and nothing of the value's loss reaches the
+/// policy's layers.
 ///
 /// Observation normalization (config.normalize_observations): each vector key is standardized
 /// with running statistics (wrappers::RunningStatistics: mean 0, var 1, count 1e-4 at first),
@@ -205,17 +212,27 @@ class Policy : public torch::nn::Module {
     torch::Tensor logits_or_mean;  // (B, action_size)
     torch::Tensor value;           // (B,)
   };
+  // The layers from the inputs to the features a head reads.
+  struct Encoder {
+    std::vector<torch::nn::Sequential> cnns;  // one per image input, in input order
+    torch::nn::Sequential mlp{nullptr};       // null when there is no vector input
+    torch::nn::Sequential trunk{nullptr};     // null when trunk_hidden == 0
+  };
+  // Builds an encoder and registers its modules as prefix + "cnn0", "cnn1", ..., "mlp", "trunk";
+  // returns it with the width of its output.
+  std::pair<Encoder, std::int64_t> make_encoder(const std::string& prefix);
+  torch::Tensor encode(Encoder& encoder, const std::vector<torch::Tensor>& images,
+                       const torch::Tensor& vectors);
   Heads forward(const ObservationTensors& obs, const torch::Tensor& shifts, std::int64_t pad);
   torch::Tensor image_input(const PolicyInput& input, const torch::Tensor& batch) const;
   torch::Tensor vector_input(std::size_t vector_index, const torch::Tensor& batch) const;
 
   PolicyConfig config_;
   std::vector<PolicyInput> inputs_;
-  std::vector<torch::nn::Sequential> cnns_;  // one per image input, in input order
-  std::vector<std::size_t> vector_inputs_;   // indices into inputs_
+  std::vector<std::size_t> vector_inputs_;  // indices into inputs_
   std::vector<std::int64_t> vector_sizes_;
-  torch::nn::Sequential mlp_{nullptr};    // null when there is no vector input
-  torch::nn::Sequential trunk_{nullptr};  // null when trunk_hidden == 0
+  Encoder encoder_;
+  std::optional<Encoder> value_encoder_;  // with separate_value_network
   torch::nn::Linear action_head_{nullptr};
   torch::nn::Linear value_head_{nullptr};
   torch::Tensor log_std_;

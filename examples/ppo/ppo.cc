@@ -110,6 +110,7 @@ void to_json(nlohmann::json& json, const PolicyConfig& config) {
                         {"mlp_hidden", config.mlp_hidden},
                         {"trunk_hidden", config.trunk_hidden},
                         {"initial_log_std", config.initial_log_std},
+                        {"separate_value_network", config.separate_value_network},
                         {"normalize_observations", config.normalize_observations},
                         {"observation_clip", config.observation_clip}};
 }
@@ -117,7 +118,7 @@ void to_json(nlohmann::json& json, const PolicyConfig& config) {
 void from_json(const nlohmann::json& json, PolicyConfig& config) {
   require_known_members(json,
                         {"cnn", "cnn_features", "mlp_hidden", "trunk_hidden", "initial_log_std",
-                         "normalize_observations", "observation_clip"},
+                         "separate_value_network", "normalize_observations", "observation_clip"},
                         "PolicyConfig");
   std::string cnn = to_string(config.cnn);
   read_member(json, "cnn", cnn);
@@ -126,6 +127,7 @@ void from_json(const nlohmann::json& json, PolicyConfig& config) {
   read_member(json, "mlp_hidden", config.mlp_hidden);
   read_member(json, "trunk_hidden", config.trunk_hidden);
   read_member(json, "initial_log_std", config.initial_log_std);
+  read_member(json, "separate_value_network", config.separate_value_network);
   read_member(json, "normalize_observations", config.normalize_observations);
   read_member(json, "observation_clip", config.observation_clip);
   config.validate();

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <memory>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "envs/spaces/box.h"
@@ -124,6 +125,66 @@ TEST(Policy, DictOfAnImageAndAVectorUsesBoth) {
   ObservationTensors wrong = obs;
   wrong["joint_pos"] = torch::randn({8, 3});
   EXPECT_THROW(policy.act(wrong, true), std::invalid_argument);
+}
+
+// separate_value_network: the value reads an encoder of its own (every part of the shared one
+// copied under a "value_" prefix), the value's gradient reaches none of the policy's layers and
+// the action's none of the value's, and the shared layers start with the same weights as without
+// the option.
+TEST(Policy, SeparateValueNetworkSharesNoLayerWithThePolicy) {
+  spaces::Dict space(
+      {{"pixels", box(0, 255, {64, 64, 3}, DType::kUInt8)}, {"joint_pos", box(-1, 1, {2})}});
+  PolicyConfig config;
+  config.separate_value_network = true;
+  torch::manual_seed(10);
+  Policy separate(space, spaces::Box(-1, 1, {1}), config);
+  torch::manual_seed(10);
+  Policy shared(space, spaces::Box(-1, 1, {1}));
+
+  const auto separate_parameters = separate.named_parameters();
+  const auto shared_parameters = shared.named_parameters();
+  std::size_t value_parameters = 0;
+  for (const auto& item : separate_parameters) {
+    if (item.key().rfind("value_", 0) == 0 && item.key().rfind("value_head", 0) != 0) {
+      ++value_parameters;
+      // Each value_ parameter mirrors a policy one of the same shape.
+      const torch::Tensor* twin = separate_parameters.find(item.key().substr(6));
+      ASSERT_NE(twin, nullptr) << item.key();
+      EXPECT_EQ(twin->sizes(), item.value().sizes()) << item.key();
+    } else {
+      const torch::Tensor* same = shared_parameters.find(item.key());
+      ASSERT_NE(same, nullptr) << item.key();
+      if (item.key().rfind("value_head", 0) != 0) {
+        EXPECT_TRUE(torch::equal(*same, item.value())) << item.key();
+      }
+    }
+  }
+  // Weights and biases of cnn0 (the small CNN: 2 convolutions and a linear), mlp (2 linears)
+  // and trunk (1 linear).
+  EXPECT_EQ(value_parameters, 12u);
+  EXPECT_EQ(separate_parameters.size(), shared_parameters.size() + value_parameters);
+
+  ObservationTensors obs{{"pixels", batch_of(4, {64, 64, 3}, DType::kUInt8)},
+                         {"joint_pos", torch::randn({4, 2})}};
+  const auto gradient_reaches = [&](const torch::Tensor& loss) {
+    separate.zero_grad();
+    loss.backward();
+    std::vector<std::string> reached;
+    for (const auto& item : separate.named_parameters()) {
+      const torch::Tensor& grad = item.value().grad();
+      if (grad.defined() && grad.abs().sum().item<double>() > 0.0) reached.push_back(item.key());
+    }
+    return reached;
+  };
+  const torch::Tensor actions = torch::zeros({4, 1});
+  for (const std::string& key : gradient_reaches(separate.evaluate(obs, actions).value.sum())) {
+    EXPECT_EQ(key.rfind("value_", 0), 0u) << key << " gets the value's gradient";
+  }
+  const auto from_log_prob = gradient_reaches(separate.evaluate(obs, actions).log_prob.sum());
+  EXPECT_FALSE(from_log_prob.empty());
+  for (const std::string& key : from_log_prob) {
+    EXPECT_NE(key.rfind("value_", 0), 0u) << key << " gets the policy's gradient";
+  }
 }
 
 // The frame-stack layouts (FrameStackObservation: new_axis, channels_first, channels_last; with

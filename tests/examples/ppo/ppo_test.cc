@@ -170,6 +170,7 @@ TEST(PpoConfig, JsonRoundTripKeepsEveryField) {
   config.policy.mlp_hidden = {32, 16, 8};
   config.policy.trunk_hidden = 0;
   config.policy.initial_log_std = -0.5;
+  config.policy.separate_value_network = true;
   config.policy.normalize_observations = false;
   config.policy.observation_clip = 5.0;
   const std::string text = config_to_json(config);
@@ -182,7 +183,7 @@ TEST(PpoConfig, JsonRoundTripKeepsEveryField) {
   // Every field is a member (one per field of the structs, policy nested).
   const nlohmann::json json = nlohmann::json::parse(text);
   EXPECT_EQ(json.size(), 22u);
-  EXPECT_EQ(json.at("policy").size(), 7u);
+  EXPECT_EQ(json.at("policy").size(), 8u);
   EXPECT_EQ(json.at("policy").at("cnn"), "nature");
 }
 
