@@ -525,24 +525,20 @@ UpdateStats Trainer::update() {
   }
 
   const auto parameters = policy_->parameters();
+  // With a separate value network the KL stop ends only the policy's steps: the value's loss
+  // reaches none of the policy's parameters, so the value network can go on through every epoch
+  // without moving the policy.
+  const bool value_after_stop = policy_->config().separate_value_network;
   bool stop = false;
-  for (std::int64_t epoch = 0; epoch < config_.update_epochs && !stop; ++epoch) {
+  for (std::int64_t epoch = 0; epoch < config_.update_epochs && !(stop && !value_after_stop);
+       ++epoch) {
     const torch::Tensor order = torch::randperm(batch, sampling_, torch::kInt64);
+    std::int64_t policy_steps_in_epoch = 0;
     for (std::int64_t m = 0; m < config_.num_minibatches; ++m) {
       const torch::Tensor index = order.slice(0, m * minibatch, (m + 1) * minibatch);
       const Evaluation now = policy_->evaluate(
           select_rows(obs, index), actions.index_select(0, index),
           shifts.defined() ? shifts.index_select(0, index) : torch::Tensor(), config_.shift_pad);
-      const torch::Tensor log_ratio = now.log_prob - old_log_probs.index_select(0, index);
-      const torch::Tensor ratio = log_ratio.exp();
-      torch::Tensor advantage = advantages.index_select(0, index);
-      if (config_.normalize_advantages && minibatch > 1) {
-        advantage = (advantage - advantage.mean()) / (advantage.std() + 1e-8);
-      }
-      const torch::Tensor policy_loss =
-          torch::max(-advantage * ratio,
-                     -advantage * ratio.clamp(1.0 - config_.clip_range, 1.0 + config_.clip_range))
-              .mean();
       const torch::Tensor target = returns.index_select(0, index);
       torch::Tensor value_loss;
       if (config_.clip_value_loss) {
@@ -554,6 +550,36 @@ UpdateStats Trainer::update() {
       } else {
         value_loss = 0.5 * (now.value - target).pow(2).mean();
       }
+      if (stop) {
+        // The value network alone. Gradients left undefined are skipped by Adam (a zero
+        // gradient would still move the policy's parameters through Adam's momentum).
+        for (torch::Tensor& parameter : policy_->parameters()) parameter.mutable_grad().reset();
+        (config_.value_coef * value_loss).backward();
+        const double grad_norm =
+            torch::nn::utils::clip_grad_norm_(parameters, config_.max_grad_norm);
+        if (!std::isfinite(value_loss.item<double>()) || !std::isfinite(grad_norm)) {
+          throw std::runtime_error("Trainer::update: update " + std::to_string(updates_ + 1) +
+                                   ", epoch " + std::to_string(epoch + 1) + ", minibatch " +
+                                   std::to_string(m + 1) + " diverged: value loss " +
+                                   std::to_string(value_loss.item<double>()) + ", gradient norm " +
+                                   std::to_string(grad_norm) +
+                                   "; the parameters are left as the previous minibatch made "
+                                   "them, not stepped");
+        }
+        optimizer_->step();
+        stats.value_minibatches += 1;
+        continue;
+      }
+      const torch::Tensor log_ratio = now.log_prob - old_log_probs.index_select(0, index);
+      const torch::Tensor ratio = log_ratio.exp();
+      torch::Tensor advantage = advantages.index_select(0, index);
+      if (config_.normalize_advantages && minibatch > 1) {
+        advantage = (advantage - advantage.mean()) / (advantage.std() + 1e-8);
+      }
+      const torch::Tensor policy_loss =
+          torch::max(-advantage * ratio,
+                     -advantage * ratio.clamp(1.0 - config_.clip_range, 1.0 + config_.clip_range))
+              .mean();
       const torch::Tensor entropy = now.entropy.mean();
       const torch::Tensor loss =
           policy_loss - config_.entropy_coef * entropy + config_.value_coef * value_loss;
@@ -587,12 +613,13 @@ UpdateStats Trainer::update() {
       stats.approx_kl += approx_kl;
       stats.grad_norm += grad_norm;
       stats.minibatches += 1;
+      policy_steps_in_epoch += 1;
       if (config_.target_kl > 0.0 && approx_kl > config_.target_kl) {
         stop = true;
-        break;
+        if (!value_after_stop) break;
       }
     }
-    stats.epochs += 1;
+    if (policy_steps_in_epoch > 0) stats.epochs += 1;
   }
   const auto count = static_cast<double>(stats.minibatches);
   stats.policy_loss /= count;

@@ -63,7 +63,9 @@ struct PpoConfig {
   double value_coef = 0.5;
   /// Gradients are rescaled to this global L2 norm at most.
   double max_grad_norm = 0.5;
-  /// Stop an update's epochs early once a minibatch's approximate KL exceeds it; 0: never.
+  /// Stop an update's epochs early once a minibatch's approximate KL exceeds it; 0: never. With
+  /// policy.separate_value_network only the policy stops: the value network goes on through
+  /// every epoch (its loss reaches none of the policy's parameters).
   double target_kl = 0.0;
   /// DrQ's random shift of every image key during updates (see Trainer::update), by up to
   /// shift_pad pixels each way.
@@ -138,7 +140,9 @@ struct UpdateStats {
   double grad_norm = 0.0;           // mean global gradient norm before clipping
   double learning_rate = 0.0;       // the learning rate used
   std::int64_t epochs = 0;          // epochs run (fewer than update_epochs after a target_kl stop)
-  std::int64_t minibatches = 0;     // minibatches run
+  std::int64_t minibatches = 0;     // minibatches run (the losses above are their means)
+  /// Minibatches of the value network alone after a target_kl stop (separate_value_network).
+  std::int64_t value_minibatches = 0;
 };
 
 /// An episode that ended during a rollout: the sum of the rewards the trainer was given (after

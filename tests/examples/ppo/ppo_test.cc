@@ -11,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -470,6 +471,47 @@ TEST(Trainer, SameSeedSameParametersAndRngStateResumesTheRandomness) {
   d.update();
   EXPECT_TRUE(same_parameters(parameters_of(a.policy()), parameters_of(d.policy())));
   EXPECT_FALSE(same_parameters(parameters_of(a.policy()), parameters_of(b.policy())));
+}
+
+// With a separate value network a target_kl stop ends the policy's steps only: the value
+// network trains on through the remaining epochs, and the policy's parameters end as if the
+// update had stopped there (Adam's momentum does not carry them on).
+TEST(Trainer, AKlStopWithASeparateValueNetworkStopsOnlyThePolicy) {
+  auto run = [](std::int64_t epochs, UpdateStats& stats) {
+    auto envs = bandit_envs(2, true);
+    PpoConfig config = small_config(2, 8);
+    config.policy.separate_value_network = true;
+    config.update_epochs = epochs;
+    // The first minibatch's ratio is exactly 1; the second's KL exceeds this.
+    config.target_kl = 1e-12;
+    Trainer trainer(*envs, config);
+    trainer.collect();
+    stats = trainer.update();
+    std::map<std::string, torch::Tensor> parameters;
+    for (const auto& item : trainer.policy().named_parameters()) {
+      parameters[item.key()] = item.value().detach().clone();
+    }
+    return parameters;
+  };
+  UpdateStats four_stats;
+  UpdateStats one_stats;
+  const auto four = run(4, four_stats);
+  const auto one = run(1, one_stats);
+  EXPECT_EQ(four_stats.minibatches, 2);
+  EXPECT_EQ(four_stats.epochs, 1);
+  EXPECT_EQ(four_stats.value_minibatches, 6);
+  EXPECT_EQ(one_stats.minibatches, 2);
+  EXPECT_EQ(one_stats.value_minibatches, 0);
+  int value_parameters = 0;
+  for (const auto& [name, tensor] : four) {
+    if (name.rfind("value_", 0) == 0) {
+      ++value_parameters;
+      EXPECT_FALSE(torch::equal(tensor, one.at(name))) << name << " did not train on";
+    } else {
+      EXPECT_TRUE(torch::equal(tensor, one.at(name))) << name << " moved after the stop";
+    }
+  }
+  EXPECT_GT(value_parameters, 0);
 }
 
 std::unique_ptr<SyncVectorEnv> counter_envs(int n) {
