@@ -523,8 +523,8 @@ CLI::App* add_run_options(CLI::App& train, TrainArguments& args) {
                    "PPO settings as JSON (any subset of the fields; the rest keep their defaults: "
                    "see examples/ppo/ppo.h, PpoConfig)");
   train.add_option("--steps", args.steps,
-                   "Env steps to train for, all envs together (default: the config's "
-                   "total_env_steps, 1,000,000)");
+                   "Env steps to train for, all envs together; with --set action_repeat=K "
+                   "each is K control steps (default: the config's total_env_steps, 1,000,000)");
   train.add_option("--minutes", args.minutes,
                    "Stop after this much wall time (then checkpoint, evaluate, write the video)");
   return &train;
