@@ -553,7 +553,7 @@ UpdateStats Trainer::update() {
       if (stop) {
         // The value network alone. Gradients left undefined are skipped by Adam (a zero
         // gradient would still move the policy's parameters through Adam's momentum).
-        for (torch::Tensor& parameter : policy_->parameters()) parameter.mutable_grad().reset();
+        for (const torch::Tensor& parameter : parameters) parameter.mutable_grad().reset();
         (config_.value_coef * value_loss).backward();
         const double grad_norm =
             torch::nn::utils::clip_grad_norm_(parameters, config_.max_grad_norm);
