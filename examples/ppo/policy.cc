@@ -85,9 +85,16 @@ nn::Sequential make_cnn(const PolicyInput& input, const PolicyConfig& config) {
   };
   static constexpr Conv kNature[] = {{32, 8, 4}, {64, 4, 2}, {64, 3, 1}};
   static constexpr Conv kSmall[] = {{16, 8, 4}, {32, 4, 2}};
-  const bool nature = config.cnn == CnnArchitecture::kNature;
-  const Conv* const first = nature ? std::begin(kNature) : std::begin(kSmall);
-  const Conv* const last = nature ? std::end(kNature) : std::end(kSmall);
+  static constexpr Conv kFine[] = {{32, 3, 2}, {32, 3, 2}, {32, 3, 2}};
+  const Conv* first = std::begin(kSmall);
+  const Conv* last = std::end(kSmall);
+  if (config.cnn == CnnArchitecture::kNature) {
+    first = std::begin(kNature);
+    last = std::end(kNature);
+  } else if (config.cnn == CnnArchitecture::kFine) {
+    first = std::begin(kFine);
+    last = std::end(kFine);
+  }
   const double gain = std::sqrt(2.0);
   nn::Sequential cnn;
   std::int64_t channels = input.channels;
@@ -186,14 +193,23 @@ ObservationTensors observation_tensors(const Value& batch) {
 }
 
 const char* to_string(CnnArchitecture architecture) {
-  return architecture == CnnArchitecture::kNature ? "nature" : "small";
+  switch (architecture) {
+    case CnnArchitecture::kNature:
+      return "nature";
+    case CnnArchitecture::kSmall:
+      return "small";
+    case CnnArchitecture::kFine:
+      return "fine";
+  }
+  return "unknown";
 }
 
 CnnArchitecture parse_cnn_architecture(const std::string& name) {
   if (name == "nature") return CnnArchitecture::kNature;
   if (name == "small") return CnnArchitecture::kSmall;
+  if (name == "fine") return CnnArchitecture::kFine;
   throw std::invalid_argument("unknown CNN architecture \"" + name +
-                              "\"; valid: \"nature\", \"small\"");
+                              "\"; valid: \"nature\", \"small\", \"fine\"");
 }
 
 void PolicyConfig::validate() const {

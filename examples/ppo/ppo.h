@@ -80,8 +80,8 @@ struct PpoConfig {
 };
 
 /// JSON form of PpoConfig: an object with one member per field, named as the fields, the CNN as
-/// "nature" / "small", `policy` a nested object. from_json takes any subset of the members (the
-/// rest keep their defaults) and throws std::invalid_argument for an unknown member (listing
+/// "nature" / "small" / "fine", `policy` a nested object. from_json takes any subset of the members
+/// (the rest keep their defaults) and throws std::invalid_argument for an unknown member (listing
 /// the known ones), a member of the wrong type, or a config that fails validate().
 void to_json(nlohmann::json& json, const PpoConfig& config);
 void from_json(const nlohmann::json& json, PpoConfig& config);

@@ -400,6 +400,64 @@ TEST(ArrayTensor, ViewsTheArrayWithoutCopyingAndKeepsItAlive) {
   EXPECT_EQ(tensors.at("pixels").data_ptr(), dict.dict().at("pixels").array().raw_data());
 }
 
+TEST(Policy, EachCnnHasItsLayersAndServesA64x64FrameStack) {
+  struct Expected {
+    CnnArchitecture cnn;
+    const char* name;
+    std::vector<std::vector<std::int64_t>> conv_weights;  // (out, in, kh, kw) per conv
+    std::int64_t flat;                                    // the linear layer's input width
+  };
+  // (64 - k) / s + 1 per conv: nature 15, 6, 4; small 15, 6; fine 31, 15, 7.
+  const std::vector<Expected> expected = {
+      {CnnArchitecture::kNature,
+       "nature",
+       {{32, 9, 8, 8}, {64, 32, 4, 4}, {64, 64, 3, 3}},
+       64 * 4 * 4},
+      {CnnArchitecture::kSmall, "small", {{16, 9, 8, 8}, {32, 16, 4, 4}}, 32 * 6 * 6},
+      {CnnArchitecture::kFine, "fine", {{32, 9, 3, 3}, {32, 32, 3, 3}, {32, 32, 3, 3}}, 32 * 7 * 7},
+  };
+  for (const Expected& e : expected) {
+    SCOPED_TRACE(e.name);
+    EXPECT_STREQ(to_string(e.cnn), e.name);
+    EXPECT_EQ(parse_cnn_architecture(e.name), e.cnn);
+    PolicyConfig config;
+    config.cnn = e.cnn;
+    torch::manual_seed(2);
+    Policy policy(*box(0, 255, {64, 64, 9}, DType::kUInt8), *box(-1, 1, {1}), config);
+    std::vector<std::vector<std::int64_t>> conv_weights;
+    std::int64_t flat = 0;
+    for (const auto& item : policy.named_parameters()) {
+      if (item.key().rfind("cnn0.", 0) != 0 || item.key().find(".weight") == std::string::npos) {
+        continue;
+      }
+      const auto sizes = item.value().sizes().vec();
+      if (sizes.size() == 4) conv_weights.push_back(sizes);
+      if (sizes.size() == 2) flat = sizes[1];
+    }
+    EXPECT_EQ(conv_weights, e.conv_weights);
+    EXPECT_EQ(flat, e.flat);
+    const ObservationTensors obs{{"", batch_of(5, {64, 64, 9}, DType::kUInt8)}};
+    const ActResult out = policy.act(obs, false);
+    EXPECT_EQ(out.action.sizes(), (std::vector<std::int64_t>{5, 1}));
+    EXPECT_EQ(out.value.sizes(), (std::vector<std::int64_t>{5}));
+    EXPECT_TRUE(torch::isfinite(out.value).all().item<bool>());
+  }
+  try {
+    parse_cnn_architecture("impala");
+    ADD_FAILURE() << "an unknown CNN name was accepted";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("\"fine\""), std::string::npos) << error.what();
+  }
+  PolicyConfig fine;
+  fine.cnn = CnnArchitecture::kFine;  // 6x6: 2x2 after one conv, nothing after the second
+  try {
+    Policy(*box(0, 255, {6, 6, 3}, DType::kUInt8), *box(-1, 1, {1}), fine);
+    ADD_FAILURE() << "a 6x6 image was accepted by the fine CNN";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("fine CNN"), std::string::npos) << error.what();
+  }
+}
+
 TEST(Policy, RejectsSpacesItCannotServe) {
   EXPECT_THROW(Policy(*box(-1, 1, {2}), spaces::MultiDiscrete({2, 2})), std::invalid_argument);
   EXPECT_THROW(Policy(*box(-1, 1, {2}), spaces::Box(-1, 1, {2}, DType::kInt64)),
