@@ -86,6 +86,7 @@ nn::Sequential make_cnn(const PolicyInput& input, const PolicyConfig& config) {
   static constexpr Conv kNature[] = {{32, 8, 4}, {64, 4, 2}, {64, 3, 1}};
   static constexpr Conv kSmall[] = {{16, 8, 4}, {32, 4, 2}};
   static constexpr Conv kFine[] = {{32, 3, 2}, {32, 3, 2}, {32, 3, 2}};
+  static constexpr Conv kFiner[] = {{32, 3, 2}, {32, 3, 2}, {32, 3, 1}};
   const Conv* first = std::begin(kSmall);
   const Conv* last = std::end(kSmall);
   if (config.cnn == CnnArchitecture::kNature) {
@@ -94,6 +95,9 @@ nn::Sequential make_cnn(const PolicyInput& input, const PolicyConfig& config) {
   } else if (config.cnn == CnnArchitecture::kFine) {
     first = std::begin(kFine);
     last = std::end(kFine);
+  } else if (config.cnn == CnnArchitecture::kFiner) {
+    first = std::begin(kFiner);
+    last = std::end(kFiner);
   }
   const double gain = std::sqrt(2.0);
   nn::Sequential cnn;
@@ -200,6 +204,8 @@ const char* to_string(CnnArchitecture architecture) {
       return "small";
     case CnnArchitecture::kFine:
       return "fine";
+    case CnnArchitecture::kFiner:
+      return "finer";
   }
   return "unknown";
 }
@@ -208,8 +214,9 @@ CnnArchitecture parse_cnn_architecture(const std::string& name) {
   if (name == "nature") return CnnArchitecture::kNature;
   if (name == "small") return CnnArchitecture::kSmall;
   if (name == "fine") return CnnArchitecture::kFine;
+  if (name == "finer") return CnnArchitecture::kFiner;
   throw std::invalid_argument("unknown CNN architecture \"" + name +
-                              "\"; valid: \"nature\", \"small\", \"fine\"");
+                              "\"; valid: \"nature\", \"small\", \"fine\", \"finer\"");
 }
 
 void PolicyConfig::validate() const {

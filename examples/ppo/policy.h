@@ -48,8 +48,11 @@ enum class CnnArchitecture : std::uint8_t {
   /// Forward + backward per sample (ppo_bench, 1 thread): 1.13x the small CNN's at 64x64, 1.9x at
   /// 84x84.
   kFine,
+  /// The fine CNN with a last convolution of stride 1: 13x13 cells at 64x64 (a 5408-wide linear
+  /// layer).
+  kFiner,
 };
-/// "nature", "small", "fine".
+/// "nature", "small", "fine", "finer".
 const char* to_string(CnnArchitecture architecture);
 /// The inverse of to_string. Throws std::invalid_argument listing the names.
 CnnArchitecture parse_cnn_architecture(const std::string& name);

@@ -79,10 +79,10 @@ struct PpoConfig {
   void validate() const;
 };
 
-/// JSON form of PpoConfig: an object with one member per field, named as the fields, the CNN as
-/// "nature" / "small" / "fine", `policy` a nested object. from_json takes any subset of the members
-/// (the rest keep their defaults) and throws std::invalid_argument for an unknown member (listing
-/// the known ones), a member of the wrong type, or a config that fails validate().
+/// JSON form of PpoConfig: an object with one member per field, named as the fields, the CNN by
+/// its name (to_string(CnnArchitecture)), `policy` a nested object. from_json takes any subset of
+/// the members (the rest keep their defaults) and throws std::invalid_argument for an unknown
+/// member (listing the known ones), a member of the wrong type, or a config that fails validate().
 void to_json(nlohmann::json& json, const PpoConfig& config);
 void from_json(const nlohmann::json& json, PpoConfig& config);
 void to_json(nlohmann::json& json, const PolicyConfig& config);

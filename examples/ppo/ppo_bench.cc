@@ -3,8 +3,9 @@
 //
 //   ppo_bench [--threads 2] [--batch 256] [--seconds 3]
 //
-// For each CNN (nature, small, fine) and image size (64x64, 84x84), a Policy over a uint8 (9, H, W)
-// image (3 stacked RGB frames, channel-first) with a 1-D Box action: samples per second of
+// For each CNN (nature, small, fine, finer) and image size (64x64, 84x84), a Policy over a
+// uint8 (9, H, W) image (3 stacked RGB frames, channel-first) with a 1-D Box action: samples per
+// second of
 //   act:    Policy::act without gradients (what collecting a rollout costs per observation);
 //   train:  Policy::evaluate + a PPO-like loss + backward + Adam step (what an update costs per
 //           sample per epoch).
@@ -63,7 +64,7 @@ int main(int argc, char** argv) {
   std::printf("%-8s %-6s %10s %16s %16s\n", "cnn", "size", "params", "act", "train");
   for (auto architecture :
        {pixelgym::ppo::CnnArchitecture::kNature, pixelgym::ppo::CnnArchitecture::kSmall,
-        pixelgym::ppo::CnnArchitecture::kFine}) {
+        pixelgym::ppo::CnnArchitecture::kFine, pixelgym::ppo::CnnArchitecture::kFiner}) {
     for (std::int64_t size : {64, 84}) {
       pixelgym::spaces::Box observation_space(0, 255, {9, size, size}, DType::kUInt8);
       pixelgym::spaces::Box action_space(-1, 1, {1});

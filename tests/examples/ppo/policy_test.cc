@@ -407,7 +407,7 @@ TEST(Policy, EachCnnHasItsLayersAndServesA64x64FrameStack) {
     std::vector<std::vector<std::int64_t>> conv_weights;  // (out, in, kh, kw) per conv
     std::int64_t flat;                                    // the linear layer's input width
   };
-  // (64 - k) / s + 1 per conv: nature 15, 6, 4; small 15, 6; fine 31, 15, 7.
+  // (64 - k) / s + 1 per conv: nature 15, 6, 4; small 15, 6; fine 31, 15, 7; finer 31, 15, 13.
   const std::vector<Expected> expected = {
       {CnnArchitecture::kNature,
        "nature",
@@ -415,6 +415,10 @@ TEST(Policy, EachCnnHasItsLayersAndServesA64x64FrameStack) {
        64 * 4 * 4},
       {CnnArchitecture::kSmall, "small", {{16, 9, 8, 8}, {32, 16, 4, 4}}, 32 * 6 * 6},
       {CnnArchitecture::kFine, "fine", {{32, 9, 3, 3}, {32, 32, 3, 3}, {32, 32, 3, 3}}, 32 * 7 * 7},
+      {CnnArchitecture::kFiner,
+       "finer",
+       {{32, 9, 3, 3}, {32, 32, 3, 3}, {32, 32, 3, 3}},
+       32 * 13 * 13},
   };
   for (const Expected& e : expected) {
     SCOPED_TRACE(e.name);
