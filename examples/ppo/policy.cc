@@ -79,33 +79,40 @@ void orthogonal(nn::Conv2d& layer, double gain) {
   nn::init::zeros_(layer->bias);
 }
 
-nn::Sequential make_cnn(const PolicyInput& input, const PolicyConfig& config) {
-  struct Conv {
-    std::int64_t channels, kernel, stride;
+struct Conv {
+  std::int64_t channels, kernel, stride;
+};
+// Each CnnArchitecture: its name and its convolutions (a ReLU after each).
+struct CnnSpec {
+  CnnArchitecture architecture;
+  const char* name;
+  std::vector<Conv> convs;
+};
+const std::vector<CnnSpec>& cnn_specs() {
+  static const std::vector<CnnSpec> specs = {
+      {CnnArchitecture::kNature, "nature", {{32, 8, 4}, {64, 4, 2}, {64, 3, 1}}},
+      {CnnArchitecture::kSmall, "small", {{16, 8, 4}, {32, 4, 2}}},
+      {CnnArchitecture::kFine, "fine", {{32, 3, 2}, {32, 3, 2}, {32, 3, 2}}},
+      {CnnArchitecture::kFiner, "finer", {{32, 3, 2}, {32, 3, 2}, {32, 3, 1}}},
   };
-  static constexpr Conv kNature[] = {{32, 8, 4}, {64, 4, 2}, {64, 3, 1}};
-  static constexpr Conv kSmall[] = {{16, 8, 4}, {32, 4, 2}};
-  static constexpr Conv kFine[] = {{32, 3, 2}, {32, 3, 2}, {32, 3, 2}};
-  static constexpr Conv kFiner[] = {{32, 3, 2}, {32, 3, 2}, {32, 3, 1}};
-  const Conv* first = std::begin(kSmall);
-  const Conv* last = std::end(kSmall);
-  if (config.cnn == CnnArchitecture::kNature) {
-    first = std::begin(kNature);
-    last = std::end(kNature);
-  } else if (config.cnn == CnnArchitecture::kFine) {
-    first = std::begin(kFine);
-    last = std::end(kFine);
-  } else if (config.cnn == CnnArchitecture::kFiner) {
-    first = std::begin(kFiner);
-    last = std::end(kFiner);
+  return specs;
+}
+const CnnSpec& cnn_spec(CnnArchitecture architecture) {
+  for (const CnnSpec& spec : cnn_specs()) {
+    if (spec.architecture == architecture) return spec;
   }
+  throw std::invalid_argument("unknown CNN architecture " +
+                              std::to_string(static_cast<int>(architecture)));
+}
+
+nn::Sequential make_cnn(const PolicyInput& input, const PolicyConfig& config) {
+  const CnnSpec& spec = cnn_spec(config.cnn);
   const double gain = std::sqrt(2.0);
   nn::Sequential cnn;
   std::int64_t channels = input.channels;
   std::int64_t height = input.height;
   std::int64_t width = input.width;
-  for (const Conv* conv_spec = first; conv_spec != last; ++conv_spec) {
-    const Conv& c = *conv_spec;
+  for (const Conv& c : spec.convs) {
     height = (height - c.kernel) / c.stride + 1;
     width = (width - c.kernel) / c.stride + 1;
     if (height < 1 || width < 1) {
@@ -196,27 +203,15 @@ ObservationTensors observation_tensors(const Value& batch) {
   return tensors;
 }
 
-const char* to_string(CnnArchitecture architecture) {
-  switch (architecture) {
-    case CnnArchitecture::kNature:
-      return "nature";
-    case CnnArchitecture::kSmall:
-      return "small";
-    case CnnArchitecture::kFine:
-      return "fine";
-    case CnnArchitecture::kFiner:
-      return "finer";
-  }
-  return "unknown";
-}
+const char* to_string(CnnArchitecture architecture) { return cnn_spec(architecture).name; }
 
 CnnArchitecture parse_cnn_architecture(const std::string& name) {
-  if (name == "nature") return CnnArchitecture::kNature;
-  if (name == "small") return CnnArchitecture::kSmall;
-  if (name == "fine") return CnnArchitecture::kFine;
-  if (name == "finer") return CnnArchitecture::kFiner;
-  throw std::invalid_argument("unknown CNN architecture \"" + name +
-                              "\"; valid: \"nature\", \"small\", \"fine\", \"finer\"");
+  std::string valid;
+  for (const CnnSpec& spec : cnn_specs()) {
+    if (name == spec.name) return spec.architecture;
+    valid += std::string(valid.empty() ? "" : ", ") + "\"" + spec.name + "\"";
+  }
+  throw std::invalid_argument("unknown CNN architecture \"" + name + "\"; valid: " + valid);
 }
 
 void PolicyConfig::validate() const {
