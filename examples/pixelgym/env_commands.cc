@@ -471,6 +471,10 @@ int run_vector_bench(const BenchArguments& args) {
 
 int run_bench(const BenchArguments& args) {
   if (args.num_envs > 0) return run_vector_bench(args);
+  if (args.threads > 0) {
+    throw UsageError("bench --threads " + std::to_string(args.threads) +
+                     ": threads step a vector env; give --num-envs N with it");
+  }
   std::unique_ptr<Env> env = make_env(args.id, args.sets, args.wraps);
   RandomRollout random(*env, args.seed);
   // Warm up (shader compilation, caches) outside the timed loop.

@@ -396,6 +396,27 @@ TEST(PixelgymCliTest, BenchPrintsStepsPerSecondLast) {
   EXPECT_GT(std::stol(result.output.substr(at + 12)), 0);
 }
 
+TEST(PixelgymCliTest, BenchWithNumEnvsStepsAVectorEnvAndCountsEveryEnvStep) {
+  const std::string small = " --set width=16 --set height=16 --steps 30";
+  const CliRun pool = run("bench CartPoleSwingup-v0 --num-envs 3 --threads 2" + small);
+  ASSERT_EQ(pool.exit_code, 0) << pool.output;
+  EXPECT_THAT(pool.output, HasSubstr("CartPoleSwingup-v0: 30 env steps (10 batches of 3 envs"));
+  EXPECT_THAT(pool.output, HasSubstr("AsyncVectorEnv, 2 threads"));
+  const std::size_t at = pool.output.rfind("steps_per_s=");
+  ASSERT_NE(at, std::string::npos) << pool.output;
+  EXPECT_EQ(pool.output.find('\n', at), pool.output.size() - 1);
+  EXPECT_GT(std::stol(pool.output.substr(at + 12)), 0);
+  // --threads 0 is the sync loop; more threads than envs are clamped to one per env.
+  EXPECT_THAT(run("bench CartPoleSwingup-v0 --num-envs 3 --threads 0" + small).output,
+              HasSubstr("SyncVectorEnv, one thread"));
+  EXPECT_THAT(run("bench CartPoleSwingup-v0 --num-envs 3 --threads 8" + small).output,
+              HasSubstr("AsyncVectorEnv, 3 threads"));
+  // Threads without a vector env would be ignored: refused instead.
+  const CliRun alone = run("bench CartPoleSwingup-v0 --threads 2" + small);
+  EXPECT_EQ(alone.exit_code, 2) << alone.output;
+  EXPECT_THAT(alone.output, HasSubstr("give --num-envs N with it"));
+}
+
 // --- --wrap: wrapper stacks from text ---
 
 TEST(PixelgymCliTest, WrappersListsEverySpecForm) {

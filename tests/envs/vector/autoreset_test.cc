@@ -175,6 +175,11 @@ TEST_P(AutoresetTest, DisabledLeavesTheResetToTheCaller) {
   EXPECT_EQ(reward(next, 0), 0.5);
   EXPECT_TRUE(ended(next, 1, truncate()));
   EXPECT_FALSE(next.infos.contains("final_obs"));
+  // A seeded masked reset seeds env i with seed + i, as a full reset does.
+  const VectorResetResult& seeded =
+      made.env->reset(50, {}, Array::from_vector<bool>({2}, {false, true}));
+  testing::ScriptedEnv alone1(testing::box(-10, 10, {3}), testing::box(-1, 1, {1}));
+  EXPECT_TRUE(row(seeded.obs, 1).equals(alone1.reset(51).obs.array()));
 }
 
 TEST_P(AutoresetTest, ResetMaskIsChecked) {

@@ -1,6 +1,7 @@
 // Same seeds and actions give byte-identical batches — pixels included — from SyncVectorEnv,
 // from AsyncVectorEnv on 1, 2 and 4 threads, and from the envs stepped one by one with Env
-// (with NextStep's autoreset done by hand), for 1, 3 and 8 envs. Episodes are cut at 4 steps so
+// (with NextStep's autoreset done by hand), for 1, 3 and 8 envs; and under SameStep (final_obs
+// included) and Disabled (the caller's masked resets) for 3 envs. Episodes are cut at 4 steps so
 // that autoresets happen inside the 9 steps compared; renders are small to keep this quick.
 // The pools alternate step() (worker 0's envs run on the calling thread) with step_async() +
 // step_wait() (they run on worker thread 0), and the vector envs run with GL contexts shared per
@@ -8,6 +9,7 @@
 // private copies of Mesa (render::MesaCopy), so their frames are compared with copy 0's too.
 #include <gtest/gtest.h>
 
+#include <optional>
 #include <ostream>
 #include <string>
 #include <utility>
@@ -137,6 +139,103 @@ TEST_P(VectorDeterminismTest, SyncAndPoolsEqualSingleEnvsByteForByte) {
   // its own): the frames compared above came from them.
   for (const int copy : {1, 2, 3}) {
     EXPECT_TRUE(render::MesaCopy::loaded(copy)) << copy << ": " << render::MesaCopy::why_not(copy);
+  }
+}
+
+// The envs one by one under SameStep's rule: a step that ends an episode comes back with the
+// next episode's first observation (an unseeded reset), `final` holding the last one.
+struct SameStepEnvStep {
+  EnvStep step;
+  std::optional<Value> final;  // none when the step ended no episode
+};
+std::vector<std::vector<SameStepEnvStep>> one_by_one_same_step(const Case& c, int num_envs,
+                                                               const std::vector<Value>& actions) {
+  std::vector<std::vector<SameStepEnvStep>> trajectory(kSteps + 1);
+  for (int i = 0; i < num_envs; ++i) {
+    std::unique_ptr<Env> env = wrappers::apply_wrappers(make(c.id, c.kwargs), c.wrappers);
+    trajectory[0].push_back({{env->reset(kSeed + static_cast<std::uint64_t>(i)).obs.clone()}, {}});
+    for (int t = 0; t < kSteps; ++t) {
+      const StepResult result = env->step(batch_slot(actions[static_cast<std::size_t>(t)], i));
+      SameStepEnvStep step{{result.obs.clone(), result.reward, result.terminated, result.truncated},
+                           {}};
+      if (result.terminated || result.truncated) {
+        step.final = std::move(step.step.obs);
+        step.step.obs = env->reset().obs.clone();
+      }
+      trajectory[static_cast<std::size_t>(t) + 1].push_back(std::move(step));
+    }
+  }
+  return trajectory;
+}
+
+// SameStep and Disabled, on the same envs: the vector envs' batches, final observations and
+// masked resets equal the envs stepped one by one, byte for byte, sync and on 1, 2 and 4 threads.
+TEST_P(VectorDeterminismTest, SameStepAndDisabledEqualSingleEnvsByteForByte) {
+  const Case& c = GetParam();
+  const int num_envs = 3;
+  std::vector<Value> actions;
+  {
+    const auto probe = make_vec(c.id, num_envs, c.kwargs, c.wrappers);
+    actions = batched_actions(probe->action_space());
+  }
+  const auto expected = one_by_one_same_step(c, num_envs, actions);
+  for (const AutoresetMode mode : {AutoresetMode::kSameStep, AutoresetMode::kDisabled}) {
+    for (const int threads : {0, 1, 2, 4}) {
+      const std::string runner =
+          std::string(mode == AutoresetMode::kSameStep ? "SameStep, " : "Disabled, ") +
+          (threads == 0 ? std::string("sync") : std::to_string(threads) + " threads");
+      const VectorOptions options{threads == 0 ? VectorMode::kSync : VectorMode::kAsync, threads,
+                                  mode};
+      const auto env = make_vec(c.id, num_envs, c.kwargs, c.wrappers, options);
+      const Value& first = env->reset(kSeed).obs;
+      for (int i = 0; i < num_envs; ++i) {
+        EXPECT_TRUE(batch_slot(first, i).equals(expected[0][static_cast<std::size_t>(i)].step.obs))
+            << runner << ", the reset, env " << i;
+      }
+      int finals = 0;
+      for (int t = 0; t < kSteps; ++t) {
+        const VectorStepResult& step = env->step(actions[static_cast<std::size_t>(t)]);
+        Array reset_mask(DType::kBool, {num_envs});
+        bool any_done = false;
+        for (int i = 0; i < num_envs; ++i) {
+          const SameStepEnvStep& want =
+              expected[static_cast<std::size_t>(t) + 1][static_cast<std::size_t>(i)];
+          const std::string where =
+              runner + ", step " + std::to_string(t + 1) + ", env " + std::to_string(i);
+          EXPECT_EQ(step.rewards.data<double>()[i], want.step.reward) << where;
+          EXPECT_EQ(step.terminated.data<bool>()[i], want.step.terminated) << where;
+          EXPECT_EQ(step.truncated.data<bool>()[i], want.step.truncated) << where;
+          const bool done = want.final.has_value();
+          if (mode == AutoresetMode::kDisabled) {
+            // The step returns the last observation; the caller resets by mask below.
+            EXPECT_TRUE(batch_slot(step.obs, i).equals(done ? *want.final : want.step.obs))
+                << where;
+            reset_mask.data<bool>()[i] = done;
+            any_done = any_done || done;
+            continue;
+          }
+          EXPECT_TRUE(batch_slot(step.obs, i).equals(want.step.obs)) << where;
+          const bool has_final = step.infos.contains("_final_obs") &&
+                                 step.infos.at("_final_obs").array().data<bool>()[i];
+          EXPECT_EQ(has_final, done) << where;
+          if (done && has_final) {
+            EXPECT_TRUE(batch_slot(step.infos.at("final_obs"), i).equals(*want.final)) << where;
+            ++finals;
+          }
+        }
+        if (any_done) {
+          const Value& reset = env->reset(std::nullopt, {}, reset_mask).obs;
+          for (int i = 0; i < num_envs; ++i) {
+            if (!reset_mask.data<bool>()[i]) continue;
+            EXPECT_TRUE(batch_slot(reset, i).equals(
+                expected[static_cast<std::size_t>(t) + 1][static_cast<std::size_t>(i)].step.obs))
+                << runner << ", the masked reset after step " << t + 1 << ", env " << i;
+            ++finals;
+          }
+        }
+      }
+      EXPECT_GT(finals, 0) << runner << ": no episode ended, the autoreset is not exercised";
+    }
   }
 }
 

@@ -5,6 +5,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "envs/spaces/dict.h"
 #include "envs/vector/make_vec.h"
@@ -179,8 +180,41 @@ TEST(AsyncVectorEnvTest, StepAsyncAndStepWait) {
   const VectorStepResult& result = env.step_wait();
   EXPECT_EQ(result.rewards.shape(), (Shape{3}));
   EXPECT_THROW(env.step_wait(), ResetNeeded);
-  // A step left pending is waited for by close() and the destructor.
+  // A step left pending is waited for by close() (and the destructor).
   env.step_async(scripted_actions(3, 0.5F));
+  env.close();
+  EXPECT_THROW(env.step_wait(), ResetNeeded);
+}
+
+// Errors on the worker threads of step_async() reach the caller at step_wait(): the lowest
+// failing env's, while the other envs still finish their step.
+TEST(AsyncVectorEnvTest, StepWaitReportsTheLowestFailingEnvAfterEveryEnvStepped) {
+  for (const int threads : {1, 2, 4}) {
+    std::vector<testing::ScriptedEnv*> scripted(4, nullptr);
+    const EnvFactory factory = [&scripted](int i) -> std::unique_ptr<Env> {
+      auto env = std::make_unique<testing::ScriptedEnv>(testing::box(-10, 10, {3}),
+                                                        testing::box(-1, 1, {1}), 100);
+      scripted[static_cast<std::size_t>(i)] = env.get();
+      if (i == 1 || i == 3) return std::make_unique<ThrowingWrapper>(std::move(env), 2);
+      return env;
+    };
+    AsyncVectorEnv env(4, factory, threads);
+    env.reset(0);
+    env.step_async(scripted_actions(4, 0.1F));
+    env.step_wait();
+    env.step_async(scripted_actions(4, 0.1F));
+    const std::string message = thrown_message<std::runtime_error>([&] { env.step_wait(); });
+    EXPECT_THAT(message, HasSubstr("env 1 (ThrowingWrapper<ScriptedEnv>)")) << threads;
+    EXPECT_THAT(message, HasSubstr("the simulation blew up")) << threads;
+    for (const int i : {0, 2}) {
+      EXPECT_EQ(scripted[static_cast<std::size_t>(i)]->actions.size(), 2U)
+          << threads << " threads, env " << i;
+    }
+    EXPECT_THROW(env.step_async(scripted_actions(4, 0.1F)), ResetNeeded);
+    env.reset(1);
+    env.step_async(scripted_actions(4, 0.1F));
+    EXPECT_EQ(env.step_wait().rewards.data<double>()[0], 1.0);
+  }
 }
 
 TEST(MakeVecTest, BadIdsKwargsAndWrappersAreReportedBeforeBuilding) {
