@@ -154,9 +154,11 @@ std::string to_bytes(const std::function<void(std::ostream&)>& save) {
 }
 
 // The checkpoint of `trainer` after its latest update: model, optimizer, generators, progress.
-ppo::CheckpointBlobs checkpoint_blobs(ppo::Trainer& trainer, const std::deque<double>& returns,
-                                      double wall_time_s) {
+ppo::CheckpointBlobs checkpoint_blobs(const RunSettings& settings, ppo::Trainer& trainer,
+                                      const std::deque<double>& returns, double wall_time_s) {
   ppo::CheckpointBlobs blobs;
+  // The run's settings, so that a checkpoint file evaluates on its own (away from its folder).
+  blobs["config"] = settings_to_json(settings).dump();
   blobs["model"] = to_bytes([&](std::ostream& out) { torch::save(trainer.policy_ptr(), out); });
   blobs["optimizer"] = to_bytes([&](std::ostream& out) { torch::save(trainer.optimizer(), out); });
   const ppo::TrainerRngState rng = trainer.rng_state();
@@ -174,6 +176,8 @@ ppo::CheckpointBlobs checkpoint_blobs(ppo::Trainer& trainer, const std::deque<do
                             {"var", scaling.statistics.var[0]},
                             {"count", scaling.statistics.count},
                             {"returns", scaling.returns}};
+  // Where the envs are, for a resume to check its replay of the actions below against.
+  meta["env_digest"] = trainer.env_digest();
   blobs["meta"] = meta.dump();
   // The envs' state, as the actions that led to it (see Trainer::replay_env).
   blobs["env_actions"] = trainer.env_action_log();
@@ -414,7 +418,9 @@ int run_train(const TrainArguments& args) {
     scaling.statistics.count = scaling_json.at("count").get<double>();
     scaling.returns = scaling_json.at("returns").get<std::vector<double>>();
     trainer.set_reward_scaling(std::move(scaling));
-    run.emplace(ppo::RunFolder::resume(folder, trainer.env_steps()));
+    run.emplace(ppo::RunFolder::resume(
+        folder, trainer.env_steps(),
+        {{"total_env_steps", settings.ppo.total_env_steps}, {"minutes", settings.minutes}}));
     std::cout << "resuming " << folder.string() << " from " << checkpoint->path.filename().string()
               << " (" << trainer.env_steps() << " env steps, " << trainer.updates() << " updates)\n"
               << "torch_threads=" << settings.torch_threads << " (as the run began)\n";
@@ -429,6 +435,14 @@ int run_train(const TrainArguments& args) {
           << std::fixed << std::setprecision(1)
           << std::chrono::duration<double>(std::chrono::steady_clock::now() - replay_start).count()
           << std::defaultfloat << " s: the envs continue their episodes\n";
+      // A checkpoint from before the digest was kept has none: nothing to compare.
+      if (meta.contains("env_digest") &&
+          meta.at("env_digest").get<std::uint64_t>() != trainer.env_digest()) {
+        std::cout << "warning: the replayed envs are not where the checkpoint's were (their "
+                     "observations or episodes differ): the code or a library changed since "
+                     "the run began, or the envs are not deterministic. Training goes on from "
+                     "here, but it is no longer the run that did not stop.\n";
+      }
     } else {
       std::cout << "the checkpoint has no env actions (written before they were kept): the envs "
                    "start new episodes\n";
@@ -445,15 +459,19 @@ int run_train(const TrainArguments& args) {
     return wall_before +
            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
+  // --minutes on this command line bounds this process's time; without it a resumed run keeps
+  // the budget it began with, counted over its whole wall time (a killed 10-minute run resumed
+  // trains for what was left of its 10 minutes, not for 10 more).
   const double time_limit_s = settings.minutes * 60.0;
+  const double time_limit_from = args.minutes > 0.0 ? wall_before : 0.0;
   ppo::ProgressStatus status;
   const auto save_checkpoint = [&] {
     ppo::write_checkpoint(run->checkpoint_path(trainer.updates()),
-                          checkpoint_blobs(trainer, returns, elapsed()));
+                          checkpoint_blobs(settings, trainer, returns, elapsed()));
     ppo::prune_checkpoints(run->path(), settings.keep_checkpoints);
   };
   while (trainer.env_steps() < settings.ppo.total_env_steps &&
-         (time_limit_s <= 0.0 || elapsed() - wall_before < time_limit_s)) {
+         (time_limit_s <= 0.0 || elapsed() - time_limit_from < time_limit_s)) {
     const auto update_start = std::chrono::steady_clock::now();
     const std::int64_t steps_before = trainer.env_steps();
     const ppo::RolloutStats rollout = trainer.collect();
@@ -489,7 +507,7 @@ int run_train(const TrainArguments& args) {
     if (trainer.updates() % settings.checkpoint_every == 0) save_checkpoint();
     status = {trainer.env_steps(),
               settings.ppo.total_env_steps,
-              elapsed() - wall_before,
+              elapsed() - time_limit_from,
               time_limit_s,
               row.fps,
               row.episode_return_mean};
@@ -526,7 +544,9 @@ CLI::App* add_run_options(CLI::App& train, TrainArguments& args) {
                    "Env steps to train for, all envs together; with --set action_repeat=K "
                    "each is K control steps (default: the config's total_env_steps, 1,000,000)");
   train.add_option("--minutes", args.minutes,
-                   "Stop after this much wall time (then checkpoint, evaluate, write the video)");
+                   "Stop after this much wall time (then checkpoint, evaluate, write the video); "
+                   "with --resume, this much more (without it, a resumed run stops when its "
+                   "whole wall time reaches the minutes it began with)");
   return &train;
 }
 
@@ -552,7 +572,11 @@ Command add_train(CLI::App& app) {
   train->add_flag("--quiet", args->quiet,
                   "No progress bar: a plain line every 10 updates (also when stdout is not a "
                   "terminal)");
-  train->add_option("--seed", args->seed, "Seed for torch, the envs and augmentation (default 0)")
+  train
+      ->add_option(
+          "--seed", args->seed,
+          "Seed for torch, the envs and augmentation (default: the config's seed, 0 unless "
+          "--config sets it)")
       ->each([args](const std::string&) { args->seed_given = true; });
   train
       ->add_option(
@@ -614,8 +638,13 @@ struct EvalArguments {
 };
 
 int run_eval(const EvalArguments& args) {
+  // RecordVideo names the clip after the path's stem and writes H.264 .mp4 (an .avi given here
+  // would come out as .mp4 under another name): refuse any other name before the work.
+  if (!args.video.empty() &&
+      (fs::path(args.video).extension() != ".mp4" || fs::path(args.video).stem().empty())) {
+    throw UsageError("eval --video: expected a FILE.mp4, got \"" + args.video + "\"");
+  }
   tune_process_for_training();
-  set_torch_threads(0);
   const fs::path given(args.run);
   fs::path checkpoint_path;
   fs::path folder;
@@ -634,12 +663,24 @@ int run_eval(const EvalArguments& args) {
     folder = given.parent_path().empty() ? fs::path(".") : given.parent_path();
     blobs = ppo::read_checkpoint(checkpoint_path);
   }
-  std::ifstream config_file(folder / "config.json");
-  if (!config_file) {
-    throw std::runtime_error("eval: no config.json in " + folder.string() +
-                             " (the run folder the checkpoint belongs to)");
+  // The settings the checkpoint carries (a checkpoint file copied anywhere evaluates), else
+  // (checkpoints from before they carried them) its run folder's config.json.
+  RunSettings settings;
+  if (const auto embedded = blobs.find("config"); embedded != blobs.end()) {
+    settings = settings_from_json(json::parse(embedded->second), checkpoint_path);
+  } else {
+    std::ifstream config_file(folder / "config.json");
+    if (!config_file) {
+      throw std::runtime_error("eval: " + checkpoint_path.string() +
+                               " does not carry its run's settings, and there is no config.json "
+                               "in " +
+                               folder.string() + " (the run folder it belongs to)");
+    }
+    settings = settings_from_json(json::parse(config_file), folder / "config.json");
   }
-  const RunSettings settings = settings_from_json(json::parse(config_file), folder / "config.json");
+  // The run's thread count: a float sum over other threads can round differently, and the
+  // evaluation would then differ from the run's summary.json.
+  set_torch_threads(settings.torch_threads);
   // The spaces come from one env built as the run's.
   std::unique_ptr<Env> probe = wrappers::apply_wrappers(
       make(settings.id, parse_sets(settings.id, settings.sets)), settings.wraps);

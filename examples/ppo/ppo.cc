@@ -396,6 +396,25 @@ void Trainer::replay_env(const std::string& env_action_log) {
   env_action_log_ = env_action_log;
 }
 
+std::uint64_t Trainer::env_digest() const {
+  if (!started_) return 0;
+  std::uint64_t digest = 14695981039346656037ULL;  // FNV-1a, 64-bit
+  const auto add = [&digest](const void* data, std::size_t size) {
+    const auto* bytes = static_cast<const unsigned char*>(data);
+    for (std::size_t k = 0; k < size; ++k) {
+      digest = (digest ^ bytes[k]) * 1099511628211ULL;
+    }
+  };
+  for (const auto& [key, tensor] : current_obs_) {  // std::map: in key order
+    add(key.data(), key.size());
+    const torch::Tensor contiguous = tensor.contiguous();
+    add(contiguous.data_ptr(), contiguous.nbytes());
+  }
+  add(episode_returns_.data(), episode_returns_.size() * sizeof(double));
+  add(episode_lengths_.data(), episode_lengths_.size() * sizeof(std::int64_t));
+  return digest;
+}
+
 RolloutStats Trainer::collect() {
   torch::NoGradGuard no_grad;
   RolloutStats stats;

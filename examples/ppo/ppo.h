@@ -258,6 +258,11 @@ class Trainer {
   /// std::invalid_argument, naming both sizes, when the log is not env_steps() / num_envs
   /// batches, and std::logic_error after a collect().
   void replay_env(const std::string& env_action_log);
+  /// A 64-bit digest (FNV-1a) of where the envs are: the bytes of the current observation
+  /// batch and the returns and lengths of the episodes in progress; 0 before the envs are reset.
+  /// A checkpoint keeps it, so that a resume can tell whether replay_env brought the envs back
+  /// to the same place (it does not when the code, Bullet or Mesa changed in between).
+  std::uint64_t env_digest() const;
 
  private:
   Trainer(vector::VectorEnv* env, vector::VectorWrapper* wrapper, PpoConfig config);

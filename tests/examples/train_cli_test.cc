@@ -35,13 +35,20 @@ fs::path fresh_folder(const std::string& name) {
   return folder;
 }
 
-// The settings every run here uses, then `more`.
-std::string train_arguments(const fs::path& folder, const std::string& more) {
-  const fs::path config = folder / "tiny.json";
-  std::ofstream(config) << R"({"num_steps": 16, "num_minibatches": 2, "update_epochs": 1})";
-  return "train CartPoleBalance-v0 --set obs_mode=pixels --set width=32 --set height=32 "
-         "--set max_episode_steps=24 --wrap frame_stack=2 --num-envs 2 --threads 2 --config " +
-         config.string() + " --eval-episodes 1 --quiet " + more;
+constexpr const char* kTinyConfig =
+    R"({"num_steps": 16, "num_minibatches": 2, "update_epochs": 1})";
+
+// The settings every run here uses, then `more`; `config` is the PPO config's JSON and
+// `obs_mode` the env's.
+std::string train_arguments(const fs::path& folder, const std::string& more,
+                            const std::string& config = kTinyConfig,
+                            const std::string& obs_mode = "pixels") {
+  const fs::path config_file = folder / "tiny.json";
+  std::ofstream(config_file) << config;
+  return "train CartPoleBalance-v0 --set obs_mode=" + obs_mode +
+         " --set width=32 --set height=32 --set max_episode_steps=24 --wrap frame_stack=2 "
+         "--num-envs 2 --threads 2 --config " +
+         config_file.string() + " --eval-episodes 1 --quiet " + more;
 }
 
 std::string read_text(const fs::path& path) {
@@ -55,7 +62,7 @@ TEST(TrainCliTest, AShortRunWritesACompleteRunFolder) {
   const fs::path folder = fresh_folder("complete");
   const fs::path run = folder / "run";
   const CliRun trained =
-      run_cli(train_arguments(folder, "--steps 96 --checkpoint-every 2 --out " + run.string()));
+      run_cli(train_arguments(folder, "--steps 320 --checkpoint-every 4 --out " + run.string()));
   ASSERT_EQ(trained.exit_code, 0) << trained.output;
   EXPECT_NE(trained.output.find("evaluation: return"), std::string::npos) << trained.output;
 
@@ -73,15 +80,16 @@ TEST(TrainCliTest, AShortRunWritesACompleteRunFolder) {
     EXPECT_EQ(config.at("torch_threads"), CPU_COUNT(&cpus));
   }
 
-  // 96 steps of 2 envs x 16: 3 updates, one row each.
+  // 320 steps of 2 envs x 16: 10 updates, one row each.
   const ppo::ProgressTable progress = ppo::read_progress_csv(run / "progress.csv");
-  ASSERT_EQ(progress.rows.size(), 3U);
-  EXPECT_EQ(progress.column("steps").back(), 96.0);
+  ASSERT_EQ(progress.rows.size(), 10U);
+  EXPECT_EQ(progress.column("steps").front(), 32.0);
+  EXPECT_EQ(progress.column("steps").back(), 320.0);
   EXPECT_GT(progress.column("fps").back(), 0.0);
   EXPECT_TRUE(std::isfinite(progress.column("entropy").back()));
 
-  // Checkpoints after update 2 (every 2) and at the end (3), both loadable.
-  for (const char* name : {"ckpt-000002.pgck", "ckpt-000003.pgck"}) {
+  // Checkpoints after updates 4 and 8 (every 4) and at the end (10), all loadable.
+  for (const char* name : {"ckpt-000004.pgck", "ckpt-000008.pgck", "ckpt-000010.pgck"}) {
     const ppo::CheckpointBlobs blobs = ppo::read_checkpoint(run / name);
     EXPECT_EQ(blobs.count("model"), 1U) << name;
     EXPECT_EQ(blobs.count("optimizer"), 1U) << name;
@@ -91,7 +99,7 @@ TEST(TrainCliTest, AShortRunWritesACompleteRunFolder) {
   EXPECT_EQ(png.substr(1, 3), "PNG");
   EXPECT_GT(fs::file_size(run / "final.mp4"), 0U);
   const json summary = json::parse(read_text(run / "summary.json"));
-  EXPECT_EQ(summary.at("env_steps"), 96);
+  EXPECT_EQ(summary.at("env_steps"), 320);
   EXPECT_EQ(summary.at("evaluation").at("episodes"), 1);
 
   // The run evaluates again from its folder, the same as at the end of training (same seed).
@@ -107,10 +115,27 @@ TEST(TrainCliTest, AShortRunWritesACompleteRunFolder) {
   std::ostringstream expected_clipped;
   expected_clipped << "clipped_action_fraction=" << clipped << "\n";
   EXPECT_NE(evaluated.output.find(expected_clipped.str()), std::string::npos) << evaluated.output;
+  // A checkpoint file carries its run's settings: copied away from its folder, it evaluates
+  // the same.
+  const fs::path away = folder / "away";
+  fs::create_directories(away);
+  fs::copy_file(run / "ckpt-000010.pgck", away / "final.pgck");
+  const CliRun alone =
+      run_cli("eval " + (away / "final.pgck").string() + " --episodes 1 --seed 1000000");
+  ASSERT_EQ(alone.exit_code, 0) << alone.output;
+  EXPECT_NE(alone.output.find(expected.str()), std::string::npos) << alone.output;
+  // A video is written as H.264 .mp4 only: any other name is refused before the work, and
+  // nothing is written.
+  const CliRun avi =
+      run_cli("eval " + run.string() + " --episodes 1 --video " + (folder / "clip.avi").string());
+  EXPECT_EQ(avi.exit_code, 2) << avi.output;
+  EXPECT_NE(avi.output.find("expected a FILE.mp4, got"), std::string::npos) << avi.output;
+  EXPECT_FALSE(fs::exists(folder / "clip.mp4"));
+  EXPECT_FALSE(fs::exists(folder / "clip.avi"));
   // A second run into the same folder is refused; the run is left as it was.
   const CliRun again = run_cli(train_arguments(folder, "--steps 32 --out " + run.string()));
   EXPECT_EQ(again.exit_code, 1) << again.output;
-  EXPECT_EQ(ppo::read_progress_csv(run / "progress.csv").rows.size(), 3U);
+  EXPECT_EQ(ppo::read_progress_csv(run / "progress.csv").rows.size(), 10U);
   fs::remove_all(folder);
 }
 
@@ -254,9 +279,17 @@ TEST(TrainCliTest, AResumedRunIsTheRunThatDidNotStop) {
   const fs::path split = folder / "split";
   // Every checkpoint kept: they are compared one by one below.
   const std::string settings = "--steps 320 --checkpoint-every 2 --keep-checkpoints 0 --out ";
-  const CliRun trained = run_cli(train_arguments(folder, settings + straight.string()));
+  // With everything that carries state across updates: the random shifts' generator
+  // (augmentation), the running statistics of the state keys (observation normalization, on by
+  // default) and of the returns (reward normalization, on by default).
+  const std::string config =
+      R"({"num_steps": 16, "num_minibatches": 2, "update_epochs": 1, "augment": true})";
+  const std::string obs_mode = "pixels+state";
+  const CliRun trained =
+      run_cli(train_arguments(folder, settings + straight.string(), config, obs_mode));
   ASSERT_EQ(trained.exit_code, 0) << trained.output;
-  ASSERT_TRUE(run_cli_until(folder, train_arguments(folder, settings + split.string()),
+  ASSERT_TRUE(run_cli_until(folder,
+                            train_arguments(folder, settings + split.string(), config, obs_mode),
                             split / "ckpt-000004.pgck"))
       << read_text(folder / "log.txt");
   const ppo::CheckpointSearch latest = ppo::find_latest_checkpoint(split);
@@ -278,10 +311,16 @@ TEST(TrainCliTest, AResumedRunIsTheRunThatDidNotStop) {
     // Not "optimizer": LibTorch keys the saved Adam state by each tensor's address, so its bytes
     // differ between processes. Its content is compared through the models: any difference in
     // it changes the parameters of the updates after the resume.
-    for (const char* blob : {"model", "rng_sampling", "env_actions"}) {
+    for (const char* blob : {"model", "rng_sampling", "rng_augmentation", "env_actions"}) {
       ASSERT_EQ(a.count(blob), 1U) << name << " " << blob;
       EXPECT_TRUE(a.at(blob) == b.at(blob)) << name << ": \"" << blob << "\" differs";
     }
+    // The model holds the observation statistics; the returns' statistics are in "meta" (beside
+    // the wall time, which differs).
+    const json meta_a = json::parse(a.at("meta"));
+    const json meta_b = json::parse(b.at("meta"));
+    EXPECT_EQ(meta_a.at("reward_scaling"), meta_b.at("reward_scaling")) << name;
+    EXPECT_EQ(meta_a.at("recent_returns"), meta_b.at("recent_returns")) << name;
   }
   const ppo::ProgressTable a = ppo::read_progress_csv(straight / "progress.csv");
   const ppo::ProgressTable b = ppo::read_progress_csv(split / "progress.csv");
@@ -297,6 +336,46 @@ TEST(TrainCliTest, AResumedRunIsTheRunThatDidNotStop) {
           << column << ", row " << row << ": " << x[row] << " vs " << y[row];
     }
   }
+  fs::remove_all(folder);
+}
+
+// --minutes bounds a run's wall time: resumed without it, the run has only what is left of its
+// budget; with it, that much more. Each resume is recorded in config.json with its budget.
+TEST(TrainCliTest, AResumedRunKeepsItsTimeBudgetUnlessGivenAnother) {
+  const fs::path folder = fresh_folder("minutes");
+  const fs::path run = folder / "run";
+  // 0.6 ms: the run stops by time after its first update.
+  const CliRun trained =
+      run_cli(train_arguments(folder, "--steps 320 --minutes 0.00001 --out " + run.string()));
+  ASSERT_EQ(trained.exit_code, 0) << trained.output;
+  ASSERT_EQ(ppo::read_progress_csv(run / "progress.csv").rows.size(), 1U);
+  const CliRun spent = run_cli("train --resume " + run.string() + " --quiet");
+  ASSERT_EQ(spent.exit_code, 0) << spent.output;
+  EXPECT_EQ(ppo::read_progress_csv(run / "progress.csv").rows.size(), 1U) << spent.output;
+  const CliRun more = run_cli("train --resume " + run.string() + " --quiet --minutes 0.00001");
+  ASSERT_EQ(more.exit_code, 0) << more.output;
+  EXPECT_EQ(ppo::read_progress_csv(run / "progress.csv").rows.size(), 2U) << more.output;
+  const json config = json::parse(read_text(run / "config.json"));
+  ASSERT_EQ(config.at("resumes").size(), 2U);
+  EXPECT_EQ(config.at("resumes")[1].at("steps"), 32);
+  EXPECT_EQ(config.at("resumes")[1].at("total_env_steps"), 320);
+  EXPECT_EQ(config.at("resumes")[1].at("minutes"), 0.00001);
+  EXPECT_EQ(more.output.find("warning: the replayed envs"), std::string::npos) << more.output;
+
+  // A checkpoint whose envs the replay does not reproduce (here: its digest altered, as after
+  // a change of code or library) resumes with a warning saying so.
+  const ppo::CheckpointSearch latest = ppo::find_latest_checkpoint(run);
+  ASSERT_TRUE(latest.latest.has_value());
+  ppo::CheckpointBlobs blobs = latest.latest->blobs;
+  json meta = json::parse(blobs.at("meta"));
+  meta["env_digest"] = meta.at("env_digest").get<std::uint64_t>() + 1;
+  blobs["meta"] = meta.dump();
+  ppo::write_checkpoint(latest.latest->path, blobs);
+  const CliRun changed = run_cli("train --resume " + run.string() + " --quiet --minutes 0.00001");
+  ASSERT_EQ(changed.exit_code, 0) << changed.output;
+  EXPECT_NE(changed.output.find("warning: the replayed envs are not where the checkpoint's were"),
+            std::string::npos)
+      << changed.output;
   fs::remove_all(folder);
 }
 

@@ -108,10 +108,15 @@ RunFolder RunFolder::create(const fs::path& folder, nlohmann::json config,
   return run;
 }
 
-RunFolder RunFolder::resume(const fs::path& folder, std::int64_t resumed_steps) {
+RunFolder RunFolder::resume(const fs::path& folder, std::int64_t resumed_steps,
+                            const nlohmann::json& budget) {
   if (resumed_steps < 0) {
     throw std::invalid_argument("RunFolder: expected resumed steps >= 0, got " +
                                 std::to_string(resumed_steps));
+  }
+  if (!budget.is_null() && !budget.is_object()) {
+    throw std::invalid_argument("RunFolder: expected the resume's budget as a JSON object, got " +
+                                std::string(budget.type_name()));
   }
   nlohmann::json config = read_json(folder / kConfigName);
   if (!config.is_object()) {
@@ -137,8 +142,10 @@ RunFolder RunFolder::resume(const fs::path& folder, std::int64_t resumed_steps) 
   if (!config.contains("resumes") || !config["resumes"].is_array()) {
     config["resumes"] = nlohmann::json::array();
   }
-  config["resumes"].push_back(
-      {{"steps", resumed_steps}, {"code_version", code_version_json(build_code_version())}});
+  nlohmann::json entry = {{"steps", resumed_steps},
+                          {"code_version", code_version_json(build_code_version())}};
+  if (budget.is_object()) entry.update(budget);
+  config["resumes"].push_back(std::move(entry));
   write_json_atomically(folder / kConfigName, config, "RunFolder");
   RunFolder run(folder, std::move(config), std::move(extra_columns), std::move(progress));
   run.open_progress();

@@ -17,8 +17,8 @@ namespace pixelgym::ppo {
 /// written), and curve.png, summary.json and checkpoints are written atomically.
 ///
 /// config.json is the caller's settings object plus "code_version" (see code_version.h); each
-/// resume adds {"steps", "code_version"} to a "resumes" array, so a run continued by other code
-/// says so.
+/// resume adds {"steps", "code_version"} and the caller's `budget` members to a "resumes" array,
+/// so a run continued by other code, or with another budget, says so.
 class RunFolder {
  public:
   /// Starts a run in `folder` (created with its parents): writes config.json and the header of
@@ -32,9 +32,12 @@ class RunFolder {
   /// Reopens the run in `folder` to continue from a checkpoint taken at `resumed_steps` env
   /// steps: rows of progress.csv after that step were logged after the checkpoint and will be
   /// logged again, so they are dropped (progress.csv is rewritten atomically without them).
-  /// The extra columns are those of progress.csv's header. Throws std::runtime_error naming the
-  /// file when config.json or progress.csv is missing or malformed.
-  static RunFolder resume(const std::filesystem::path& folder, std::int64_t resumed_steps);
+  /// The extra columns are those of progress.csv's header. `budget` (an object, or null) is
+  /// merged into the "resumes" entry. Throws std::runtime_error naming the file when config.json
+  /// or progress.csv is missing or malformed; std::invalid_argument for a `budget` that is not
+  /// an object or null.
+  static RunFolder resume(const std::filesystem::path& folder, std::int64_t resumed_steps,
+                          const nlohmann::json& budget = nullptr);
 
   RunFolder(RunFolder&&) noexcept;
   RunFolder& operator=(RunFolder&&) noexcept;

@@ -411,6 +411,7 @@ TEST(Trainer, MovesTheGaussianMeanToTheBestActionOfAContinuousBandit) {
 }
 
 TEST(Trainer, FirstMinibatchStartsAtRatioOneWithAndWithoutAugmentation) {
+  std::vector<std::vector<torch::Tensor>> updated;  // the parameters after the update, per case
   for (const bool augment : {false, true}) {
     SCOPED_TRACE(augment ? "augment" : "no augmentation");
     SyncVectorEnv envs(
@@ -433,7 +434,11 @@ TEST(Trainer, FirstMinibatchStartsAtRatioOneWithAndWithoutAugmentation) {
     EXPECT_NEAR(stats.approx_kl, 0.0, 1e-7);
     EXPECT_DOUBLE_EQ(stats.clip_fraction, 0.0);
     EXPECT_TRUE(std::isfinite(stats.value_loss));
+    updated.push_back(parameters_of(trainer.policy()));
   }
+  // Same seed, same rollout: only the shifts tell the two updates apart, so the images were
+  // shifted (were every shift (pad, pad), the identity, the parameters would be equal).
+  EXPECT_FALSE(same_parameters(updated[0], updated[1]));
 }
 
 TEST(Trainer, SameSeedSameParametersAndRngStateResumesTheRandomness) {
@@ -544,8 +549,19 @@ TEST(Trainer, ReplayEnvContinuesTheEpisodesInProgress) {
                  "Trainer::replay_env: an action log of 8 batches of 16 bytes (128 bytes, for 16 "
                  "env steps) expected, got 120 bytes");
   }
+  EXPECT_EQ(b.env_digest(), 0U);  // not reset yet
   b.replay_env(log);
   EXPECT_EQ(b.env_action_log(), log);
+  // The digest a checkpoint keeps says the replay arrived where the envs were...
+  EXPECT_NE(a.env_digest(), 0U);
+  EXPECT_EQ(b.env_digest(), a.env_digest());
+  // ...and tells other places apart: the first rollout's half of the log leaves the envs at
+  // step 4 of their episodes, not step 3 of the next.
+  auto envs_c = counter_envs(2);
+  Trainer c(*envs_c, config);
+  c.set_progress(a.env_steps() / 2, 1);
+  c.replay_env(log.substr(0, log.size() / 2));
+  EXPECT_NE(c.env_digest(), a.env_digest());
   const RolloutStats next_a = a.collect();
   const RolloutStats next_b = b.collect();
   // Step 8 of a 5-step episode cycle: observations 0.3, 0.4, then 0.0 after the truncation.

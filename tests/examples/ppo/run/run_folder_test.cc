@@ -132,7 +132,8 @@ TEST(RunFolderTest, ResumeDropsRowsAfterTheCheckpointAndAppendsAfterTheRest) {
     }
   }
   // The last checkpoint was at 3000 steps: 4000 and 5000 will be logged again.
-  RunFolder run = RunFolder::resume(folder, 3000);
+  EXPECT_THROW(RunFolder::resume(folder, 3000, nlohmann::json::array()), std::invalid_argument);
+  RunFolder run = RunFolder::resume(folder, 3000, {{"total_env_steps", 9000}, {"minutes", 2.5}});
   EXPECT_EQ(steps_on_disk(folder), (std::vector<double>{1000, 2000, 3000}));
   EXPECT_EQ(run.progress().rows.size(), 3U);
   EXPECT_EQ(run.extra_columns(), std::vector<std::string>{"lr"});
@@ -142,11 +143,13 @@ TEST(RunFolderTest, ResumeDropsRowsAfterTheCheckpointAndAppendsAfterTheRest) {
   run.append_progress(row);
   EXPECT_EQ(steps_on_disk(folder), (std::vector<double>{1000, 2000, 3000, 4000}));
   EXPECT_EQ(as_csv(read_progress_csv(folder / "progress.csv").rows), as_csv(run.progress().rows));
-  // The resume is in config.json, with the code that resumed.
+  // The resume is in config.json, with the code that resumed and its budget.
   const nlohmann::json config = read_json(folder / "config.json");
   ASSERT_EQ(config["resumes"].size(), 1U);
   EXPECT_EQ(config["resumes"][0]["steps"], 3000);
   EXPECT_TRUE(config["resumes"][0]["code_version"].contains("commit"));
+  EXPECT_EQ(config["resumes"][0]["total_env_steps"], 9000);
+  EXPECT_EQ(config["resumes"][0]["minutes"], 2.5);
   EXPECT_EQ(config["env_id"], "CartPoleBalance-v0");
   // No temporary left by the rewrite.
   EXPECT_EQ(entries(folder), (std::vector<std::string>{"config.json", "progress.csv"}));
