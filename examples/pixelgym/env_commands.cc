@@ -427,6 +427,7 @@ struct BenchArguments {
   int steps = 2000;
   int num_envs = 0;  // 0: one Env in a loop; else a vector env
   int threads = 0;   // with num_envs: 0 for SyncVectorEnv, else AsyncVectorEnv's worker threads
+  bool threads_given = false;
   std::vector<std::string> sets;
   std::vector<std::string> wraps;
 };
@@ -471,7 +472,7 @@ int run_vector_bench(const BenchArguments& args) {
 
 int run_bench(const BenchArguments& args) {
   if (args.num_envs > 0) return run_vector_bench(args);
-  if (args.threads > 0) {
+  if (args.threads_given) {
     throw UsageError("bench --threads " + std::to_string(args.threads) +
                      ": threads step a vector env; give --num-envs N with it");
   }
@@ -513,7 +514,8 @@ Command add_bench(CLI::App& app) {
                    "With --num-envs: 0 for SyncVectorEnv (a loop on this thread), T for an "
                    "AsyncVectorEnv on T threads, this one included (clamped to N)")
       ->capture_default_str()
-      ->check(integer_in(0));
+      ->check(integer_in(0))
+      ->each([args](const std::string&) { args->threads_given = true; });
   add_set_option(*bench, args->sets);
   add_wrap_option(*bench, args->wraps);
   return {bench, [args] { return run_bench(*args); }};

@@ -179,8 +179,9 @@ ppo::CheckpointBlobs checkpoint_blobs(const RunSettings& settings, ppo::Trainer&
   // Where the envs are, for a resume to check its replay of the actions below against.
   meta["env_digest"] = trainer.env_digest();
   blobs["meta"] = meta.dump();
-  // The envs' state, as the actions that led to it (see Trainer::replay_env).
-  blobs["env_actions"] = trainer.env_action_log();
+  // The envs' state, as the actions that led to it (see Trainer::replay_env); none when the log
+  // does not go back to the first reset (a run resumed from a checkpoint without actions).
+  if (trainer.env_action_log_complete()) blobs["env_actions"] = trainer.env_action_log();
   return blobs;
 }
 
@@ -349,6 +350,8 @@ int run_train(const TrainArguments& args) {
   tune_process_for_training();
   RunSettings settings;
   std::optional<ppo::LoadedCheckpoint> checkpoint;
+  json meta;                    // the checkpoint's progress (with --resume)
+  double budget_minutes = 0.0;  // of wall time over the whole run; 0: none
   fs::path folder;
   if (!args.resume.empty()) {
     folder = args.resume;
@@ -356,8 +359,17 @@ int run_train(const TrainArguments& args) {
     if (!config_file) {
       throw std::runtime_error("--resume " + folder.string() + ": no config.json there");
     }
-    settings = settings_from_json(json::parse(config_file), folder / "config.json");
+    const json config = json::parse(config_file);
+    settings = settings_from_json(config, folder / "config.json");
     check_resume_flags(args, settings);
+    // The budget as the latest resume left it (a --steps or --minutes given then holds on).
+    budget_minutes = settings.minutes;
+    if (config.contains("resumes") && config.at("resumes").is_array() &&
+        !config.at("resumes").empty()) {
+      const json& latest = config.at("resumes").back();
+      settings.ppo.total_env_steps = latest.value("total_env_steps", settings.ppo.total_env_steps);
+      budget_minutes = latest.value("minutes", budget_minutes);
+    }
     const ppo::CheckpointSearch search = ppo::find_latest_checkpoint(folder);
     for (const auto& skipped : search.skipped) {
       std::cerr << "train: skipping " << skipped.path.string() << ": " << skipped.reason << "\n";
@@ -366,6 +378,7 @@ int run_train(const TrainArguments& args) {
       throw std::runtime_error("--resume " + folder.string() + ": no valid checkpoint there");
     }
     checkpoint = *search.latest;
+    meta = read_meta(checkpoint->blobs, checkpoint->path);
   } else {
     settings.id = args.id;
     settings.sets = args.sets;
@@ -387,15 +400,39 @@ int run_train(const TrainArguments& args) {
     folder = args.out.empty() ? fs::path("runs") / settings.id : fs::path(args.out);
   }
   if (args.steps > 0) settings.ppo.total_env_steps = args.steps;
-  if (args.minutes > 0.0) settings.minutes = args.minutes;
+  // The wall time of the run before this process: its checkpoint's.
+  const double wall_before = checkpoint ? meta.at("wall_time_s").get<double>() : 0.0;
+  if (args.minutes > 0.0) {
+    if (!checkpoint) settings.minutes = args.minutes;  // config.json's: the run's first budget
+    budget_minutes = wall_before / 60.0 + args.minutes;
+  }
   settings.ppo.validate();
+  if (checkpoint) {
+    // Nothing left to do: say so, and leave the run as it is (its checkpoint, summary and
+    // video are those of its end).
+    const auto steps_done = meta.at("env_steps").get<std::int64_t>();
+    const bool steps_spent = steps_done >= settings.ppo.total_env_steps;
+    const bool time_spent = budget_minutes > 0.0 && wall_before >= budget_minutes * 60.0;
+    if (steps_spent || time_spent) {
+      std::ostringstream message;
+      message << "--resume " << folder.string() << ": nothing to do, the run has spent its ";
+      if (steps_spent) {
+        message << "env steps (" << steps_done << " of " << settings.ppo.total_env_steps
+                << "): give --steps N (more than " << steps_done << ") to train on\n";
+      } else {
+        message << "time (" << std::fixed << std::setprecision(1) << wall_before / 60.0 << " of "
+                << budget_minutes << " minutes): give --minutes M to train M more\n";
+      }
+      std::cout << message.str();
+      return 0;
+    }
+  }
   // The count in use goes into config.json, so that --resume runs with it (results depend on it).
   settings.torch_threads = set_torch_threads(settings.torch_threads);
 
   const std::unique_ptr<vector::VectorEnv> env = make_training_env(settings);
   ppo::Trainer trainer(*env, settings.ppo);
   std::deque<double> returns;
-  double wall_before = 0.0;  // wall time of the run before this process
   std::optional<ppo::RunFolder> run;
   if (checkpoint) {
     load_blob(checkpoint->blobs, "model", trainer.policy_ptr(), checkpoint->path);
@@ -404,10 +441,8 @@ int run_train(const TrainArguments& args) {
     load_blob(checkpoint->blobs, "rng_sampling", rng.sampling, checkpoint->path);
     load_blob(checkpoint->blobs, "rng_augmentation", rng.augmentation, checkpoint->path);
     trainer.set_rng_state(rng);
-    const json meta = read_meta(checkpoint->blobs, checkpoint->path);
     trainer.set_progress(meta.at("env_steps").get<std::int64_t>(),
                          meta.at("updates").get<std::int64_t>());
-    wall_before = meta.at("wall_time_s").get<double>();
     for (const double r : meta.at("recent_returns").get<std::vector<double>>()) {
       returns.push_back(r);
     }
@@ -418,9 +453,11 @@ int run_train(const TrainArguments& args) {
     scaling.statistics.count = scaling_json.at("count").get<double>();
     scaling.returns = scaling_json.at("returns").get<std::vector<double>>();
     trainer.set_reward_scaling(std::move(scaling));
-    run.emplace(ppo::RunFolder::resume(
-        folder, trainer.env_steps(),
-        {{"total_env_steps", settings.ppo.total_env_steps}, {"minutes", settings.minutes}}));
+    // The budget from here on: the env steps, and the minutes of wall time over the whole run
+    // (0: none), with the --minutes this resume was given when it was.
+    json budget = {{"total_env_steps", settings.ppo.total_env_steps}, {"minutes", budget_minutes}};
+    if (args.minutes > 0.0) budget["minutes_given"] = args.minutes;
+    run.emplace(ppo::RunFolder::resume(folder, trainer.env_steps(), budget));
     std::cout << "resuming " << folder.string() << " from " << checkpoint->path.filename().string()
               << " (" << trainer.env_steps() << " env steps, " << trainer.updates() << " updates)\n"
               << "torch_threads=" << settings.torch_threads << " (as the run began)\n";
@@ -435,9 +472,10 @@ int run_train(const TrainArguments& args) {
           << std::fixed << std::setprecision(1)
           << std::chrono::duration<double>(std::chrono::steady_clock::now() - replay_start).count()
           << std::defaultfloat << " s: the envs continue their episodes\n";
-      // A checkpoint from before the digest was kept has none: nothing to compare.
-      if (meta.contains("env_digest") &&
-          meta.at("env_digest").get<std::uint64_t>() != trainer.env_digest()) {
+      // A checkpoint from before the digest was kept has none, and one taken before the envs
+      // were first reset has 0: nothing to compare.
+      const std::uint64_t digest = meta.value("env_digest", std::uint64_t{0});
+      if (digest != 0 && digest != trainer.env_digest()) {
         std::cout << "warning: the replayed envs are not where the checkpoint's were (their "
                      "observations or episodes differ): the code or a library changed since "
                      "the run began, or the envs are not deterministic. Training goes on from "
@@ -459,11 +497,11 @@ int run_train(const TrainArguments& args) {
     return wall_before +
            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
-  // --minutes on this command line bounds this process's time; without it a resumed run keeps
-  // the budget it began with, counted over its whole wall time (a killed 10-minute run resumed
-  // trains for what was left of its 10 minutes, not for 10 more).
-  const double time_limit_s = settings.minutes * 60.0;
-  const double time_limit_from = args.minutes > 0.0 ? wall_before : 0.0;
+  // The run's time budget counts its whole wall time, as of its latest checkpoint: a killed
+  // 10-minute run, resumed, trains for what was left of its 10 minutes. --minutes M given to
+  // this command adds M to the wall time so far, and always allows one update.
+  const double time_limit_s = budget_minutes * 60.0;
+  bool one_update_due = args.minutes > 0.0;
   ppo::ProgressStatus status;
   const auto save_checkpoint = [&] {
     ppo::write_checkpoint(run->checkpoint_path(trainer.updates()),
@@ -471,7 +509,8 @@ int run_train(const TrainArguments& args) {
     ppo::prune_checkpoints(run->path(), settings.keep_checkpoints);
   };
   while (trainer.env_steps() < settings.ppo.total_env_steps &&
-         (time_limit_s <= 0.0 || elapsed() - time_limit_from < time_limit_s)) {
+         (time_limit_s <= 0.0 || one_update_due || elapsed() < time_limit_s)) {
+    one_update_due = false;
     const auto update_start = std::chrono::steady_clock::now();
     const std::int64_t steps_before = trainer.env_steps();
     const ppo::RolloutStats rollout = trainer.collect();
@@ -505,12 +544,9 @@ int run_train(const TrainArguments& args) {
     run->append_progress(row);
     run->write_curve(title);
     if (trainer.updates() % settings.checkpoint_every == 0) save_checkpoint();
-    status = {trainer.env_steps(),
-              settings.ppo.total_env_steps,
-              elapsed() - time_limit_from,
-              time_limit_s,
-              row.fps,
-              row.episode_return_mean};
+    status = {
+        trainer.env_steps(),    settings.ppo.total_env_steps, elapsed(), time_limit_s, row.fps,
+        row.episode_return_mean};
     progress.update(status);
   }
   progress.finish(status);
@@ -543,10 +579,12 @@ CLI::App* add_run_options(CLI::App& train, TrainArguments& args) {
   train.add_option("--steps", args.steps,
                    "Env steps to train for, all envs together; with --set action_repeat=K "
                    "each is K control steps (default: the config's total_env_steps, 1,000,000)");
-  train.add_option("--minutes", args.minutes,
-                   "Stop after this much wall time (then checkpoint, evaluate, write the video); "
-                   "with --resume, this much more (without it, a resumed run stops when its "
-                   "whole wall time reaches the minutes it began with)");
+  train
+      .add_option("--minutes", args.minutes,
+                  "Stop after this much wall time (then checkpoint, evaluate, write the video); "
+                  "with --resume, this much more, and at least one update (without it, a "
+                  "resumed run stops when its whole wall time reaches its budget so far)")
+      ->check(CLI::Range(0.0, 1e9));
   return &train;
 }
 

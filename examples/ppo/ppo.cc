@@ -396,6 +396,11 @@ void Trainer::replay_env(const std::string& env_action_log) {
   env_action_log_ = env_action_log;
 }
 
+bool Trainer::env_action_log_complete() const {
+  const auto batches = static_cast<std::size_t>(env_steps_ / config_.num_envs);
+  return env_action_log_.size() == batches * actions_.array().nbytes();
+}
+
 std::uint64_t Trainer::env_digest() const {
   if (!started_) return 0;
   std::uint64_t digest = 14695981039346656037ULL;  // FNV-1a, 64-bit

@@ -250,6 +250,9 @@ class Trainer {
   /// size is env_steps() x the bytes of one env's action (4 MB per million env steps of a
   /// one-dimensional float32 action).
   const std::string& env_action_log() const { return env_action_log_; }
+  /// Whether env_action_log covers every env step done (false after set_progress without
+  /// replay_env: a resume from a checkpoint that kept no actions).
+  bool env_action_log_complete() const;
   /// Brings the envs to where they were when `env_action_log` was taken, for a resume: resets
   /// them with config.seed, as the first collect() does, and steps them with the logged
   /// batches (no policy, no gradients, no reward statistics: those come from the checkpoint),

@@ -412,9 +412,11 @@ TEST(PixelgymCliTest, BenchWithNumEnvsStepsAVectorEnvAndCountsEveryEnvStep) {
   EXPECT_THAT(run("bench CartPoleSwingup-v0 --num-envs 3 --threads 8" + small).output,
               HasSubstr("AsyncVectorEnv, 3 threads"));
   // Threads without a vector env would be ignored: refused instead.
-  const CliRun alone = run("bench CartPoleSwingup-v0 --threads 2" + small);
-  EXPECT_EQ(alone.exit_code, 2) << alone.output;
-  EXPECT_THAT(alone.output, HasSubstr("give --num-envs N with it"));
+  for (const char* threads : {" --threads 2", " --threads 0"}) {
+    const CliRun alone = run(std::string("bench CartPoleSwingup-v0") + threads + small);
+    EXPECT_EQ(alone.exit_code, 2) << threads << ": " << alone.output;
+    EXPECT_THAT(alone.output, HasSubstr("give --num-envs N with it"));
+  }
 }
 
 // --- --wrap: wrapper stacks from text ---

@@ -124,6 +124,23 @@ TEST(TrainCliTest, AShortRunWritesACompleteRunFolder) {
       run_cli("eval " + (away / "final.pgck").string() + " --episodes 1 --seed 1000000");
   ASSERT_EQ(alone.exit_code, 0) << alone.output;
   EXPECT_NE(alone.output.find(expected.str()), std::string::npos) << alone.output;
+  // A checkpoint without the settings (written before they were kept) needs its folder's
+  // config.json: away from it, it is refused by name; beside it, it evaluates the same.
+  ppo::CheckpointBlobs older = ppo::read_checkpoint(run / "ckpt-000010.pgck");
+  older.erase("config");
+  ppo::write_checkpoint(away / "older.pgck", older);
+  const CliRun lost = run_cli("eval " + (away / "older.pgck").string() + " --episodes 1");
+  EXPECT_EQ(lost.exit_code, 1) << lost.output;
+  EXPECT_NE(lost.output.find("does not carry its run's settings, and there is no config.json in " +
+                             away.string()),
+            std::string::npos)
+      << lost.output;
+  ppo::write_checkpoint(run / "older.pgck", older);
+  const CliRun beside =
+      run_cli("eval " + (run / "older.pgck").string() + " --episodes 1 --seed 1000000");
+  ASSERT_EQ(beside.exit_code, 0) << beside.output;
+  EXPECT_NE(beside.output.find(expected.str()), std::string::npos) << beside.output;
+  fs::remove(run / "older.pgck");
   // A video is written as H.264 .mp4 only: any other name is refused before the work, and
   // nothing is written.
   const CliRun avi =
@@ -339,28 +356,50 @@ TEST(TrainCliTest, AResumedRunIsTheRunThatDidNotStop) {
   fs::remove_all(folder);
 }
 
-// --minutes bounds a run's wall time: resumed without it, the run has only what is left of its
-// budget; with it, that much more. Each resume is recorded in config.json with its budget.
-TEST(TrainCliTest, AResumedRunKeepsItsTimeBudgetUnlessGivenAnother) {
+// --minutes bounds a run's whole wall time. A resume without it has what is left (here
+// nothing: it says so and leaves the run as it is); --minutes M given to a resume adds M (and
+// always allows one update), and later resumes keep that budget. Each resume is recorded in
+// config.json with its budget.
+TEST(TrainCliTest, AResumedRunKeepsItsTimeBudgetUnlessGivenMore) {
   const fs::path folder = fresh_folder("minutes");
   const fs::path run = folder / "run";
-  // 0.6 ms: the run stops by time after its first update.
+  const auto rows = [&] { return ppo::read_progress_csv(run / "progress.csv").rows.size(); };
+  // 0.6 ms: the run stops by time after its one update.
   const CliRun trained =
       run_cli(train_arguments(folder, "--steps 320 --minutes 0.00001 --out " + run.string()));
   ASSERT_EQ(trained.exit_code, 0) << trained.output;
-  ASSERT_EQ(ppo::read_progress_csv(run / "progress.csv").rows.size(), 1U);
+  ASSERT_EQ(rows(), 1U);
+  const std::string files_before = read_text(run / "ckpt-000001.pgck") +
+                                   read_text(run / "summary.json") + read_text(run / "final.mp4") +
+                                   read_text(run / "config.json");
   const CliRun spent = run_cli("train --resume " + run.string() + " --quiet");
   ASSERT_EQ(spent.exit_code, 0) << spent.output;
-  EXPECT_EQ(ppo::read_progress_csv(run / "progress.csv").rows.size(), 1U) << spent.output;
+  EXPECT_NE(spent.output.find("nothing to do, the run has spent its time"), std::string::npos)
+      << spent.output;
+  EXPECT_NE(spent.output.find("give --minutes M to train M more"), std::string::npos)
+      << spent.output;
+  EXPECT_EQ(rows(), 1U);
+  EXPECT_TRUE(read_text(run / "ckpt-000001.pgck") + read_text(run / "summary.json") +
+                  read_text(run / "final.mp4") + read_text(run / "config.json") ==
+              files_before)
+      << "a resume with nothing to do changed the run";
+
   const CliRun more = run_cli("train --resume " + run.string() + " --quiet --minutes 0.00001");
   ASSERT_EQ(more.exit_code, 0) << more.output;
-  EXPECT_EQ(ppo::read_progress_csv(run / "progress.csv").rows.size(), 2U) << more.output;
+  EXPECT_EQ(rows(), 2U) << more.output;
   const json config = json::parse(read_text(run / "config.json"));
-  ASSERT_EQ(config.at("resumes").size(), 2U);
-  EXPECT_EQ(config.at("resumes")[1].at("steps"), 32);
-  EXPECT_EQ(config.at("resumes")[1].at("total_env_steps"), 320);
-  EXPECT_EQ(config.at("resumes")[1].at("minutes"), 0.00001);
+  ASSERT_EQ(config.at("resumes").size(), 1U);
+  const json& resume = config.at("resumes")[0];
+  EXPECT_EQ(resume.at("steps"), 32);
+  EXPECT_EQ(resume.at("total_env_steps"), 320);
+  EXPECT_EQ(resume.at("minutes_given"), 0.00001);
+  EXPECT_GT(resume.at("minutes").get<double>(), 0.00001);  // the wall time so far + 0.00001
   EXPECT_EQ(more.output.find("warning: the replayed envs"), std::string::npos) << more.output;
+  // That budget holds for the next resume: spent too.
+  const CliRun again = run_cli("train --resume " + run.string() + " --quiet");
+  EXPECT_NE(again.output.find("nothing to do, the run has spent its time"), std::string::npos)
+      << again.output;
+  EXPECT_EQ(rows(), 2U);
 
   // A checkpoint whose envs the replay does not reproduce (here: its digest altered, as after
   // a change of code or library) resumes with a warning saying so.
@@ -376,6 +415,7 @@ TEST(TrainCliTest, AResumedRunKeepsItsTimeBudgetUnlessGivenAnother) {
   EXPECT_NE(changed.output.find("warning: the replayed envs are not where the checkpoint's were"),
             std::string::npos)
       << changed.output;
+  EXPECT_EQ(rows(), 3U);
   fs::remove_all(folder);
 }
 

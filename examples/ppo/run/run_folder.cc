@@ -118,6 +118,12 @@ RunFolder RunFolder::resume(const fs::path& folder, std::int64_t resumed_steps,
     throw std::invalid_argument("RunFolder: expected the resume's budget as a JSON object, got " +
                                 std::string(budget.type_name()));
   }
+  for (const char* reserved : {"steps", "code_version"}) {
+    if (budget.is_object() && budget.contains(reserved)) {
+      throw std::invalid_argument(std::string("RunFolder: the resume's budget may not set \"") +
+                                  reserved + "\" (the resume's own entry)");
+    }
+  }
   nlohmann::json config = read_json(folder / kConfigName);
   if (!config.is_object()) {
     throw std::runtime_error("RunFolder: " + (folder / kConfigName).string() +

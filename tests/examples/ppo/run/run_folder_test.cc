@@ -133,6 +133,7 @@ TEST(RunFolderTest, ResumeDropsRowsAfterTheCheckpointAndAppendsAfterTheRest) {
   }
   // The last checkpoint was at 3000 steps: 4000 and 5000 will be logged again.
   EXPECT_THROW(RunFolder::resume(folder, 3000, nlohmann::json::array()), std::invalid_argument);
+  EXPECT_THROW(RunFolder::resume(folder, 3000, {{"steps", 1}}), std::invalid_argument);
   RunFolder run = RunFolder::resume(folder, 3000, {{"total_env_steps", 9000}, {"minutes", 2.5}});
   EXPECT_EQ(steps_on_disk(folder), (std::vector<double>{1000, 2000, 3000}));
   EXPECT_EQ(run.progress().rows.size(), 3U);
