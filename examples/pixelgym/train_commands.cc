@@ -1,6 +1,4 @@
 // pixelgym train / eval: PPO from pixels (examples/ppo) with a run folder (examples/ppo/run).
-#include <dlfcn.h>
-#include <malloc.h>
 #include <sched.h>
 #include <torch/torch.h>
 
@@ -26,6 +24,7 @@
 #include "examples/ppo/policy.h"
 #include "examples/ppo/ppo.h"
 #include "examples/ppo/run/checkpoint_file.h"
+#include "examples/ppo/run/process_tuning.h"
 #include "examples/ppo/run/progress_line.h"
 #include "examples/ppo/run/run_folder.h"
 #include "wrappers/record_video.h"
@@ -36,27 +35,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-// Sets up the process for training on a CPU; measured with `pixelgym train CartPoleBalance-v0
-// --set obs_mode=pixels --set width=64 --set height=64 --wrap frame_stack=3` on the 2-core VM:
-// - glibc returns large freed blocks to the system (mmap'd ones at once, the heap's top past
-//   128 KiB), so torch's per-minibatch tensors were faulted in afresh every time: 22-35 s of
-//   system time per 52 s and 170 env steps/s. Keeping freed memory in the process (no mmap'd
-//   blocks, no trimming) gives 950 env steps/s with 1.6 s of system time.
-// - OpenBLAS's own threads (one per core) wait for work by yielding the core, on top of torch's
-//   intra-op threads: the same speed with 1 thread, and 20 s less CPU per 50 s.
-// Not applied when the user set the corresponding environment variables.
-void tune_process_for_training() {
-  if (std::getenv("MALLOC_MMAP_MAX_") == nullptr) mallopt(M_MMAP_MAX, 0);
-  if (std::getenv("MALLOC_TRIM_THRESHOLD_") == nullptr) mallopt(M_TRIM_THRESHOLD, 1 << 30);
-  if (std::getenv("MALLOC_TOP_PAD_") == nullptr) mallopt(M_TOP_PAD, 256 << 20);
-  if (std::getenv("OPENBLAS_NUM_THREADS") == nullptr) {
-    using SetThreads = void (*)(int);
-    if (auto* set = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))) {
-      set(1);
-    }
-  }
-}
 
 // LibTorch's intra-op threads (the convolutions and matrix products of the updates and forward
 // passes): `requested`, or when 0 one per core this process may run on. LibTorch's own default is
@@ -347,7 +325,7 @@ double std_of(const std::deque<double>& values) {
 }
 
 int run_train(const TrainArguments& args) {
-  tune_process_for_training();
+  ppo::tune_process_for_training();
   RunSettings settings;
   std::optional<ppo::LoadedCheckpoint> checkpoint;
   json meta;                    // the checkpoint's progress (with --resume)
@@ -682,7 +660,7 @@ int run_eval(const EvalArguments& args) {
       (fs::path(args.video).extension() != ".mp4" || fs::path(args.video).stem().empty())) {
     throw UsageError("eval --video: expected a FILE.mp4, got \"" + args.video + "\"");
   }
-  tune_process_for_training();
+  ppo::tune_process_for_training();
   const fs::path given(args.run);
   fs::path checkpoint_path;
   fs::path folder;

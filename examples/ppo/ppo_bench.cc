@@ -3,6 +3,7 @@
 //
 //   ppo_bench [--threads 2] [--batch 256] [--seconds 3]
 //
+// The process is set up as `pixelgym train` sets it up (ppo::tune_process_for_training).
 // For each CNN (nature, small, fine, finer) and image size (64x64, 84x84), a Policy over a
 // uint8 (9, H, W) image (3 stacked RGB frames, channel-first) with a 1-D Box action: samples per
 // second of
@@ -20,6 +21,7 @@
 
 #include "envs/spaces/box.h"
 #include "examples/ppo/policy.h"
+#include "examples/ppo/run/process_tuning.h"
 
 namespace {
 
@@ -42,6 +44,8 @@ double run_for(double seconds, const std::function<void()>& body) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // As pixelgym train runs (OpenBLAS on one thread beside torch's, freed memory kept).
+  pixelgym::ppo::tune_process_for_training();
   int threads = 2;
   std::int64_t batch = 256;
   double seconds = 3.0;
