@@ -386,12 +386,23 @@ int run_train(const TrainArguments& args) {
   }
   settings.ppo.validate();
   if (checkpoint) {
-    // Nothing left to do: say so, and leave the run as it is (its checkpoint, summary and
-    // video are those of its end).
     const auto steps_done = meta.at("env_steps").get<std::int64_t>();
+    if (args.steps > 0 && args.steps <= steps_done) {
+      throw UsageError("train --resume --steps " + std::to_string(args.steps) + ": the run has " +
+                       std::to_string(steps_done) + " env steps done; give more to train on");
+    }
     const bool steps_spent = steps_done >= settings.ppo.total_env_steps;
     const bool time_spent = budget_minutes > 0.0 && wall_before >= budget_minutes * 60.0;
-    if (steps_spent || time_spent) {
+    // Nothing left to do once the run's summary is of its last checkpoint: say so, and leave the
+    // run as it is. (A run killed between its last checkpoint and its evaluation goes on to
+    // evaluate and write final.mp4 and summary.json.)
+    bool summarized = false;
+    if (std::ifstream summary_file(folder / "summary.json"); summary_file) {
+      const json summary = json::parse(summary_file, nullptr, /*allow_exceptions=*/false);
+      summarized = summary.is_object() && summary.contains("env_steps") &&
+                   summary.at("env_steps") == steps_done;
+    }
+    if ((steps_spent || time_spent) && summarized) {
       std::ostringstream message;
       message << "--resume " << folder.string() << ": nothing to do, the run has spent its ";
       if (steps_spent) {
@@ -480,7 +491,10 @@ int run_train(const TrainArguments& args) {
   // this command adds M to the wall time so far, and always allows one update.
   const double time_limit_s = budget_minutes * 60.0;
   bool one_update_due = args.minutes > 0.0;
-  ppo::ProgressStatus status;
+  // Where the run stands, before any update of this process (what the line shows should none
+  // be left to do).
+  ppo::ProgressStatus status{trainer.env_steps(), settings.ppo.total_env_steps, elapsed(),
+                             time_limit_s,        ppo::ProgressStatus::kNone,   mean_of(returns)};
   const auto save_checkpoint = [&] {
     ppo::write_checkpoint(run->checkpoint_path(trainer.updates()),
                           checkpoint_blobs(settings, trainer, returns, elapsed()));

@@ -397,8 +397,27 @@ TEST(TrainCliTest, AResumedRunKeepsItsTimeBudgetUnlessGivenMore) {
   EXPECT_EQ(more.output.find("warning: the replayed envs"), std::string::npos) << more.output;
   // That budget holds for the next resume: spent too.
   const CliRun again = run_cli("train --resume " + run.string() + " --quiet");
+  EXPECT_EQ(again.exit_code, 0) << again.output;
   EXPECT_NE(again.output.find("nothing to do, the run has spent its time"), std::string::npos)
       << again.output;
+  EXPECT_EQ(rows(), 2U);
+  // A run stopped between its last checkpoint and its evaluation (no summary of it) goes on to
+  // evaluate, and trains no more.
+  fs::remove(run / "summary.json");
+  fs::remove(run / "final.mp4");
+  const CliRun unfinished = run_cli("train --resume " + run.string() + " --quiet");
+  ASSERT_EQ(unfinished.exit_code, 0) << unfinished.output;
+  EXPECT_EQ(rows(), 2U);
+  EXPECT_EQ(json::parse(read_text(run / "summary.json")).at("env_steps"), 64);
+  EXPECT_TRUE(fs::exists(run / "final.mp4"));
+  // Budgets that cannot be: --steps no more than done, negative minutes.
+  const CliRun fewer = run_cli("train --resume " + run.string() + " --quiet --steps 64");
+  EXPECT_EQ(fewer.exit_code, 2) << fewer.output;
+  EXPECT_NE(fewer.output.find("the run has 64 env steps done; give more to train on"),
+            std::string::npos)
+      << fewer.output;
+  const CliRun negative = run_cli("train --resume " + run.string() + " --quiet --minutes -1");
+  EXPECT_EQ(negative.exit_code, 2) << negative.output;
   EXPECT_EQ(rows(), 2U);
 
   // A checkpoint whose envs the replay does not reproduce (here: its digest altered, as after
