@@ -512,7 +512,8 @@ Command add_bench(CLI::App& app) {
   bench
       ->add_option("--threads", args->threads,
                    "With --num-envs: 0 for SyncVectorEnv (a loop on this thread), T for an "
-                   "AsyncVectorEnv on T threads, this one included (clamped to N)")
+                   "AsyncVectorEnv on T threads, this one included (clamped to N); refused without "
+                   "--num-envs")
       ->capture_default_str()
       ->check(integer_in(0))
       ->each([args](const std::string&) { args->threads_given = true; });
