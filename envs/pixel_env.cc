@@ -123,9 +123,27 @@ EnvDescription PixelEnv::describe(const Task& task, const TaskConfig& config) {
   return description;
 }
 
-PixelEnv::PixelEnv(std::unique_ptr<Task> task, TaskConfig config, std::string name)
+PixelRenderResources::PixelRenderResources(int mesa_copy, bool share_context)
+    : group_(mesa_copy), share_context_(share_context) {}
+
+PixelRenderResources::~PixelRenderResources() = default;
+
+std::unique_ptr<render::Renderer> PixelRenderResources::make_renderer() {
+  if (share_context_) return std::make_unique<render::Renderer>(group_);
+  return std::make_unique<render::Renderer>(group_.backend(), group_.mesa_copy());
+}
+
+PixelEnv::PixelEnv(std::unique_ptr<Task> task, TaskConfig config, std::string name,
+                   std::shared_ptr<RenderResources> render)
     : task_(std::move(task)), config_(std::move(config)), name_(std::move(name)) {
   if (task_ == nullptr) throw std::invalid_argument("PixelEnv: task is null");
+  if (render != nullptr) {
+    render_resources_ = std::dynamic_pointer_cast<PixelRenderResources>(render);
+    if (render_resources_ == nullptr) {
+      throw std::invalid_argument(name_ +
+                                  ": the render resources given are not PixelRenderResources");
+    }
+  }
   EnvDescription description = describe(*task_, config_);
   camera_ = config_.camera.empty() ? description.cameras.at(0) : config_.camera;
   observation_space_ = std::move(description.observation_space);
@@ -139,12 +157,16 @@ PixelEnv::PixelEnv(std::unique_ptr<Task> task, TaskConfig config, std::string na
   task_->build(*world_);
   scene_ = std::make_unique<WorldScene>(*world_);
   scene_->scene().shadows = config_.shadows;
+  if (config_.has_pixels()) renderer();
 }
 
 PixelEnv::~PixelEnv() = default;
 
 render::Renderer& PixelEnv::renderer() {
-  if (renderer_ == nullptr) renderer_ = std::make_unique<render::Renderer>();
+  if (renderer_ == nullptr) {
+    renderer_ = render_resources_ != nullptr ? render_resources_->make_renderer()
+                                             : std::make_unique<render::Renderer>();
+  }
   return *renderer_;
 }
 
@@ -219,10 +241,13 @@ EnvSpec pixel_task_spec(const std::string& id, const std::string& description,
   spec.description = description;
   spec.params = TaskConfig::params();
   spec.params.insert(spec.params.end(), extra_params.begin(), extra_params.end());
-  spec.factory = [id, make_task](const Params& kwargs) {
+  spec.factory = [id, make_task](const Params& kwargs, const MakeOptions& options) {
     std::unique_ptr<Task> task = make_task(kwargs);
     TaskConfig config = TaskConfig::from_params(kwargs, task->camera_names(), id);
-    return std::make_unique<PixelEnv>(std::move(task), std::move(config), id);
+    return std::make_unique<PixelEnv>(std::move(task), std::move(config), id, options.render);
+  };
+  spec.make_render_resources = [](int worker, bool share_contexts) {
+    return std::make_shared<PixelRenderResources>(worker, share_contexts);
   };
   spec.describe = [id, make_task](const Params& kwargs) {
     const std::unique_ptr<Task> task = make_task(kwargs);

@@ -10,23 +10,31 @@
 #include "engine/world.h"
 #include "envs/env.h"
 #include "envs/registry.h"
+#include "envs/render_resources.h"
 #include "envs/task.h"
 #include "envs/world_scene.h"
 #include "render/renderer.h"
 
 namespace pixelgym {
 
+class PixelRenderResources;
+
 /// Runs a Task: reset rebuilds the world and lets the task set the episode's start; each step
 /// repeats `action_repeat` times before_step -> physics steps -> reward, then observes into the
 /// caller's buffer (Env::step_into). Observations are {"pixels": (H, W, 3) uint8, <state
 /// arrays>: float32} per obs_mode; spaces come from the config and the task alone, before any
-/// world exists (`describe`). The renderer (an OpenGL context) is created on first use, so
-/// obs_mode="state" never renders. A PixelEnv never truncates on its own: the registry's
-/// TimeLimit does, after the task's episode length (Task::episode_length).
+/// world exists (`describe`). The renderer draws with the PixelRenderResources it is given (null:
+/// a GL context of its own); it is built in the constructor when observations hold pixels, and
+/// on the first render() call otherwise, so obs_mode="state" never creates a GL context unless
+/// asked to render. A PixelEnv never truncates on its own: the registry's TimeLimit does, after
+/// the task's episode length (Task::episode_length).
 class PixelEnv final : public Env {
  public:
-  /// `name` is how messages name the env before the registry sets its id.
-  PixelEnv(std::unique_ptr<Task> task, TaskConfig config, std::string name);
+  /// `name` is how messages name the env before the registry sets its id. Throws
+  /// std::invalid_argument when `render` is not null and not PixelRenderResources, and
+  /// std::runtime_error when the GL context cannot be created.
+  PixelEnv(std::unique_ptr<Task> task, TaskConfig config, std::string name,
+           std::shared_ptr<RenderResources> render = nullptr);
   ~PixelEnv() override;
 
   const Space& observation_space() const override { return *observation_space_; }
@@ -78,13 +86,37 @@ class PixelEnv final : public Env {
   int substeps_ = 1;
   std::unique_ptr<engine::World> world_;
   std::unique_ptr<WorldScene> scene_;
+  std::shared_ptr<PixelRenderResources> render_resources_;  // null: a context of its own
   std::unique_ptr<render::Renderer> renderer_;
   int control_steps_ = 0;
   std::int64_t frames_rendered_ = 0;
 };
 
+/// What the pixel envs that one thread steps share to draw (RenderResources, made by make_vec
+/// through EnvSpec::make_render_resources): one GL context group (render::ContextGroup) in copy
+/// `mesa_copy` of Mesa, or, without sharing, only the copy (each env's context of its own in it).
+/// Frames are byte-identical whatever is shared. The envs given one must be stepped by one thread
+/// at a time (render::ContextGroup).
+class PixelRenderResources final : public RenderResources {
+ public:
+  /// Throws std::invalid_argument for mesa_copy < 0.
+  PixelRenderResources(int mesa_copy, bool share_context);
+  ~PixelRenderResources() override;
+
+  int mesa_copy() const { return group_.mesa_copy(); }
+  bool shares_context() const { return share_context_; }
+  /// A renderer for one env: with the group's context when shared, else with one of its own in
+  /// the copy. Throws as render::Renderer's constructors.
+  std::unique_ptr<render::Renderer> make_renderer();
+
+ private:
+  render::ContextGroup group_;
+  bool share_context_;
+};
+
 /// The registry entry of a pixel task: the shared TaskConfig keys plus `extra_params`; the
-/// factory builds the task with `make_task(kwargs)` and runs it in a PixelEnv; `describe` and
+/// factory builds the task with `make_task(kwargs)` and runs it in a PixelEnv drawing with the
+/// MakeOptions' render resources (make_render_resources makes PixelRenderResources); `describe` and
 /// the default max_episode_steps come from the task and config without building a world.
 EnvSpec pixel_task_spec(const std::string& id, const std::string& description,
                         std::function<std::unique_ptr<Task>(const Params& kwargs)> make_task,

@@ -123,7 +123,7 @@ EnvDescription Registry::describe(const std::string& id, const Params& kwargs) c
     description = resolved.spec->describe(resolved.kwargs);
   } else {
     // No describe: build the env and keep it alive behind its spaces (aliasing pointers).
-    std::shared_ptr<Env> env = resolved.spec->factory(resolved.kwargs);
+    std::shared_ptr<Env> env = resolved.spec->factory(resolved.kwargs, MakeOptions{});
     if (env == nullptr) throw std::runtime_error(id + ": the registered factory returned null");
     description.observation_space = SpacePtr(env, &env->observation_space());
     description.action_space = SpacePtr(env, &env->action_space());
@@ -134,9 +134,10 @@ EnvDescription Registry::describe(const std::string& id, const Params& kwargs) c
   return description;
 }
 
-std::unique_ptr<Env> Registry::make(const std::string& id, const Params& kwargs) const {
+std::unique_ptr<Env> Registry::make(const std::string& id, const Params& kwargs,
+                                    const MakeOptions& options) const {
   const Resolved resolved = resolve(id, kwargs);
-  std::unique_ptr<Env> env = resolved.spec->factory(resolved.kwargs);
+  std::unique_ptr<Env> env = resolved.spec->factory(resolved.kwargs, options);
   if (env == nullptr) throw std::runtime_error(id + ": the registered factory returned null");
   // The made env's spec says what it was made with (as gymnasium's env.spec does).
   auto made = std::make_shared<EnvSpec>(*resolved.spec);
@@ -181,8 +182,8 @@ Registry& default_registry() {
   return *registry;
 }
 
-std::unique_ptr<Env> make(const std::string& id, const Params& kwargs) {
-  return default_registry().make(id, kwargs);
+std::unique_ptr<Env> make(const std::string& id, const Params& kwargs, const MakeOptions& options) {
+  return default_registry().make(id, kwargs, options);
 }
 
 void register_env(EnvSpec spec) { default_registry().register_env(std::move(spec)); }

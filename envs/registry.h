@@ -11,6 +11,7 @@
 
 #include "envs/env.h"
 #include "envs/params.h"
+#include "envs/render_resources.h"
 
 namespace pixelgym {
 
@@ -41,8 +42,14 @@ struct EnvSpec {
   /// On the spec of an env that `make` returned: the kwargs it was made with, resolved (every
   /// declared key present, max_episode_steps excluded). Empty in the registry.
   Params kwargs;
-  /// Builds the env from kwargs already resolved against `params` (every key present, typed).
-  std::function<std::unique_ptr<Env>(const Params& kwargs)> factory;
+  /// Builds the env from kwargs already resolved against `params` (every key present, typed),
+  /// with the resources `options` shares (MakeOptions::render null: its own).
+  std::function<std::unique_ptr<Env>(const Params& kwargs, const MakeOptions& options)> factory;
+  /// Optional: what the envs that one thread steps share to render (see RenderResources), for
+  /// worker thread `worker` of a vector env (make_vec: its envs draw with copy `worker` of Mesa),
+  /// their GL contexts shared when `share_contexts`. Unset for envs that share nothing.
+  std::function<std::shared_ptr<RenderResources>(int worker, bool share_contexts)>
+      make_render_resources;
   /// Describes the env `factory` would build from the same kwargs without building it. Optional:
   /// when unset, Registry::describe builds the env to read its spaces.
   std::function<EnvDescription(const Params& kwargs)> describe;
@@ -59,8 +66,10 @@ class Registry {
   /// Builds env `id` with `kwargs`, wrapped in TimeLimit when the spec (or the reserved kwarg
   /// "max_episode_steps") sets a limit. Throws std::invalid_argument for an unknown id (naming
   /// the closest registered ids, or all of them when none is close), an unknown kwarg (listing the
-  /// valid ones with types and defaults) or a kwarg of the wrong type.
-  std::unique_ptr<Env> make(const std::string& id, const Params& kwargs = {}) const;
+  /// valid ones with types and defaults) or a kwarg of the wrong type. `options` are passed to the
+  /// factory (see MakeOptions).
+  std::unique_ptr<Env> make(const std::string& id, const Params& kwargs = {},
+                            const MakeOptions& options = {}) const;
 
   /// What `make(id, kwargs)` would return — spaces, time limit, cameras, metadata — computed
   /// from the spec alone when it has a `describe` (no world, no GL context). Throws like `make`.
@@ -93,8 +102,9 @@ class Registry {
 /// The process-wide registry, holding the built-in envs.
 Registry& default_registry();
 
-/// `default_registry().make(id, kwargs)`.
-std::unique_ptr<Env> make(const std::string& id, const Params& kwargs = {});
+/// `default_registry().make(id, kwargs, options)`.
+std::unique_ptr<Env> make(const std::string& id, const Params& kwargs = {},
+                          const MakeOptions& options = {});
 /// `default_registry().describe(id, kwargs)`.
 EnvDescription describe(const std::string& id, const Params& kwargs = {});
 /// `default_registry().register_env(spec)`.

@@ -1,6 +1,7 @@
 // Wrapper bases: Wrapper, ObservationWrapper, ActionWrapper, RewardWrapper (as in Gymnasium).
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -8,6 +9,11 @@
 #include "envs/env.h"
 
 namespace pixelgym {
+
+/// Wraps an env and returns the outermost wrapper (the first wrapper innermost): what
+/// vector::make_vec applies to each env it makes. wrappers::wrapping builds one from the
+/// `--wrap` text form; any callable that takes and returns an env will do.
+using EnvWrapping = std::function<std::unique_ptr<Env>(std::unique_ptr<Env> env)>;
 
 /// An env that owns another and, by default, passes every call through to it.
 ///

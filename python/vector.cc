@@ -58,7 +58,7 @@ class VectorHandle {
           wrappers::describe_wrapped(describe(id, kwargs_), wrappers_).max_episode_steps;
     });
     py::gil_scoped_release release;
-    env_ = vector::make_vec(id, num_envs, kwargs_, wrappers_, options);
+    env_ = vector::make_vec(id, num_envs, kwargs_, wrappers::wrapping(wrappers_), options);
   }
 
   py::tuple reset(const py::object& seed, const py::object& options, const py::object& mask) {

@@ -16,8 +16,9 @@ struct Context::Impl {
   std::vector<unsigned char> dummy = std::vector<unsigned char>(4);
 };
 
-Context::Context(GlBackend backend) : backend_(backend), impl_(std::make_unique<Impl>()) {
-  impl_->library = &library_for_new_context();
+Context::Context(GlBackend backend, int mesa_copy)
+    : backend_(backend), impl_(std::make_unique<Impl>()) {
+  impl_->library = &library_for_new_context(mesa_copy);
   prepare_thread(*impl_->library);
   const int attributes[] = {OSMESA_FORMAT,
                             OSMESA_RGBA,

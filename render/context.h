@@ -23,20 +23,21 @@ enum class GlBackend {
 /// done with a context for now releases it, as `Scope` does; Renderer binds its context only
 /// for the length of each call.
 ///
-/// Copies of Mesa: a context is created in the copy of libOSMesa that MesaCopy::Use selects on
-/// the creating thread (copy 0, the linked library, by default). Contexts of different copies
+/// Copies of Mesa: a context is created in the copy of libOSMesa its constructor is given (copy
+/// 0, the linked library, by default). Contexts of different copies
 /// rasterize in parallel; those of one copy take turns (see render/mesa_copy.h).
 ///
 /// llvmpipe threads: Mesa's software rasterizer starts LP_NUM_THREADS worker threads per context
 /// (by default one per core). For the small images of pixel observations they cost more than they
-/// give (measured in bench/render_bench), so the first context pixelgym creates in a process sets
-/// LP_NUM_THREADS=0 unless the variable is already set. Set it yourself (e.g. to the core count)
-/// before the first render to override this.
+/// give (docs/design-notes.md, "Rendering"), so the first context pixelgym creates in a process
+/// sets LP_NUM_THREADS=0 unless the variable is already set. Set it yourself (e.g. to the core
+/// count) before the first render to override this.
 class Context {
  public:
-  /// Creates a context, current on the calling thread. Throws std::runtime_error naming the backend
-  /// and Mesa's reason when it cannot be created.
-  explicit Context(GlBackend backend = GlBackend::kOSMesa);
+  /// Creates a context of copy `mesa_copy` of Mesa (see MesaCopy; taken modulo max_copies()),
+  /// current on the calling thread. Throws std::runtime_error naming the backend and Mesa's
+  /// reason when it cannot be created, std::invalid_argument for mesa_copy < 0.
+  explicit Context(GlBackend backend = GlBackend::kOSMesa, int mesa_copy = 0);
   /// Destroys the context, on any thread, provided no other thread has it current.
   ~Context();
   Context(const Context&) = delete;
@@ -65,8 +66,8 @@ class Context {
   /// True when this context is current on the calling thread.
   bool is_current() const;
   GlBackend backend() const { return backend_; }
-  /// The copy of Mesa the context is from (see MesaCopy): the one selected on the thread that
-  /// created it, or 0 when that one could not be loaded.
+  /// The copy of Mesa the context is from (see MesaCopy): the one it was created for, or 0 when
+  /// that one could not be loaded.
   int mesa_copy() const;
   /// GL_RENDERER and GL_VERSION, e.g. "llvmpipe (LLVM 15.0.6, 256 bits), 4.5 (Core Profile)
   /// Mesa 22.3.6".

@@ -23,8 +23,9 @@ struct GlLibrary {
 /// first call per thread and copy. Context calls it before every call into OSMesa.
 void prepare_thread(const GlLibrary& library);
 
-/// The library a context created on this thread now uses: MesaCopy::resolve(MesaCopy::in_use()),
-/// loaded if need be. Sets LP_NUM_THREADS first (see Context). Thread-safe.
-const GlLibrary& library_for_new_context();
+/// The library a context of Mesa copy `copy` uses: MesaCopy::resolve(copy), loaded if need be.
+/// Sets LP_NUM_THREADS first (see Context). Throws std::invalid_argument for copy < 0.
+/// Thread-safe.
+const GlLibrary& library_for_new_context(int copy);
 
 }  // namespace pixelgym::render

@@ -24,7 +24,6 @@ namespace {
 constexpr int kMostCopies = 16;
 constexpr int kDefaultCopies = 8;
 
-thread_local int copy_in_use = 0;
 thread_local unsigned copies_ready_here = 1U;  // bit k: init_thread of copy k ran on this thread
 
 void default_llvmpipe_threads() {
@@ -167,17 +166,6 @@ const GlLibrary& library(int copy) {
 
 }  // namespace
 
-MesaCopy::Use::Use(int copy) : previous_(copy_in_use) {
-  if (copy < 0) {
-    throw std::invalid_argument("MesaCopy::Use: copy must be >= 0, got " + std::to_string(copy));
-  }
-  copy_in_use = copy;
-}
-
-MesaCopy::Use::~Use() { copy_in_use = previous_; }
-
-int MesaCopy::in_use() { return copy_in_use; }
-
 int MesaCopy::max_copies() {
   const char* text = std::getenv("PIXELGYM_MESA_COPIES");
   if (text == nullptr || *text == '\0') return kDefaultCopies;
@@ -222,9 +210,12 @@ void prepare_thread(const GlLibrary& library) {
   }
 }
 
-const GlLibrary& library_for_new_context() {
+const GlLibrary& library_for_new_context(int copy) {
+  if (copy < 0) {
+    throw std::invalid_argument("Context: mesa_copy must be >= 0, got " + std::to_string(copy));
+  }
   default_llvmpipe_threads();
-  return library(MesaCopy::in_use() % MesaCopy::max_copies());
+  return library(copy % MesaCopy::max_copies());
 }
 
 }  // namespace pixelgym::render

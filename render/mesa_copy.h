@@ -7,19 +7,17 @@
 namespace pixelgym::render {
 
 /// llvmpipe, Mesa's software rasterizer, has one screen per loaded library, and it rasterizes the
-/// frames of every context of that screen under one lock (with LP_NUM_THREADS=0 on the drawing
-/// thread itself). So threads drawing at once with contexts of one libOSMesa take turns: two
-/// threads rendering cart-pole frames got 1.0x the frames of one. A library loaded a second time
-/// in a link namespace of its own (dlmopen) is a separate copy, with its own screen and lock, and
-/// threads drawing with contexts of different copies run in parallel (1.96x with two).
+/// frames of every context of that screen under one lock: threads drawing at once with contexts
+/// of one libOSMesa take turns. A library loaded a second time in a link namespace of its own
+/// (dlmopen) is a separate copy, with its own screen and lock, and threads drawing with contexts
+/// of different copies run in parallel (figures: docs/design-notes.md, "Rendering").
 ///
 /// Copy 0 is the libOSMesa the process links. Copies 1, 2, ... are private copies of the same
-/// file, loaded when a context first asks for them and kept until the process ends (about 70 ms
-/// and a few MiB each; the code pages are shared with copy 0). The copies run the same code on
-/// the same machine, so a scene drawn with any copy gives the same bytes.
+/// file, loaded when a context first asks for them and kept until the process ends. The copies run
+/// the same code on the same machine, so a scene drawn with any copy gives the same bytes.
 ///
-/// A context uses the copy selected on the thread that creates it (`MesaCopy::Use`; copy 0 when
-/// none is). The vector envs give the envs of worker thread w copy w (see vector::VectorEnv).
+/// A context is created in the copy its creator names (Context's `mesa_copy`, ContextGroup's; copy
+/// 0 by default). make_vec gives the envs of worker thread w copy w (see vector::make_vec).
 ///
 /// Limits: glibc has 16 link namespaces per process, and copies loaded later share a small
 /// reserve of static thread-local storage, which in a plain process ran out at the 10th copy. So
@@ -30,21 +28,6 @@ namespace pixelgym::render {
 /// with the reason.
 class MesaCopy {
  public:
-  /// While alive, contexts created on this thread (Context, and so Renderer and SharedContext)
-  /// use copy `copy` (taken modulo max_copies()). Nests: the previous selection is restored when
-  /// it ends. Throws std::invalid_argument for copy < 0.
-  class Use {
-   public:
-    explicit Use(int copy);
-    ~Use();
-    Use(const Use&) = delete;
-    Use& operator=(const Use&) = delete;
-
-   private:
-    int previous_;
-  };
-  /// The copy selected on this thread (0 when none is).
-  static int in_use();
   /// The most copies, copy 0 included: PIXELGYM_MESA_COPIES when set (1 to 16), else 8.
   static int max_copies();
   /// The copy a context asking for `copy` gets: `copy` modulo max_copies(), loaded if need be,

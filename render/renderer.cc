@@ -76,29 +76,24 @@ struct Background {
 // Backgrounds kept per image size and sample count.
 constexpr std::size_t kBackgroundsPerSize = 16;
 
-// The calling thread's SharedContext in use (SharedContext::Use).
-thread_local SharedContext* shared_in_use = nullptr;
-
 }  // namespace
 
-SharedContext::SharedContext(GlBackend backend) : backend_(backend) {}
-
-SharedContext::~SharedContext() = default;
-
-SharedContext::Use::Use(SharedContext& shared) : previous_(shared_in_use) {
-  shared_in_use = &shared;
+ContextGroup::ContextGroup(int mesa_copy, GlBackend backend)
+    : backend_(backend), mesa_copy_(mesa_copy) {
+  if (mesa_copy < 0) {
+    throw std::invalid_argument("ContextGroup: mesa_copy must be >= 0, got " +
+                                std::to_string(mesa_copy));
+  }
 }
 
-SharedContext::Use::~Use() { shared_in_use = previous_; }
-
-SharedContext* SharedContext::in_use() { return shared_in_use; }
+ContextGroup::~ContextGroup() = default;
 
 // Everything a renderer draws with: the GL context, the shader programs, the meshes, textures and
 // framebuffers, and per-frame scratch. A Renderer of its own context has a State of its own; the
-// renderers of a SharedContext share one, drawing one after another: every frame sets all the GL
+// renderers of a ContextGroup share one, drawing one after another: every frame sets all the GL
 // state and uniforms it draws with and redraws every pixel of the scratch targets it reads.
-struct SharedContext::State {
-  explicit State(GlBackend backend) : context(backend), floor(make_floor_mesh()) {
+struct ContextGroup::State {
+  State(GlBackend backend, int mesa_copy) : context(backend, mesa_copy), floor(make_floor_mesh()) {
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     glFrontFace(GL_CW);  // the flipped projection mirrors the winding
@@ -369,7 +364,7 @@ struct SharedContext::State {
   }
 
   Context context;  // first: destroyed after every GL object below
-  // Shared by the renderers of a SharedContext: every uniform a frame draws with is set during
+  // Shared by the renderers of a ContextGroup: every uniform a frame draws with is set during
   // that frame, never left from an earlier one (tests/render/shared_context_test.cc checks).
   ShaderPrograms programs;
   MeshArena arena;
@@ -378,7 +373,7 @@ struct SharedContext::State {
   ShadowFootprints shadow_floor;
   std::shared_ptr<const MeshData> floor;
   std::map<TargetKey, ColorTarget> targets;
-  // Several per size (the renderers of a SharedContext may look from different cameras), the
+  // Several per size (the renderers of a ContextGroup may look from different cameras), the
   // least recently used redrawn when none matches.
   std::map<TargetKey, std::vector<Background>> backgrounds;
   std::uint64_t frames = 0;
@@ -392,33 +387,27 @@ struct SharedContext::State {
   std::vector<std::uint8_t> readback;  // RGBA, packed into RGB
 };
 
-std::shared_ptr<SharedContext::State> SharedContext::state() {
+std::shared_ptr<ContextGroup::State> ContextGroup::state() {
   if (state_ == nullptr) {
-    state_ = std::make_shared<State>(backend_);
+    state_ = std::make_shared<State>(backend_, mesa_copy_);
   } else {
     state_->context.make_current();
   }
   return state_;
 }
 
-namespace {
-
-// The state a new renderer draws with, its context current on the calling thread: the
-// SharedContext's in use here when it is of `backend`, else its own.
-std::shared_ptr<SharedContext::State> state_for(GlBackend backend) {
-  SharedContext* shared = SharedContext::in_use();
-  if (shared != nullptr && shared->backend() == backend) return shared->state();
-  return std::make_shared<SharedContext::State>(backend);
-}
-
-}  // namespace
-
 struct Renderer::Impl {
-  std::shared_ptr<SharedContext::State> state;
+  std::shared_ptr<ContextGroup::State> state;
 };
 
-Renderer::Renderer(GlBackend backend) : impl_(std::make_unique<Impl>(Impl{state_for(backend)})) {
-  impl_->state->context.release();  // current since state_for; see render()
+Renderer::Renderer(GlBackend backend, int mesa_copy)
+    : impl_(
+          std::make_unique<Impl>(Impl{std::make_shared<ContextGroup::State>(backend, mesa_copy)})) {
+  impl_->state->context.release();  // current since created; see render()
+}
+
+Renderer::Renderer(ContextGroup& group) : impl_(std::make_unique<Impl>(Impl{group.state()})) {
+  impl_->state->context.release();  // current since state(); see render()
 }
 
 Renderer::~Renderer() {

@@ -28,49 +28,31 @@ struct RenderTargets {
 };
 
 /// A GL context, with everything drawn with it, that several Renderers share, drawing one after
-/// another: the renderers constructed on a thread while a `SharedContext::Use` is alive there
-/// draw with that SharedContext's context instead of one of their own. They share the compiled
-/// shader programs, the meshes and textures uploaded (by MeshData address and texture path, so
-/// envs of one task upload each mesh once), the framebuffers a frame is drawn in, the shadow map,
-/// and the cached backgrounds (by camera and scene settings, up to 16 per image size). Every frame
-/// sets all the GL state it draws with and redraws every pixel it reads, so a renderer's frames
-/// are byte-identical to those of a renderer with a context of its own. Meshes and textures stay
-/// until the SharedContext and all its renderers are gone.
-///
-/// Why: llvmpipe compiles shaders per context into machine code of its own and keeps per-context
-/// state; N renderers with N contexts drawn in turn on one core keep N copies of that, and of
-/// every mesh and framebuffer, in the caches. Measured with bench/vector_bench (CartPoleSwingup-v0,
-/// 84x84, thread CPU time): 8 envs with their own contexts stepped in turn cost 0.79-0.82x the
-/// steps/s of one env stepped alone, 16 envs 0.73-0.78x; sharing one context, 1.0x and 0.91-0.97x.
-/// The vector envs give each thread that runs envs one SharedContext.
+/// another: the renderers constructed with it (`Renderer(group)`) draw with its context instead of
+/// one of their own. They share the compiled shader programs, the meshes and textures uploaded (by
+/// MeshData address and texture path, so envs of one task upload each mesh once), the framebuffers
+/// a frame is drawn in, the shadow map, and the cached backgrounds (by camera and scene settings,
+/// up to 16 per image size). Every frame sets all the GL state it draws with and redraws every
+/// pixel it reads, so a renderer's frames are byte-identical to those of a renderer with a context
+/// of its own. Meshes and textures stay until the group and all its renderers are gone. Its
+/// context is of copy `mesa_copy()` of Mesa (see MesaCopy). Why share: docs/design-notes.md,
+/// "Rendering".
 ///
 /// Threads: the renderers sharing a context must never draw (or be made or destroyed) at the same
-/// time: use one SharedContext for renderers that one thread runs in turn (or several threads,
-/// one after the other). The GL context is created by the first renderer that uses it, on that
-/// renderer's thread, and destroyed with the last of the SharedContext and its renderers.
-class SharedContext {
+/// time: give one group to renderers that one thread runs in turn (or several threads, one after
+/// the other). The GL context is created by the first renderer made with the group, on that
+/// renderer's thread, and destroyed with the last of the group and its renderers.
+class ContextGroup {
  public:
-  explicit SharedContext(GlBackend backend = GlBackend::kOSMesa);
-  ~SharedContext();
-  SharedContext(const SharedContext&) = delete;
-  SharedContext& operator=(const SharedContext&) = delete;
-
-  /// While alive, Renderers constructed on this thread draw with `shared`'s context. Nests: the
-  /// previous SharedContext in use (or none) is restored when it ends.
-  class Use {
-   public:
-    explicit Use(SharedContext& shared);
-    ~Use();
-    Use(const Use&) = delete;
-    Use& operator=(const Use&) = delete;
-
-   private:
-    SharedContext* previous_;
-  };
-  /// The SharedContext in use on the calling thread, or null.
-  static SharedContext* in_use();
+  /// Throws std::invalid_argument for mesa_copy < 0.
+  explicit ContextGroup(int mesa_copy = 0, GlBackend backend = GlBackend::kOSMesa);
+  ~ContextGroup();
+  ContextGroup(const ContextGroup&) = delete;
+  ContextGroup& operator=(const ContextGroup&) = delete;
 
   GlBackend backend() const { return backend_; }
+  /// The copy of Mesa its context is made in, as asked (Context::mesa_copy says which it got).
+  int mesa_copy() const { return mesa_copy_; }
   /// Whether a renderer has created the GL context yet.
   bool created() const { return state_ != nullptr; }
 
@@ -81,10 +63,11 @@ class SharedContext {
 
  private:
   GlBackend backend_;
+  int mesa_copy_;
   std::shared_ptr<State> state_;
 };
 
-/// Turns scenes into pixels with its own OpenGL context (or a SharedContext's). Meshes and textures
+/// Turns scenes into pixels with its own OpenGL context (or a ContextGroup's). Meshes and textures
 /// are uploaded on first use and kept for later frames (keyed by MeshData address, kept alive by
 /// the renderer, and by texture path).
 ///
@@ -94,10 +77,13 @@ class SharedContext {
 /// scene and camera give identical bytes on one machine and one Mesa build.
 class Renderer {
  public:
-  /// Draws with the SharedContext in use on this thread when there is one of `backend` (see
-  /// SharedContext::Use), else with a context of its own. Throws std::runtime_error when the GL
-  /// context cannot be created or the shaders do not build.
-  explicit Renderer(GlBackend backend = GlBackend::kOSMesa);
+  /// Draws with a context of its own, of copy `mesa_copy` of Mesa (see MesaCopy). Throws
+  /// std::runtime_error when the GL context cannot be created or the shaders do not build,
+  /// std::invalid_argument for mesa_copy < 0.
+  explicit Renderer(GlBackend backend = GlBackend::kOSMesa, int mesa_copy = 0);
+  /// Draws with `group`'s context (created now if it is the group's first renderer), which it
+  /// keeps alive: the group object itself may go first. Throws as above.
+  explicit Renderer(ContextGroup& group);
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;

@@ -42,21 +42,8 @@
 // at each side; the cart-pole frame fails because the pole on it, one pixel wide, moves too);
 // shading within about a level everywhere; a few isolated pixels.
 //
-// Measured (2x2 windows / displaced pixels / clipped mean) against pixelgym's goldens:
-//  - Mesa softpipe (GALLIUM_DRIVER=softpipe) instead of llvmpipe, every golden: at most 0 / 5 /
-//    0.17 at 84 x 84 (5 displaced in env_ArmPush-v0), 2 / 1 / 0.04 in cartpole_256 and 0 / 27 /
-//    0.07 in arm_256 (0.04 % displaced): it passes. (The old criterion, unclipped mean <= 1.0 and
-//    <= 1 % of pixels off by more than 8, failed it: mean up to 1.56, up to 1.9 % off. That is why
-//    the two simple figures, mean absolute difference and share of pixels off, are reported but
-//    not bounded by default: set max_mean_difference / max_off_fraction to bound them.)
-//  - Mutants planted in the tasks' initialize_episode (first observation at 84 x 84), each fails:
-//    cart-pole pole +-0.05 rad: 11-19 windows (and 5-19 displaced); cart +-0.05 m (one pixel):
-//    23-25 windows, from the pole; swing-up starting upright (kPi dropped): 2 windows but 48
-//    displaced; acrobot lower link +-0.1 rad: 31-34 windows; pendulum +-0.05 rad: 14-19 windows.
-//    None moves the clipped mean past 0.09: it is there for colour and light, not for motion.
-//  - Smaller mutants, for the edge of what it sees: pole +0.02 rad fails both swing-up frames (6
-//    windows) but passes the balance frames; +0.03 rad fails all four (6-8 windows); pendulum
-//    +0.02 rad fails (5 windows); acrobot lower link +0.05 rad fails (23 windows).
+// How the criterion was chosen (softpipe against llvmpipe, planted mutants): docs/design-notes.md,
+// "Snapshot tests".
 //
 // The diff image: grey is |difference| x 8, red marks the 2 x 2 windows all off, blue the
 // displaced pixels (magenta both).

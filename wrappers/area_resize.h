@@ -1,6 +1,5 @@
 // AreaResize: OpenCV's INTER_AREA shrink of a uint8 image, precomputed for one size pair, with no
-// allocation per call and 4.6x (portable) to 9.7x (AVX2) faster than cv::resize for non-integer
-// factors.
+// allocation per call, and faster than cv::resize for non-integer factors.
 #pragma once
 
 #include <cstdint>
@@ -30,9 +29,7 @@ namespace pixelgym::wrappers {
 ///    pixel's channels share one register in the column pass; one channel gathers four output
 ///    elements per register.
 /// The two can differ by one level on a few elements, so pixels are identical on one machine, not
-/// across CPUs with and without AVX2. Measured on this machine, 84x84x3 -> 64x64x3, CPU time per
-/// call (perf stat task-clock over 100,000 calls, -O3): cv::resize 42.6 us, portable 9.3 us,
-/// AVX2 4.4 us; 84x84x1 -> 64x64x1: portable 4.4 us, AVX2 1.7 us.
+/// across CPUs with and without AVX2. Speeds: docs/design-notes.md, "Wrappers".
 class AreaResize {
  public:
   /// Requires 1 <= height <= source_height, 1 <= width <= source_width and channels >= 1.

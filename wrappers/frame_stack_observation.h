@@ -18,24 +18,11 @@
 // no allocation per step. A reset appends a fresh window of k slots (k - 1 padding frames, then
 // the reset frame) after the last used slot, in the same tape when it has room.
 //
-// Tape size N = kTapeSlotsPerFrame * k = 16 k slots (64 for k = 4: 1.3 MiB at 84x84x3). Two costs
-// pull in opposite directions: the k - 1 frames copied to the front of each new tape (memory and
-// copying, (k - 1) / N), and the granularity of what is kept alive (one held observation keeps
-// its whole tape, N frames; the tape being filled is allocated in full). Measured by
-// tests/wrappers/frame_stack_observation_memory_test.cc (the allocator's usable size of every
-// distinct allocation the held observations keep, over the bytes of the distinct frames they
-// show), k = 4 at 84x84x3, one episode:
-//   N          every obs of 1,000 steps   every obs of 10,000 steps   every 100th obs of 1,000
-//   4 k = 16      1.235                      1.232                        4.29
-//   8 k = 32      1.123                      1.104                        8.59
-//   16 k = 64     1.088                      1.050                       17.2
-//   32 k = 128    1.152                      1.037                       28.1
-//   64 k = 256    1.024 (4 tapes just fit)   1.024                       25.0
-//   Gymnasium-style copies: 4.000 for every observation, 1.073 for every 100th.
-// 16 k is the smallest that keeps a 1,000-step replay buffer within 1.1 and stays within 3 % of
-// the larger tapes on long buffers (the bound is about N / (N - k + 1) + N / frames held).
-// Keeping one observation in many costs up to N / k times what copying would: such a caller
-// should clone() what it keeps or step into buffers of its own.
+// Tape size N = kTapeSlotsPerFrame * k = 16 k slots (64 for k = 4: 1.3 MiB at 84x84x3): the
+// smallest that keeps a 1,000-step replay buffer within 1.1x the bytes of its distinct frames
+// (docs/design-notes.md, "Wrappers", has the measurement). Keeping one observation in many costs
+// up to N / k times what copying would: such a caller should clone() what it keeps or step into
+// buffers of its own.
 //
 // Tapes in use: a caller that keeps nothing (or steps into its own buffers) uses one, rewound;
 // one that keeps only the latest observation uses two in turn (the wrapper keeps the previous

@@ -31,10 +31,9 @@ struct ImageSize {
 ///    the integer shrink allocates nothing. Throws std::runtime_error should OpenCV ever
 ///    reallocate the target view.
 ///  - a shrink by a non-integer factor (84 -> 64): AreaResize, the same area weights with tables
-///    and buffers built once (no allocation per step) and rows blended before columns, which
-///    makes it 4.6x (portable) to 9.7x (AVX2) faster than cv::resize here (whose INTER_AREA path
-///    for such factors costs more than a third of a whole pixel step at 84x84); a value may differ
-///    from cv::resize's by one level (float sums in another order).
+///    and buffers built once (no allocation per step) and rows blended before columns, faster
+///    than cv::resize (docs/design-notes.md, "Wrappers"); a value may differ from cv::resize's by
+///    one level (float sums in another order).
 class ResizeObservation final : public ObservationWrapper {
  public:
   /// The largest height or width accepted.

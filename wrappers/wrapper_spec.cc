@@ -10,6 +10,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "envs/described_env.h"
 #include "envs/time_limit.h"
 #include "wrappers/add_render_observation.h"
 #include "wrappers/channel_first_observation.h"
@@ -311,31 +312,6 @@ std::string param_names(const Entry& entry) {
   return entry.name + "'s parameters are: " + names;
 }
 
-// An env with described spaces and metadata only, for describe_wrapped: wrappers read the
-// spaces and metadata of the env they wrap in their constructors, and nothing else.
-class DescribedEnv final : public Env {
- public:
-  explicit DescribedEnv(const EnvDescription& description) : description_(description) {}
-  const Space& observation_space() const override { return *description_.observation_space; }
-  const Space& action_space() const override { return *description_.action_space; }
-  const Metadata& metadata() const override { return description_.metadata; }
-
- protected:
-  std::string type_name() const override { return "DescribedEnv"; }
-  void do_reset(std::optional<std::uint64_t> /*seed*/, const Options& /*options*/,
-                ResetResult& /*out*/) override {
-    refuse();
-  }
-  void do_step(const Value& /*action*/, StepResult& /*out*/) override { refuse(); }
-  Array do_render() override { refuse(); }
-
- private:
-  [[noreturn]] static void refuse() {
-    throw std::logic_error("describe_wrapped: the stand-in env only describes spaces");
-  }
-  const EnvDescription description_;
-};
-
 // "resize=HxW[,key=pixels]": the form of a spec, for messages and help.
 std::string usage(const Entry& entry) {
   std::string usage = entry.name;
@@ -451,6 +427,17 @@ std::unique_ptr<Env> apply_wrappers(std::unique_ptr<Env> env,
   for (const std::string& text : specs)
     env = apply_wrapper(std::move(env), parse_wrapper_spec(text));
   return env;
+}
+
+EnvWrapping wrapping(const std::vector<std::string>& specs) {
+  std::vector<WrapperSpec> parsed;
+  parsed.reserve(specs.size());
+  for (const std::string& text : specs) parsed.push_back(parse_wrapper_spec(text));
+  if (parsed.empty()) return nullptr;
+  return [parsed](std::unique_ptr<Env> env) {
+    for (const WrapperSpec& spec : parsed) env = apply_wrapper(std::move(env), spec);
+    return env;
+  };
 }
 
 EnvDescription describe_wrapped(EnvDescription description, const std::vector<std::string>& specs) {

@@ -9,6 +9,7 @@
 
 #include "envs/env.h"
 #include "envs/registry.h"
+#include "envs/wrapper.h"
 
 namespace pixelgym::wrappers {
 
@@ -40,6 +41,11 @@ std::unique_ptr<Env> apply_wrapper(std::unique_ptr<Env> env, const WrapperSpec& 
 /// Throws as parse_wrapper_spec and apply_wrapper do.
 std::unique_ptr<Env> apply_wrappers(std::unique_ptr<Env> env,
                                     const std::vector<std::string>& specs);
+
+/// The EnvWrapping of `specs` (what vector::make_vec applies to each env it makes): parses them
+/// now, throwing as parse_wrapper_spec, and applies them in order to each env it is given,
+/// throwing as apply_wrapper. Empty (null) for no specs.
+EnvWrapping wrapping(const std::vector<std::string>& specs);
 
 /// What an env described by `description` (Registry::describe) looks like under `specs`, without
 /// making it: the wrappers are built over a stand-in env that has the described spaces and

@@ -170,7 +170,7 @@ EnvSpec GridWorld::spec_v0() {
   spec.description = "4x4 grid: reach the green goal, avoid the wall; Discrete(4) moves";
   spec.params = GridWorldConfig::params();
   spec.max_episode_steps = kMaxEpisodeSteps;
-  spec.factory = [](const Params& kwargs) {
+  spec.factory = [](const Params& kwargs, const MakeOptions& /*options: draws on the CPU*/) {
     return std::make_unique<GridWorld>(GridWorldConfig::from_params(kwargs));
   };
   spec.describe = [](const Params& kwargs) {

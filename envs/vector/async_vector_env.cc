@@ -58,15 +58,19 @@ struct AsyncVectorEnv::Worker {
   std::condition_variable wake;
 };
 
+int AsyncVectorEnv::threads_for(int num_envs, int num_threads) {
+  return clamp_threads(num_envs, num_threads);
+}
+
 AsyncVectorEnv::AsyncVectorEnv(int num_envs, const EnvFactory& make_env, int num_threads,
-                               AutoresetMode autoreset, bool share_gl_contexts)
-    : VectorEnv("AsyncVectorEnv", num_envs, autoreset, share_gl_contexts) {
+                               AutoresetMode autoreset)
+    : BatchRunner("AsyncVectorEnv", num_envs, autoreset) {
   const int threads = clamp_threads(num_envs, num_threads);
   spin_ = threads <= static_cast<int>(std::thread::hardware_concurrency());
   for (int w = 0; w < threads; ++w) workers_.push_back(std::make_unique<Worker>());
   try {
     for (int w = 0; w < threads; ++w) workers_[w]->thread = std::thread([this, w] { work(w); });
-    build(make_env, threads);
+    build(make_env);
   } catch (...) {
     stop();
     throw;

@@ -10,40 +10,29 @@
 #include <thread>
 #include <vector>
 
-#include "envs/vector/vector_env.h"
+#include "envs/vector/batch_runner.h"
 
 namespace pixelgym::vector {
 
-/// A VectorEnv whose envs run on `num_threads()` threads, results written straight into the
+/// A BatchRunner whose envs run on `num_threads()` threads, results written straight into the
 /// shared batch buffers (each env into its own row, so threads never write the same bytes).
 ///
 /// Threads. Env i belongs to worker i % num_threads() for its whole life: that worker builds it
-/// (calls the factory), resets, steps, closes and destroys it, and its envs draw with one shared
-/// GL context (see VectorEnv: GL contexts). Worker 0's envs run on the calling thread in the calls
-/// that wait for the envs (the constructor, reset, step, close, the destructor), since the caller
-/// would otherwise sit idle: step() with T threads keeps exactly T threads busy, and with one
-/// thread it is a plain loop on the caller, as SyncVectorEnv. Only step_async hands worker 0's
-/// envs to worker thread 0, so that the caller is free until step_wait. So an env runs on one
-/// thread at a time, always the same one for workers 1..T-1, and the caller or worker thread 0
-/// (never both at once) for worker 0. That is safe because a renderer binds its GL context only
-/// for the length of each frame (render::Context: a context left bound on a thread it moved away
-/// from would be flushed, and read after it was freed, by that thread).
+/// (calls the factory), resets, steps, closes and destroys it; make_vec gives the envs of worker
+/// w the rendering resources of worker w (see make_vec). Worker 0's envs run on the calling
+/// thread in the calls that wait for the envs (the constructor, reset, step, close, the
+/// destructor), since the caller would otherwise sit idle: step() with T threads keeps exactly T
+/// threads busy, and with one thread it is a plain loop on the caller, as SyncVectorEnv. Only
+/// step_async hands worker 0's envs to worker thread 0, so that the caller is free until
+/// step_wait. So an env runs on one thread at a time, always the same one for workers 1..T-1,
+/// and the caller or worker thread 0 (never both at once) for worker 0 (a pixel env binds its GL
+/// context only for the length of each frame, render::Context, so it may move between threads).
 ///
-/// Waiting. Handing a batch to a sleeping thread and waking the caller when the last finishes
-/// costs tens of microseconds each on a VM (a futex wake is an inter-processor interrupt there),
-/// as much as a pixel step. So a worker done with a call, and the caller done with its share,
-/// first spin (pausing the core) for up to 200 microseconds for the next call or the other
-/// threads, and only then sleep on a condition variable. They spin only when the threads are no
-/// more than the cores (spinning threads would otherwise take cores from those still working).
-/// Between the steps of a learner that computes for longer, each worker spins 200 microseconds and
-/// then sleeps.
-///
-/// Speed-up. With pixel envs on OSMesa, two threads give about 1.75-1.8x one thread at 8 envs
-/// (bench/vector_bench, the README's scaling table). llvmpipe rasterizes the frames of all the
-/// contexts of one loaded libOSMesa under one lock, so threads drawing with one library take
-/// turns (a second thread added only 10-30 %); each worker w >= 1 therefore creates its contexts
-/// in private copy w of Mesa (render::MesaCopy; worker 0 uses the linked library, copy 0), and
-/// the workers rasterize in parallel.
+/// Waiting. A worker done with a call, and the caller done with its share, first spin (pausing
+/// the core) for up to 200 microseconds for the next call or the other threads, and only then
+/// sleep on a condition variable; they spin only when the threads are no more than the cores
+/// (spinning threads would otherwise take cores from those still working). Why: see
+/// docs/design-notes.md, "Vector envs".
 ///
 /// Threads: `num_threads` 0 means min(num_envs, std::thread::hardware_concurrency()); more
 /// threads than envs are clamped to num_envs (a thread without envs would only wait), not an
@@ -51,17 +40,16 @@ namespace pixelgym::vector {
 /// (8 envs on 3 threads: 3, 3, 2).
 ///
 /// Results are byte-identical to SyncVectorEnv's for the same seeds and actions, for any number
-/// of threads: envs share nothing but GL contexts (and those only between envs that run one after
-/// another), every copy of Mesa draws the same bytes, and infos are batched on the calling thread
-/// in index order.
-class AsyncVectorEnv final : public VectorEnv {
+/// of threads: the envs share nothing the runner gives them, and infos are batched on the
+/// calling thread in index order.
+class AsyncVectorEnv final : public BatchRunner {
  public:
   /// Starts the workers and builds env i with `make_env(i)` on its thread (several at once:
   /// make_env must be thread-safe). Throws std::invalid_argument for num_envs < 1, num_threads
   /// < 0 or envs whose spaces differ, and what make_env throws, naming the env index (the envs
   /// built are destroyed and the workers stopped first).
   AsyncVectorEnv(int num_envs, const EnvFactory& make_env, int num_threads = 0,
-                 AutoresetMode autoreset = AutoresetMode::kNextStep, bool share_gl_contexts = true);
+                 AutoresetMode autoreset = AutoresetMode::kNextStep);
   /// Waits for a pending step, destroys the envs on their threads and stops the workers.
   ~AsyncVectorEnv() override;
 
@@ -75,6 +63,9 @@ class AsyncVectorEnv final : public VectorEnv {
 
   /// Threads that run envs, the caller's share included (after clamping).
   int num_threads() const { return static_cast<int>(workers_.size()); }
+  /// The num_threads() an AsyncVectorEnv of `num_envs` envs asked for `num_threads` has (env i
+  /// runs on worker i % that). Throws std::invalid_argument for num_threads < 0.
+  static int threads_for(int num_envs, int num_threads);
 
  protected:
   void start_all() override;

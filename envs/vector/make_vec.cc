@@ -1,27 +1,42 @@
 #include "envs/vector/make_vec.h"
 
+#include <utility>
+#include <vector>
+
+#include "envs/described_env.h"
 #include "envs/registry.h"
 #include "envs/vector/async_vector_env.h"
 #include "envs/vector/sync_vector_env.h"
-#include "wrappers/wrapper_spec.h"
 
 namespace pixelgym::vector {
 
 std::unique_ptr<VectorEnv> make_vec(const std::string& id, int num_envs, const Params& kwargs,
-                                    const std::vector<std::string>& wrappers,
-                                    const VectorOptions& options) {
-  // Bad ids, kwargs and wrapper specs are reported here, on the calling thread, without
-  // building a world or a GL context.
-  wrappers::describe_wrapped(describe(id, kwargs), wrappers);
-  const EnvFactory make_env = [&](int /*index*/) {
-    return wrappers::apply_wrappers(make(id, kwargs), wrappers);
-  };
-  if (options.mode == VectorMode::kAsync) {
-    return std::make_unique<AsyncVectorEnv>(num_envs, make_env, options.num_threads,
-                                            options.autoreset, options.share_gl_contexts);
+                                    const EnvWrapping& wrap, const VectorOptions& options) {
+  // Bad ids, kwargs and wrappings are reported here, on the calling thread, without building a
+  // world or a GL context.
+  EnvDescription description = describe(id, kwargs);
+  if (wrap) wrap(std::make_unique<DescribedEnv>(std::move(description)));
+
+  const bool async = options.mode == VectorMode::kAsync;
+  const int threads = async ? AsyncVectorEnv::threads_for(num_envs, options.num_threads) : 1;
+  const std::shared_ptr<const EnvSpec> spec = default_registry().spec(id);
+  std::vector<MakeOptions> thread_options(static_cast<std::size_t>(threads));
+  if (spec->make_render_resources) {
+    for (int w = 0; w < threads; ++w) {
+      thread_options[static_cast<std::size_t>(w)].render =
+          spec->make_render_resources(w, options.share_gl_contexts);
+    }
   }
-  return std::make_unique<SyncVectorEnv>(num_envs, make_env, options.autoreset,
-                                         options.share_gl_contexts);
+  const EnvFactory make_env = [&](int index) {
+    std::unique_ptr<Env> env =
+        make(id, kwargs, thread_options[static_cast<std::size_t>(index % threads)]);
+    return wrap ? wrap(std::move(env)) : std::move(env);
+  };
+  if (async) {
+    return std::make_unique<AsyncVectorEnv>(num_envs, make_env, options.num_threads,
+                                            options.autoreset);
+  }
+  return std::make_unique<SyncVectorEnv>(num_envs, make_env, options.autoreset);
 }
 
 }  // namespace pixelgym::vector

@@ -1,13 +1,13 @@
-// make_vec: a vector env of a registered env, each copy with the same kwargs and wrapper stack
+// make_vec: a vector env of a registered env, each copy with the same kwargs and wrapping
 // (gymnasium.make_vec).
 #pragma once
 
 #include <memory>
 #include <string>
-#include <vector>
 
 #include "envs/params.h"
 #include "envs/vector/vector_env.h"
+#include "envs/wrapper.h"
 
 namespace pixelgym::vector {
 
@@ -23,18 +23,28 @@ struct VectorOptions {
   /// AsyncVectorEnv's worker threads: 0 for one per core; clamped to num_envs. Ignored by kSync.
   int num_threads = 0;
   AutoresetMode autoreset = AutoresetMode::kNextStep;
-  /// Whether the envs one thread runs draw with one shared GL context (see VectorEnv: GL
-  /// contexts); false gives every env its own.
+  /// Whether the envs one thread runs share their render resources' GL context (the pixel tasks:
+  /// one context per thread, whose compiled shaders, meshes and framebuffers its envs share);
+  /// false gives every env a context of its own. Frames are byte-identical either way.
   bool share_gl_contexts = true;
 };
 
-/// `num_envs` copies of `make(id, kwargs)`, each wrapped by `wrappers` (the `--wrap` text form,
-/// applied in order: the first wraps the env, the last is outermost; see
-/// wrappers::apply_wrappers), run as `options` say. Throws std::invalid_argument for an unknown
-/// id, kwarg or wrapper spec (before any env is built: the first env is described first), and
-/// as the VectorEnv constructors do.
+/// `num_envs` copies of `make(id, kwargs, options)`, each passed through `wrap` (when set; see
+/// EnvWrapping, and wrappers::wrapping for the `--wrap` text form), run as `options` say.
+///
+/// Rendering resources: make_vec owns what the envs share. For each thread that runs envs
+/// (SyncVectorEnv: one; AsyncVectorEnv: worker w runs env i when w = i % threads) it makes the
+/// spec's render resources once (EnvSpec::make_render_resources(w, share_gl_contexts)) and hands
+/// them to each env of that thread through MakeOptions. So for the pixel tasks the envs of worker
+/// w draw with copy w of Mesa (render::MesaCopy: threads with different copies rasterize in
+/// parallel) and, by default, with one GL context.
+///
+/// Errors: std::invalid_argument for an unknown id or kwarg, and for a wrapping that does not fit
+/// the env, before any env is built (the id and kwargs are described, and `wrap` is applied to a
+/// DescribedEnv stand-in: a wrapping must not reset, step or render the env it wraps); then as
+/// the SyncVectorEnv / AsyncVectorEnv constructors.
 std::unique_ptr<VectorEnv> make_vec(const std::string& id, int num_envs, const Params& kwargs = {},
-                                    const std::vector<std::string>& wrappers = {},
+                                    const EnvWrapping& wrap = nullptr,
                                     const VectorOptions& options = {});
 
 }  // namespace pixelgym::vector

@@ -4,16 +4,14 @@
 
 namespace pixelgym::vector {
 
-SyncVectorEnv::SyncVectorEnv(int num_envs, const EnvFactory& make_env, AutoresetMode autoreset,
-                             bool share_gl_contexts)
-    : VectorEnv("SyncVectorEnv", num_envs, autoreset, share_gl_contexts) {
-  build(make_env, 1);
+SyncVectorEnv::SyncVectorEnv(int num_envs, const EnvFactory& make_env, AutoresetMode autoreset)
+    : BatchRunner("SyncVectorEnv", num_envs, autoreset) {
+  build(make_env);
 }
 
-SyncVectorEnv::SyncVectorEnv(std::vector<std::unique_ptr<Env>> envs, AutoresetMode autoreset,
-                             bool share_gl_contexts)
-    : VectorEnv("SyncVectorEnv", static_cast<int>(envs.size()), autoreset, share_gl_contexts) {
-  build([&envs](int i) { return std::move(envs[static_cast<std::size_t>(i)]); }, 1);
+SyncVectorEnv::SyncVectorEnv(std::vector<std::unique_ptr<Env>> envs, AutoresetMode autoreset)
+    : BatchRunner("SyncVectorEnv", static_cast<int>(envs.size()), autoreset) {
+  build([&envs](int i) { return std::move(envs[static_cast<std::size_t>(i)]); });
 }
 
 SyncVectorEnv::~SyncVectorEnv() { destroy_envs(); }

@@ -439,7 +439,8 @@ int run_vector_bench(const BenchArguments& args) {
       args.threads == 0 ? vector::VectorMode::kSync : vector::VectorMode::kAsync, args.threads,
       vector::AutoresetMode::kNextStep};
   const std::unique_ptr<vector::VectorEnv> env =
-      vector::make_vec(args.id, args.num_envs, parse_sets(args.id, args.sets), args.wraps, options);
+      vector::make_vec(args.id, args.num_envs, parse_sets(args.id, args.sets),
+                       wrappers::wrapping(args.wraps), options);
   Rng rng(args.seed);
   std::vector<Value> actions;
   for (int k = 0; k < 64; ++k) actions.push_back(env->action_space().sample(rng));

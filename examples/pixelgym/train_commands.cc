@@ -122,7 +122,8 @@ std::unique_ptr<vector::VectorEnv> make_training_env(const RunSettings& settings
   const vector::VectorOptions options{vector::VectorMode::kAsync, settings.num_threads,
                                       vector::AutoresetMode::kSameStep, true};
   return vector::make_vec(settings.id, static_cast<int>(settings.ppo.num_envs),
-                          parse_sets(settings.id, settings.sets), settings.wraps, options);
+                          parse_sets(settings.id, settings.sets),
+                          wrappers::wrapping(settings.wraps), options);
 }
 
 std::string to_bytes(const std::function<void(std::ostream&)>& save) {

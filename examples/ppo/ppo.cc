@@ -296,9 +296,11 @@ ObservationTensors RolloutStorage::flat_observations() const {
 
 namespace {
 
-// A VectorEnv or a VectorWrapper: the same public methods, no common base.
-template <typename Env>
-std::shared_ptr<Policy> make_policy(const Env& env, const PpoConfig& config) {
+// The stats key of the trainer's own RecordEpisodeStatistics (not "episode": the env given may
+// record its own).
+const char* const kEpisodeKey = "ppo_episode";
+
+std::shared_ptr<Policy> make_policy(const vector::VectorEnv& env, const PpoConfig& config) {
   config.validate();
   if (env.autoreset_mode() != vector::AutoresetMode::kSameStep) {
     throw std::invalid_argument(
@@ -318,54 +320,41 @@ std::shared_ptr<Policy> make_policy(const Env& env, const PpoConfig& config) {
 }  // namespace
 
 Trainer::Trainer(vector::VectorEnv& env, PpoConfig config)
-    : Trainer(&env, nullptr, std::move(config)) {}
-
-Trainer::Trainer(vector::VectorWrapper& env, PpoConfig config)
-    : Trainer(nullptr, &env, std::move(config)) {}
-
-Trainer::Trainer(vector::VectorEnv* env, vector::VectorWrapper* wrapper, PpoConfig config)
-    : env_(env),
-      wrapper_(wrapper),
-      config_(std::move(config)),
-      policy_(env != nullptr ? make_policy(*env, config_) : make_policy(*wrapper, config_)),
+    : config_(std::move(config)),
+      policy_(make_policy(env, config_)),
       optimizer_(std::make_unique<torch::optim::Adam>(
           policy_->parameters(),
           torch::optim::AdamOptions(config_.learning_rate).eps(config_.adam_epsilon))),
       storage_(*policy_, config_.num_steps, config_.num_envs),
       sampling_(at::detail::createCPUGenerator(config_.seed)),
       augmentation_(at::detail::createCPUGenerator(config_.seed + 1)),
-      actions_(env != nullptr ? env->action_space().zeros() : wrapper->action_space().zeros()),
-      episode_returns_(static_cast<std::size_t>(config_.num_envs), 0.0),
-      episode_lengths_(static_cast<std::size_t>(config_.num_envs), 0) {
-  reward_scaling_.returns.assign(static_cast<std::size_t>(config_.num_envs), 0.0);
+      actions_(env.action_space().zeros()) {
   if (!actions_.is_array()) {
-    throw std::invalid_argument(
-        "Trainer: the batched action space must be an array space, got " +
-        (env != nullptr ? env->action_space() : wrapper->action_space()).to_string());
+    throw std::invalid_argument("Trainer: the batched action space must be an array space, got " +
+                                env.action_space().to_string());
   }
+  auto episodes = std::make_unique<vector::RecordEpisodeStatistics>(
+      std::make_unique<vector::VectorWrapper>(env), 1, kEpisodeKey);
+  episodes_ = episodes.get();
+  normalizer_ =
+      std::make_unique<vector::NormalizeReward>(std::move(episodes), config_.gamma, kRewardEpsilon);
 }
 
-const vector::VectorResetResult& Trainer::reset_env(std::uint64_t seed) {
-  return env_ != nullptr ? env_->reset(seed) : wrapper_->reset(seed);
+vector::VectorEnv& Trainer::stepped() {
+  if (config_.normalize_rewards) return *normalizer_;
+  return *episodes_;
 }
 
-const vector::VectorStepResult& Trainer::step_env(const Value& actions) {
-  return env_ != nullptr ? env_->step(actions) : wrapper_->step(actions);
-}
-
-void Trainer::count_episode_steps(const vector::VectorStepResult& step,
-                                  std::vector<Episode>& ended) {
-  const double* rewards = step.rewards.data<double>();
-  const bool* terminated = step.terminated.data<bool>();
-  const bool* truncated = step.truncated.data<bool>();
-  for (std::size_t i = 0; i < episode_returns_.size(); ++i) {
-    episode_returns_[i] += rewards[i];
-    episode_lengths_[i] += 1;
-    if (terminated[i] || truncated[i]) {
-      ended.push_back({episode_returns_[i], episode_lengths_[i]});
-      episode_returns_[i] = 0.0;
-      episode_lengths_[i] = 0;
-    }
+void Trainer::add_ended_episodes(const vector::VectorStepResult& step,
+                                 std::vector<Episode>& ended) const {
+  const std::string mask_key = std::string("_") + kEpisodeKey;
+  if (!step.infos.contains(mask_key)) return;
+  const bool* mask = step.infos.at(mask_key).array().data<bool>();
+  const ValueDict& stats = step.infos.at(kEpisodeKey).dict();
+  const double* returns = stats.at("r").array().data<double>();
+  const std::int64_t* lengths = stats.at("l").array().data<std::int64_t>();
+  for (std::int64_t i = 0; i < config_.num_envs; ++i) {
+    if (mask[i]) ended.push_back({returns[i], lengths[i]});
   }
 }
 
@@ -384,14 +373,12 @@ void Trainer::replay_env(const std::string& env_action_log) {
                                 std::to_string(env_action_log.size()) + " bytes");
   }
   torch::NoGradGuard no_grad;
-  current_obs_ = observation_tensors(reset_env(config_.seed).obs);
+  // Below the reward normalization, whose state comes from the checkpoint.
+  current_obs_ = observation_tensors(episodes_->reset(config_.seed).obs);
   started_ = true;
-  std::vector<Episode> ended;
   for (std::size_t b = 0; b < batches; ++b) {
     std::memcpy(env_actions.raw_data(), env_action_log.data() + b * batch_bytes, batch_bytes);
-    const vector::VectorStepResult& step = step_env(actions_);
-    count_episode_steps(step, ended);
-    current_obs_ = observation_tensors(step.obs);
+    current_obs_ = observation_tensors(episodes_->step(actions_).obs);
   }
   env_action_log_ = env_action_log;
 }
@@ -415,8 +402,10 @@ std::uint64_t Trainer::env_digest() const {
     const torch::Tensor contiguous = tensor.contiguous();
     add(contiguous.data_ptr(), contiguous.nbytes());
   }
-  add(episode_returns_.data(), episode_returns_.size() * sizeof(double));
-  add(episode_lengths_.data(), episode_lengths_.size() * sizeof(std::int64_t));
+  const std::vector<double>& returns = episodes_->episode_returns();
+  const std::vector<std::int64_t>& lengths = episodes_->episode_lengths();
+  add(returns.data(), returns.size() * sizeof(double));
+  add(lengths.data(), lengths.size() * sizeof(std::int64_t));
   return digest;
 }
 
@@ -425,7 +414,7 @@ RolloutStats Trainer::collect() {
   RolloutStats stats;
   if (!started_) {
     const auto start = Clock::now();
-    current_obs_ = observation_tensors(reset_env(config_.seed).obs);
+    current_obs_ = observation_tensors(stepped().reset(config_.seed).obs);
     stats.env_seconds += seconds_since(start);
     started_ = true;
   }
@@ -449,38 +438,24 @@ RolloutStats Trainer::collect() {
     env_action_log_.append(static_cast<const char*>(env_actions.raw_data()), env_actions.nbytes());
 
     start = Clock::now();
-    const vector::VectorStepResult& step = step_env(actions_);
+    const vector::VectorStepResult& step = stepped().step(actions_);
     stats.env_seconds += seconds_since(start);
     const double* rewards = step.rewards.data<double>();
     const bool* terminated = step.terminated.data<bool>();
     const bool* truncated = step.truncated.data<bool>();
-    count_episode_steps(step, stats.episodes);
+    add_ended_episodes(step, stats.episodes);
     // The storage tensors are contiguous (T, N): row t starts at t * N.
     float* stored_rewards = storage_.rewards.data_ptr<float>() + t * envs;
     std::uint8_t* stored_terminated = storage_.terminated.data_ptr<std::uint8_t>() + t * envs;
     std::uint8_t* stored_truncated = storage_.truncated.data_ptr<std::uint8_t>() + t * envs;
     float* stored_final_values = storage_.final_values.data_ptr<float>() + t * envs;
-    double reward_scale = 1.0;
-    if (config_.normalize_rewards) {
-      std::vector<double>& returns = reward_scaling_.returns;
-      for (std::size_t i = 0; i < returns.size(); ++i) {
-        returns[i] = config_.gamma * returns[i] + rewards[i];
-      }
-      reward_scaling_.statistics.update_batch(
-          returns.size(), [&](std::size_t row, std::size_t) { return returns[row]; });
-      reward_scale = 1.0 / std::sqrt(reward_scaling_.statistics.var[0] + kRewardEpsilon);
-    }
     std::vector<std::int64_t> bootstrap;  // envs truncated (not terminated) in this step
     for (std::int64_t n = 0; n < envs; ++n) {
-      const auto i = static_cast<std::size_t>(n);
-      stored_rewards[n] = static_cast<float>(rewards[n] * reward_scale);
+      stored_rewards[n] = static_cast<float>(rewards[n]);
       stored_terminated[n] = terminated[n] ? 1 : 0;
       stored_truncated[n] = truncated[n] ? 1 : 0;
       stored_final_values[n] = 0.0f;
-      if (terminated[n] || truncated[n]) {
-        reward_scaling_.returns[i] = 0.0;
-        if (!terminated[n]) bootstrap.push_back(n);
-      }
+      if (truncated[n] && !terminated[n]) bootstrap.push_back(n);
     }
     if (!bootstrap.empty()) {
       if (!step.infos.contains("final_obs")) {
@@ -675,6 +650,10 @@ void Trainer::set_progress(std::int64_t env_steps, std::int64_t updates) {
   updates_ = updates;
 }
 
+RewardScaling Trainer::reward_scaling() const {
+  return {normalizer_->statistics(), normalizer_->discounted_returns()};
+}
+
 void Trainer::set_reward_scaling(RewardScaling scaling) {
   const std::string invalid = scaling.statistics.invalid_reason(1);
   if (!invalid.empty()) {
@@ -691,7 +670,8 @@ void Trainer::set_reward_scaling(RewardScaling scaling) {
                                   std::to_string(r));
     }
   }
-  reward_scaling_ = std::move(scaling);
+  normalizer_->set_statistics(std::move(scaling.statistics));
+  normalizer_->set_discounted_returns(std::move(scaling.returns));
 }
 
 TrainerRngState Trainer::rng_state() const {

@@ -11,7 +11,8 @@
 #include <vector>
 
 #include "envs/vector/vector_env.h"
-#include "envs/vector/wrappers/vector_wrapper.h"
+#include "envs/vector/wrappers/normalize_reward.h"
+#include "envs/vector/wrappers/record_episode_statistics.h"
 #include "examples/ppo/policy.h"
 #include "wrappers/running_statistics.h"
 
@@ -177,8 +178,8 @@ struct RewardScaling {
 /// Trains a Policy with PPO on a vector env: `collect()` steps the env for one rollout,
 /// `update()` learns from it; `iterate()` does both.
 ///
-/// The env is a VectorEnv or a VectorWrapper over one (RecordEpisodeStatistics, NormalizeReward:
-/// the trainer learns from the rewards it is given, and its Episode records sum those). It must
+/// The env is any VectorEnv (a vector wrapper over one included: the trainer learns from the
+/// rewards it is given, and its Episode records sum those). It must
 /// autoreset in SameStep mode (make_vec's VectorOptions::autoreset =
 /// AutoresetMode::kSameStep): a truncated step's final observation comes from
 /// infos["final_obs"], whose value bootstraps the step's return (see compute_gae). Its
@@ -191,11 +192,12 @@ struct RewardScaling {
 /// from another seeded with config.seed + 1; the envs reset with config.seed on the first
 /// collect(). Same seed, same env, same torch thread count: same parameters.
 ///
-/// Reward normalization (config.normalize_rewards): each env keeps its discounted return
-/// R_i = gamma R_i + r_i, every step merges the batch's R_i into one RunningStatistics, and the
-/// rollout stores r_i / sqrt(var + 1e-8): exactly the rewards vector::NormalizeReward gives
-/// under SameStep autoreset (R_i restarts after a step that ends env i's episode). Values,
-/// advantages and returns are on that scale; RolloutStats's Episode returns are the env's.
+/// The trainer steps the env through vector wrappers of its own: a vector::RecordEpisodeStatistics
+/// (its Episode records and env_digest's episodes in progress), and, with config.normalize_rewards,
+/// a vector::NormalizeReward (gamma config.gamma, epsilon 1e-8) over that: the rollout stores
+/// r_i / sqrt(var + 1e-8) of the discounted returns R_i = gamma R_i + r_i, R_i restarting after a
+/// step that ends env i's episode. Values, advantages and returns are on that scale;
+/// RolloutStats's Episode returns are the env's.
 ///
 /// Observation normalization: after each update the rollout's observations are merged into
 /// the policy's statistics (Policy::update_observation_statistics), so the next rollout acts
@@ -205,7 +207,6 @@ class Trainer {
   /// Throws std::invalid_argument when config.validate() fails, when the env's autoreset mode
   /// is not SameStep or its num_envs differs from config.num_envs, and as Policy's constructor.
   Trainer(vector::VectorEnv& env, PpoConfig config);
-  Trainer(vector::VectorWrapper& env, PpoConfig config);
 
   /// Steps every env num_steps times with actions sampled from the policy (no gradients),
   /// storing the transitions and the values GAE needs, then computes advantages and returns.
@@ -233,10 +234,11 @@ class Trainer {
   /// The learning rate the next update uses.
   double learning_rate() const;
 
-  /// The reward normalization's state (checkpoints), and its restore: throws
-  /// std::invalid_argument when the statistics are not valid statistics of one element or
-  /// `returns` has not num_envs entries (nothing changes then).
-  const RewardScaling& reward_scaling() const { return reward_scaling_; }
+  /// The reward normalization's state (checkpoints): its NormalizeReward's statistics and
+  /// discounted returns. Its restore throws std::invalid_argument when the statistics are not
+  /// valid statistics of one element or `returns` has not num_envs finite entries (nothing
+  /// changes then).
+  RewardScaling reward_scaling() const;
   void set_reward_scaling(RewardScaling scaling);
 
   TrainerRngState rng_state() const;
@@ -268,14 +270,14 @@ class Trainer {
   std::uint64_t env_digest() const;
 
  private:
-  Trainer(vector::VectorEnv* env, vector::VectorWrapper* wrapper, PpoConfig config);
-  const vector::VectorResetResult& reset_env(std::uint64_t seed);
-  const vector::VectorStepResult& step_env(const Value& actions);
-  // Adds a step's rewards to the episodes in progress; appends those that ended to `ended`.
-  void count_episode_steps(const vector::VectorStepResult& step, std::vector<Episode>& ended);
+  // The env the trainer steps: normalizer_ when it normalizes rewards, else episodes_.
+  vector::VectorEnv& stepped();
+  // Appends the episodes that `step` ended (episodes_'s infos) to `ended`.
+  void add_ended_episodes(const vector::VectorStepResult& step, std::vector<Episode>& ended) const;
 
-  vector::VectorEnv* env_;  // exactly one of env_ and wrapper_ is set
-  vector::VectorWrapper* wrapper_;
+  // The trainer's wrappers over the given env: normalizer_ owns episodes_, which borrows the env.
+  std::unique_ptr<vector::NormalizeReward> normalizer_;
+  vector::RecordEpisodeStatistics* episodes_;
   PpoConfig config_;
   std::shared_ptr<Policy> policy_;
   std::unique_ptr<torch::optim::Adam> optimizer_;
@@ -284,9 +286,6 @@ class Trainer {
   at::Generator augmentation_;
   Value actions_;                   // laid out as env_.action_space()
   ObservationTensors current_obs_;  // views of the env's observation batch
-  std::vector<double> episode_returns_;
-  std::vector<std::int64_t> episode_lengths_;
-  RewardScaling reward_scaling_;
   std::string env_action_log_;
   bool started_ = false;
   bool collected_ = false;

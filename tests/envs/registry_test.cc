@@ -16,7 +16,7 @@ EnvSpec probe_spec(const std::string& id) {
   spec.id = id;
   spec.description = "probe";
   spec.params = {{"episode_length", 20, "steps until terminated"}, {"gain", 0.1, "unused"}};
-  spec.factory = [](const Params& kwargs) {
+  spec.factory = [](const Params& kwargs, const MakeOptions& /*options*/) {
     return std::make_unique<testing::ProbeEnv>(
         testing::Fault::kNone, static_cast<int>(kwargs.at("episode_length").as_int()));
   };

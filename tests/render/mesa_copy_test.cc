@@ -51,31 +51,28 @@ Frame draw(Renderer& renderer, float offset) {
 
 // The frames of one renderer made in copy `copy` on this thread.
 std::vector<Frame> frames_with_copy(int copy, int count) {
-  const MesaCopy::Use use(copy);
-  Renderer renderer;
+  Renderer renderer(GlBackend::kOSMesa, copy);
   std::vector<Frame> frames;
   for (int f = 0; f < count; ++f) frames.push_back(draw(renderer, 0.05F * static_cast<float>(f)));
   return frames;
 }
 
-TEST(MesaCopyTest, AContextIsOfTheCopySelectedOnItsThread) {
-  EXPECT_EQ(MesaCopy::in_use(), 0);
+TEST(MesaCopyTest, AContextIsOfTheCopyItIsGiven) {
   {
     const Context linked;
     EXPECT_EQ(linked.mesa_copy(), 0);
   }
-  const MesaCopy::Use use(1);
-  EXPECT_EQ(MesaCopy::in_use(), 1);
-  const Context first;
+  const Context first(GlBackend::kOSMesa, 1);
   EXPECT_EQ(first.mesa_copy(), 1) << MesaCopy::why_not(1);
   EXPECT_TRUE(MesaCopy::loaded(1));
   {
-    const MesaCopy::Use nested(2);
-    const Context second;
+    const Context second(GlBackend::kOSMesa, 2);
     EXPECT_EQ(second.mesa_copy(), 2) << MesaCopy::why_not(2);
   }
-  EXPECT_EQ(MesaCopy::in_use(), 1);
-  EXPECT_THROW(MesaCopy::Use(-1), std::invalid_argument);
+  // A group's renderers draw with contexts of the group's copy.
+  ContextGroup group(2);
+  EXPECT_EQ(group.mesa_copy(), 2);
+  EXPECT_THROW(Context(GlBackend::kOSMesa, -1), std::invalid_argument);
 }
 
 TEST(MesaCopyTest, EveryCopyDrawsTheSameBytes) {
@@ -115,10 +112,7 @@ TEST(MesaCopyTest, ThreadsDrawWithDifferentCopiesAtOnce) {
 // worker 0 envs move between the caller and worker thread 0).
 TEST(MesaCopyTest, ARendererOfACopyMovesBetweenThreads) {
   const std::vector<Frame> expected = frames_with_copy(0, 2);
-  auto renderer = [] {
-    const MesaCopy::Use use(6);
-    return std::make_unique<Renderer>();
-  }();
+  auto renderer = std::make_unique<Renderer>(GlBackend::kOSMesa, 6);
   Frame first;
   std::thread([&] { first = draw(*renderer, 0.0F); }).join();
   EXPECT_TRUE(first == expected[0]);
@@ -133,15 +127,9 @@ TEST(MesaCopyTest, CopyNumbersWrapAtTheLimitAndTheLimitIsChecked) {
   setenv("PIXELGYM_MESA_COPIES", "3", 1);
   EXPECT_EQ(MesaCopy::max_copies(), 3);
   EXPECT_EQ(MesaCopy::resolve(4), 1);
-  {
-    const MesaCopy::Use use(5);
-    EXPECT_EQ(Context().mesa_copy(), 2);
-  }
+  EXPECT_EQ(Context(GlBackend::kOSMesa, 5).mesa_copy(), 2);
   setenv("PIXELGYM_MESA_COPIES", "1", 1);  // no private copies
-  {
-    const MesaCopy::Use use(1);
-    EXPECT_EQ(Context().mesa_copy(), 0);
-  }
+  EXPECT_EQ(Context(GlBackend::kOSMesa, 1).mesa_copy(), 0);
   for (const char* bad : {"0", "17", "two", "2x", "-1"}) {
     setenv("PIXELGYM_MESA_COPIES", bad, 1);
     try {
@@ -152,8 +140,7 @@ TEST(MesaCopyTest, CopyNumbersWrapAtTheLimitAndTheLimitIsChecked) {
                   HasSubstr("PIXELGYM_MESA_COPIES must be a whole number from 1 to 16"));
       EXPECT_THAT(error.what(), HasSubstr(std::string("got \"") + bad + "\""));
     }
-    const MesaCopy::Use use(1);
-    EXPECT_THROW(Context(), std::invalid_argument) << bad;
+    EXPECT_THROW(Context(GlBackend::kOSMesa, 1), std::invalid_argument) << bad;
   }
   unsetenv("PIXELGYM_MESA_COPIES");
   EXPECT_THROW(MesaCopy::resolve(-1), std::invalid_argument);

@@ -52,7 +52,7 @@ void normalize_row(const T* x, float* y, const RunningStatistics& statistics, do
 
 }  // namespace
 
-NormalizeObservation::NormalizeObservation(InnerVectorEnv env, const std::string& key,
+NormalizeObservation::NormalizeObservation(std::unique_ptr<VectorEnv> env, const std::string& key,
                                            double epsilon)
     : VectorWrapper(std::move(env)), epsilon_(epsilon) {
   if (!std::isfinite(epsilon) || !(epsilon > 0.0)) {

@@ -47,7 +47,7 @@ class NormalizeObservation final : public VectorWrapper {
   /// Throws std::invalid_argument as wrappers::find_box when `key` does not name a Box of the
   /// single observation space (empty `key`: the space itself must be a Box), for a bool Box, and
   /// unless epsilon is finite and > 0.
-  explicit NormalizeObservation(InnerVectorEnv env, const std::string& key = "",
+  explicit NormalizeObservation(std::unique_ptr<VectorEnv> env, const std::string& key = "",
                                 double epsilon = 1e-8);
 
   const std::string& key() const { return where_.key; }

@@ -7,7 +7,7 @@
 
 namespace pixelgym::vector {
 
-NormalizeReward::NormalizeReward(InnerVectorEnv env, double gamma, double epsilon)
+NormalizeReward::NormalizeReward(std::unique_ptr<VectorEnv> env, double gamma, double epsilon)
     : VectorWrapper(std::move(env)), gamma_(gamma), epsilon_(epsilon) {
   if (!(gamma >= 0.0 && gamma <= 1.0)) {
     std::ostringstream text;
@@ -33,6 +33,20 @@ void NormalizeReward::set_statistics(wrappers::RunningStatistics statistics) {
     throw std::invalid_argument("NormalizeReward: statistics for 1 element expected: " + reason);
   }
   statistics_ = std::move(statistics);
+}
+
+void NormalizeReward::set_discounted_returns(std::vector<double> returns) {
+  if (returns.size() != returns_.size()) {
+    throw std::invalid_argument("NormalizeReward: " + std::to_string(returns_.size()) +
+                                " discounted returns expected (num_envs), got " +
+                                std::to_string(returns.size()));
+  }
+  for (const double r : returns) {
+    if (!std::isfinite(r)) {
+      throw std::invalid_argument("NormalizeReward: a discounted return is " + std::to_string(r));
+    }
+  }
+  returns_ = std::move(returns);
 }
 
 const VectorResetResult& NormalizeReward::do_reset(std::optional<std::uint64_t> seed,

@@ -33,12 +33,16 @@ namespace pixelgym::vector {
 class NormalizeReward final : public VectorWrapper {
  public:
   /// Throws std::invalid_argument unless 0 <= gamma <= 1 and epsilon is finite and > 0.
-  explicit NormalizeReward(InnerVectorEnv env, double gamma = 0.99, double epsilon = 1e-8);
+  explicit NormalizeReward(std::unique_ptr<VectorEnv> env, double gamma = 0.99,
+                           double epsilon = 1e-8);
 
   double gamma() const { return gamma_; }
   double epsilon() const { return epsilon_; }
   /// Each env's discounted return R_i of its current episode so far (num_envs entries).
   const std::vector<double>& discounted_returns() const { return returns_; }
+  /// Replaces them (restoring a checkpoint). Throws std::invalid_argument naming the wrapper
+  /// unless `returns` has num_envs entries, all finite; nothing changes then.
+  void set_discounted_returns(std::vector<double> returns);
 
   /// Whether steps update the statistics (true at construction).
   bool update_statistics() const { return update_statistics_; }

@@ -6,7 +6,8 @@
 
 namespace pixelgym::vector {
 
-RecordEpisodeStatistics::RecordEpisodeStatistics(InnerVectorEnv env, std::int64_t buffer_length,
+RecordEpisodeStatistics::RecordEpisodeStatistics(std::unique_ptr<VectorEnv> env,
+                                                 std::int64_t buffer_length,
                                                  const std::string& stats_key)
     : VectorWrapper(std::move(env)),
       buffer_length_(buffer_length),
@@ -76,11 +77,9 @@ const VectorStepResult& RecordEpisodeStatistics::do_step(const Value& actions) {
 
   Info& infos = result_.infos;
   if (infos.contains(stats_key_) || infos.contains(mask_key_)) {
-    throw std::runtime_error(
-        "RecordEpisodeStatistics: infos already hold \"" +
-        (infos.contains(stats_key_) ? stats_key_ : mask_key_) + "\" from " +
-        (inner_wrapper() != nullptr ? inner_wrapper()->name() : unwrapped().name()) +
-        "; give another stats_key");
+    throw std::runtime_error("RecordEpisodeStatistics: infos already hold \"" +
+                             (infos.contains(stats_key_) ? stats_key_ : mask_key_) + "\" from " +
+                             this->inner().name() + "; give another stats_key");
   }
   const auto count = static_cast<std::int64_t>(n);
   Array r(DType::kFloat64, {count});

@@ -47,7 +47,7 @@ namespace pixelgym::vector {
 class RecordEpisodeStatistics final : public VectorWrapper {
  public:
   /// Throws std::invalid_argument unless buffer_length >= 1 and stats_key is not empty.
-  explicit RecordEpisodeStatistics(InnerVectorEnv env, std::int64_t buffer_length = 100,
+  explicit RecordEpisodeStatistics(std::unique_ptr<VectorEnv> env, std::int64_t buffer_length = 100,
                                    const std::string& stats_key = "episode");
 
   std::int64_t buffer_length() const { return buffer_length_; }

@@ -39,81 +39,26 @@ bool same_views(const Value& a, const Value& b) {
 
 }  // namespace
 
-VectorWrapper::VectorWrapper(InnerVectorEnv env)
-    : env_(std::move(env.env)), wrapper_(std::move(env.wrapper)) {
-  if (env_ == nullptr && wrapper_ == nullptr) {
-    throw std::invalid_argument("VectorWrapper: the vector env to wrap is null");
-  }
+VectorWrapper::VectorWrapper(std::unique_ptr<VectorEnv> env)
+    : owned_(std::move(env)), env_(owned_.get()) {
+  if (env_ == nullptr) throw std::invalid_argument("VectorWrapper: the vector env to wrap is null");
 }
+
+VectorWrapper::VectorWrapper(VectorEnv& env) : env_(&env) {}
 
 VectorWrapper::~VectorWrapper() = default;
 
-const VectorResetResult& VectorWrapper::reset(std::optional<std::uint64_t> seed,
-                                              const Options& options) {
-  return do_reset(seed, options, nullptr);
-}
-
-const VectorResetResult& VectorWrapper::reset(std::optional<std::uint64_t> seed,
-                                              const Options& options, const Array& reset_mask) {
-  return do_reset(seed, options, &reset_mask);
-}
-
-const VectorStepResult& VectorWrapper::step(const Value& actions) { return do_step(actions); }
-
-void VectorWrapper::close() {
-  if (wrapper_ != nullptr) {
-    wrapper_->close();
-  } else {
-    env_->close();
-  }
-}
-
-int VectorWrapper::num_envs() const {
-  return wrapper_ != nullptr ? wrapper_->num_envs() : env_->num_envs();
-}
-
 const Space& VectorWrapper::single_observation_space() const {
   if (single_observation_space_ != nullptr) return *single_observation_space_;
-  return wrapper_ != nullptr ? wrapper_->single_observation_space()
-                             : env_->single_observation_space();
-}
-
-const Space& VectorWrapper::single_action_space() const {
-  return wrapper_ != nullptr ? wrapper_->single_action_space() : env_->single_action_space();
+  return env_->single_observation_space();
 }
 
 const Space& VectorWrapper::observation_space() const {
   if (observation_space_ != nullptr) return *observation_space_;
-  return wrapper_ != nullptr ? wrapper_->observation_space() : env_->observation_space();
+  return env_->observation_space();
 }
 
-const Space& VectorWrapper::action_space() const {
-  return wrapper_ != nullptr ? wrapper_->action_space() : env_->action_space();
-}
-
-const VectorMetadata& VectorWrapper::metadata() const {
-  return wrapper_ != nullptr ? wrapper_->metadata() : env_->metadata();
-}
-
-bool VectorWrapper::closed() const {
-  return wrapper_ != nullptr ? wrapper_->closed() : env_->closed();
-}
-
-std::string VectorWrapper::name() const {
-  return type_name() + "<" + (wrapper_ != nullptr ? wrapper_->name() : env_->name()) + ">";
-}
-
-const Env& VectorWrapper::env(int i) const {
-  return wrapper_ != nullptr ? wrapper_->env(i) : env_->env(i);
-}
-
-VectorEnv& VectorWrapper::unwrapped() {
-  return wrapper_ != nullptr ? wrapper_->unwrapped() : *env_;
-}
-
-const VectorEnv& VectorWrapper::unwrapped() const {
-  return wrapper_ != nullptr ? wrapper_->unwrapped() : *env_;
-}
+std::string VectorWrapper::name() const { return type_name() + "<" + env_->name() + ">"; }
 
 const VectorResetResult& VectorWrapper::do_reset(std::optional<std::uint64_t> seed,
                                                  const Options& options, const Array* reset_mask) {
@@ -125,16 +70,8 @@ const VectorStepResult& VectorWrapper::do_step(const Value& actions) { return st
 const VectorResetResult& VectorWrapper::reset_inner(std::optional<std::uint64_t> seed,
                                                     const Options& options,
                                                     const Array* reset_mask) {
-  if (wrapper_ != nullptr) {
-    return reset_mask != nullptr ? wrapper_->reset(seed, options, *reset_mask)
-                                 : wrapper_->reset(seed, options);
-  }
   return reset_mask != nullptr ? env_->reset(seed, options, *reset_mask)
                                : env_->reset(seed, options);
-}
-
-const VectorStepResult& VectorWrapper::step_inner(const Value& actions) {
-  return wrapper_ != nullptr ? wrapper_->step(actions) : env_->step(actions);
 }
 
 void VectorWrapper::set_single_observation_space(SpacePtr space) {

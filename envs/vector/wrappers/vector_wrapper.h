@@ -24,102 +24,70 @@
 #include <memory>
 #include <optional>
 #include <string>
-#include <type_traits>
-#include <utility>
 
 #include "envs/vector/vector_env.h"
 
 namespace pixelgym::vector {
 
-class VectorWrapper;
-
-/// What a VectorWrapper wraps, taken from either owner: a `std::unique_ptr` to a VectorEnv
-/// (SyncVectorEnv, AsyncVectorEnv, what make_vec returns) or to a VectorWrapper (any subclass),
-/// so that wrappers stack: `NormalizeReward(std::make_unique<RecordEpisodeStatistics>(make_vec(
-/// ...)))`.
-struct InnerVectorEnv {
-  template <typename V, std::enable_if_t<std::is_base_of_v<VectorEnv, V>, int> = 0>
-  InnerVectorEnv(std::unique_ptr<V> vector_env)  // NOLINT(google-explicit-constructor)
-      : env(std::move(vector_env)) {}
-  template <typename V, std::enable_if_t<std::is_base_of_v<VectorWrapper, V>, int> = 0>
-  InnerVectorEnv(std::unique_ptr<V> vector_wrapper)  // NOLINT(google-explicit-constructor)
-      : wrapper(std::move(vector_wrapper)) {}
-
-  std::unique_ptr<VectorEnv> env;  // at most one of the two is set
-  std::unique_ptr<VectorWrapper> wrapper;
-};
-
-/// A vector env that owns another (a VectorEnv, or another VectorWrapper) and forwards every
-/// call to it: reset (both forms), step, close, the spaces, metadata, num_envs. Subclasses
-/// override the do_* hooks that change something, as Env's wrappers do.
+/// A VectorEnv that holds another (a BatchRunner, or another VectorWrapper) and forwards every
+/// call to it: reset (both forms), step, close, the spaces, metadata, num_envs
+/// (gymnasium.vector.VectorWrapper). Subclasses override the do_* hooks that change something,
+/// as Env's wrappers do; wrappers stack:
+/// `NormalizeReward(std::make_unique<RecordEpisodeStatistics>( make_vec(...)))`.
 ///
-/// Not a VectorEnv subclass: VectorEnv owns its envs and buffers and its public methods are not
-/// virtual, so a wrapper could not stand in for one. VectorWrapper has the same public methods
-/// with the same names and meanings instead, so code written as a template over the vector env
-/// type takes either; `unwrapped()` reaches the VectorEnv underneath.
-///
-/// Results. As VectorEnv's, the results are views of buffers that the next reset or step
+/// Results. As every VectorEnv's, the results are views of buffers that the next reset or step
 /// overwrites; a wrapper's are its own (or its inner env's, for what it leaves unchanged), bound
 /// once: forwarding a result allocates nothing unless infos are not empty (their Dict is copied
-/// then, as VectorEnv builds it then). Steps go through the inner env's `step()`
+/// then, as BatchRunner builds it then). Steps go through the inner env's `step()`
 /// (AsyncVectorEnv's step_async / step_wait are not forwarded).
 ///
 /// Errors: what the inner env throws, unchanged (ResetNeeded for calls out of order, actions not
 /// laid out as action_space(), a failed env). One thread at a time calls a vector wrapper.
-class VectorWrapper {
+class VectorWrapper : public VectorEnv {
  public:
-  /// Throws std::invalid_argument when `env` holds no env (a null pointer).
-  explicit VectorWrapper(InnerVectorEnv env);
-  virtual ~VectorWrapper();
-  VectorWrapper(const VectorWrapper&) = delete;
-  VectorWrapper& operator=(const VectorWrapper&) = delete;
+  /// Owns `env`. Throws std::invalid_argument when `env` is null.
+  explicit VectorWrapper(std::unique_ptr<VectorEnv> env);
+  /// Wraps `env` without owning it: the caller keeps it alive for the wrapper's life (as a
+  /// Gymnasium wrapper holds a reference). For code that is handed a VectorEnv& and adds a
+  /// wrapper of its own around it (ppo::Trainer).
+  explicit VectorWrapper(VectorEnv& env);
+  ~VectorWrapper() override;
 
-  /// As VectorEnv::reset: every env (env i seeded with `seed + i` when a seed is given).
-  const VectorResetResult& reset(std::optional<std::uint64_t> seed = std::nullopt,
-                                 const Options& options = {});
-  /// As VectorEnv::reset with a mask: the envs whose entry of `reset_mask` is true.
-  const VectorResetResult& reset(std::optional<std::uint64_t> seed, const Options& options,
-                                 const Array& reset_mask);
-  /// As VectorEnv::step.
-  const VectorStepResult& step(const Value& actions);
   /// Closes the inner env (calling it again does nothing).
-  void close();
+  void close() override { env_->close(); }
 
-  int num_envs() const;
+  int num_envs() const override { return env_->num_envs(); }
   /// The spaces as this wrapper changes them (the inner env's when it does not).
-  const Space& single_observation_space() const;
-  const Space& single_action_space() const;
-  const Space& observation_space() const;
-  const Space& action_space() const;
-  const VectorMetadata& metadata() const;
-  AutoresetMode autoreset_mode() const { return metadata().autoreset_mode; }
-  bool closed() const;
+  const Space& single_observation_space() const override;
+  const Space& single_action_space() const override { return env_->single_action_space(); }
+  const Space& observation_space() const override;
+  const Space& action_space() const override { return env_->action_space(); }
+  const VectorMetadata& metadata() const override { return env_->metadata(); }
+  bool closed() const override { return env_->closed(); }
   /// "NormalizeReward<SyncVectorEnv(CartPoleSwingup-v0, num_envs=4)>".
-  std::string name() const;
-  /// Env `i` of the VectorEnv underneath (see VectorEnv::env). Throws std::out_of_range.
-  const Env& env(int i) const;
+  std::string name() const override;
+  /// Env `i` of the VectorEnv underneath. Throws std::out_of_range.
+  const Env& env(int i) const override { return env_->env(i); }
 
   /// The VectorEnv beneath every wrapper.
-  VectorEnv& unwrapped();
-  const VectorEnv& unwrapped() const;
-  /// The wrapper one level in; null when this one wraps the VectorEnv itself.
-  VectorWrapper* inner_wrapper() { return wrapper_.get(); }
-  const VectorWrapper* inner_wrapper() const { return wrapper_.get(); }
+  VectorEnv& unwrapped() override { return env_->unwrapped(); }
+  const VectorEnv& unwrapped() const override { return env_->unwrapped(); }
+  /// The env one level in.
+  VectorEnv& inner() { return *env_; }
+  const VectorEnv& inner() const { return *env_; }
 
  protected:
   /// The class name used in name().
   virtual std::string type_name() const { return "VectorWrapper"; }
-  /// reset: `reset_mask` null for every env, else the mask (already checked by the inner env
-  /// when reset_inner returns). The default returns the inner env's result.
-  virtual const VectorResetResult& do_reset(std::optional<std::uint64_t> seed,
-                                            const Options& options, const Array* reset_mask);
-  /// step. The default returns the inner env's result.
-  virtual const VectorStepResult& do_step(const Value& actions);
+  /// The defaults return the inner env's results.
+  const VectorResetResult& do_reset(std::optional<std::uint64_t> seed, const Options& options,
+                                    const Array* reset_mask) override;
+  const VectorStepResult& do_step(const Value& actions) override;
 
   /// The inner env's reset (with the mask when not null) and step.
   const VectorResetResult& reset_inner(std::optional<std::uint64_t> seed, const Options& options,
                                        const Array* reset_mask);
-  const VectorStepResult& step_inner(const Value& actions);
+  const VectorStepResult& step_inner(const Value& actions) { return env_->step(actions); }
 
   /// Replaces the single observation space (from a subclass constructor); the batched one
   /// becomes batch_space(space, num_envs()). Throws as batch_space.
@@ -137,8 +105,8 @@ class VectorWrapper {
   static void forward(const VectorStepResult& inner, VectorStepResult& out);
 
  private:
-  std::unique_ptr<VectorEnv> env_;  // exactly one of env_ and wrapper_ is set
-  std::unique_ptr<VectorWrapper> wrapper_;
+  std::unique_ptr<VectorEnv> owned_;  // null when the wrapper borrows its env
+  VectorEnv* env_;
   SpacePtr single_observation_space_;  // null: the inner env's
   SpacePtr observation_space_;
 };

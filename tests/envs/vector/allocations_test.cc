@@ -19,6 +19,7 @@
 #include "envs/vector/make_vec.h"
 #include "tests/alloc_counter.h"
 #include "tests/envs/env_ids.h"
+#include "wrappers/wrapper_spec.h"
 
 namespace pixelgym::vector {
 namespace {
@@ -61,7 +62,7 @@ void expect_no_allocations(const std::string& id, const std::vector<std::string>
   for (const int threads : {0, 2}) {
     const VectorOptions options{threads == 0 ? VectorMode::kSync : VectorMode::kAsync, threads,
                                 AutoresetMode::kNextStep};
-    const auto env = make_vec(id, 2, {}, wrappers, options);
+    const auto env = make_vec(id, 2, {}, pixelgym::wrappers::wrapping(wrappers), options);
     int counted = 0;
     const AllocCounts counts = count_step_allocations(*env, 20, 60, counted);
     EXPECT_GE(counted, 30) << id << ": too few steps counted";

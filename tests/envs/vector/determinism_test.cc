@@ -100,7 +100,8 @@ TEST_P(VectorDeterminismTest, SyncAndPoolsEqualSingleEnvsByteForByte) {
   for (const int num_envs : {1, 3, 8}) {
     std::vector<Value> actions;
     {
-      const auto probe = make_vec(c.id, num_envs, c.kwargs, c.wrappers);
+      const auto probe =
+          make_vec(c.id, num_envs, c.kwargs, pixelgym::wrappers::wrapping(c.wrappers));
       actions = batched_actions(probe->action_space());
     }
     const Trajectory expected = one_by_one(c, num_envs, actions);
@@ -119,7 +120,8 @@ TEST_P(VectorDeterminismTest, SyncAndPoolsEqualSingleEnvsByteForByte) {
           (shared ? "" : ", a GL context per env");
       const VectorOptions options{threads == 0 ? VectorMode::kSync : VectorMode::kAsync, threads,
                                   AutoresetMode::kNextStep, shared};
-      const auto env = make_vec(c.id, num_envs, c.kwargs, c.wrappers, options);
+      const auto env =
+          make_vec(c.id, num_envs, c.kwargs, pixelgym::wrappers::wrapping(c.wrappers), options);
       auto* pool = dynamic_cast<AsyncVectorEnv*>(env.get());
       expect_same(expected, *env, env->reset(kSeed).obs, nullptr, 0, runner);
       for (int t = 0; t < kSteps; ++t) {
@@ -175,7 +177,7 @@ TEST_P(VectorDeterminismTest, SameStepAndDisabledEqualSingleEnvsByteForByte) {
   const int num_envs = 3;
   std::vector<Value> actions;
   {
-    const auto probe = make_vec(c.id, num_envs, c.kwargs, c.wrappers);
+    const auto probe = make_vec(c.id, num_envs, c.kwargs, pixelgym::wrappers::wrapping(c.wrappers));
     actions = batched_actions(probe->action_space());
   }
   const auto expected = one_by_one_same_step(c, num_envs, actions);
@@ -186,7 +188,8 @@ TEST_P(VectorDeterminismTest, SameStepAndDisabledEqualSingleEnvsByteForByte) {
           (threads == 0 ? std::string("sync") : std::to_string(threads) + " threads");
       const VectorOptions options{threads == 0 ? VectorMode::kSync : VectorMode::kAsync, threads,
                                   mode};
-      const auto env = make_vec(c.id, num_envs, c.kwargs, c.wrappers, options);
+      const auto env =
+          make_vec(c.id, num_envs, c.kwargs, pixelgym::wrappers::wrapping(c.wrappers), options);
       const Value& first = env->reset(kSeed).obs;
       for (int i = 0; i < num_envs; ++i) {
         EXPECT_TRUE(batch_slot(first, i).equals(expected[0][static_cast<std::size_t>(i)].step.obs))

@@ -10,6 +10,7 @@
 #include "envs/spaces/dict.h"
 #include "envs/vector/make_vec.h"
 #include "tests/envs/vector/vector_test_util.h"
+#include "wrappers/wrapper_spec.h"
 
 namespace pixelgym::vector {
 namespace {
@@ -220,14 +221,15 @@ TEST(AsyncVectorEnvTest, StepWaitReportsTheLowestFailingEnvAfterEveryEnvStepped)
 TEST(MakeVecTest, BadIdsKwargsAndWrappersAreReportedBeforeBuilding) {
   EXPECT_THROW(make_vec("NoSuchEnv-v0", 2), std::invalid_argument);
   EXPECT_THROW(make_vec("GridWorld-v0", 2, {{"no_such_kwarg", 1}}), std::invalid_argument);
-  EXPECT_THROW(make_vec("GridWorld-v0", 2, {}, {"no_such_wrapper"}), std::invalid_argument);
+  EXPECT_THROW(make_vec("GridWorld-v0", 2, {}, pixelgym::wrappers::wrapping({"no_such_wrapper"})),
+               std::invalid_argument);
   EXPECT_THROW(make_vec("GridWorld-v0", 0), std::invalid_argument);
 }
 
 TEST(MakeVecTest, BuildsTheWrappedEnvs) {
-  auto env =
-      make_vec("CartPoleSwingup-v0", 2, {{"width", 32}, {"height", 32}, {"obs_mode", "pixels"}},
-               {"grayscale", "frame_stack=3"}, {VectorMode::kAsync, 2});
+  auto env = make_vec(
+      "CartPoleSwingup-v0", 2, {{"width", 32}, {"height", 32}, {"obs_mode", "pixels"}},
+      pixelgym::wrappers::wrapping({"grayscale", "frame_stack=3"}), {VectorMode::kAsync, 2});
   EXPECT_EQ(env->name(), "AsyncVectorEnv(CartPoleSwingup-v0, num_envs=2)");
   const auto& single = dynamic_cast<const spaces::Dict&>(env->single_observation_space());
   EXPECT_EQ(single.at("pixels").shape(), (Shape{3, 32, 32}));

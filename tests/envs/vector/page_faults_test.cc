@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "envs/pixel_env.h"
 #include "envs/registry.h"
 #include "envs/rng.h"
 #include "render/mesa_copy.h"
@@ -30,8 +31,8 @@ long page_faults_on_this_thread() {
 // page while other tests load the machine, say) comes now and then, and the fewest leaves it out.
 long fewest_page_faults_stepping(const std::string& id, int copy, int warmup, int steps,
                                  int windows) {
-  const render::MesaCopy::Use use(copy);
-  std::unique_ptr<Env> env = make(id);
+  std::unique_ptr<Env> env =
+      make(id, {}, MakeOptions{std::make_shared<PixelRenderResources>(copy, false)});
   Rng rng(3);
   std::vector<Value> actions;
   for (int k = 0; k < 64; ++k) actions.push_back(env->action_space().sample(rng));

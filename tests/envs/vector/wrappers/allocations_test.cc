@@ -21,6 +21,7 @@
 #include "envs/vector/wrappers/record_episode_statistics.h"
 #include "tests/alloc_counter.h"
 #include "tests/envs/vector/vector_test_util.h"
+#include "wrappers/wrapper_spec.h"
 
 namespace pixelgym::vector {
 namespace {
@@ -117,7 +118,7 @@ TEST(VectorWrapperPixelAllocationsTest, PixelStepsAllocateNothing) {
     const VectorOptions options{threads == 0 ? VectorMode::kSync : VectorMode::kAsync, threads,
                                 AutoresetMode::kNextStep};
     const auto env = wrap(make_vec("CartPoleSwingup-v0", 2, {{"width", 32}, {"height", 32}},
-                                   {"frame_stack=2"}, options),
+                                   pixelgym::wrappers::wrapping({"frame_stack=2"}), options),
                           "pixels");
     int counted = 0;
     const AllocCounts counts = count_step_allocations(*env, 10, 30, counted);

@@ -37,8 +37,8 @@ TEST_P(VectorWrapperTest, ForwardsSpacesMetadataAndNames) {
   EXPECT_EQ(twice.autoreset_mode(), AutoresetMode::kSameStep);
   EXPECT_EQ(&twice.metadata(), &inner->metadata());
   EXPECT_EQ(&twice.unwrapped(), inner);
-  EXPECT_EQ(twice.inner_wrapper(), once_view);
-  EXPECT_EQ(once_view->inner_wrapper(), nullptr);
+  EXPECT_EQ(&twice.inner(), once_view);
+  EXPECT_EQ(&once_view->inner(), inner);
   EXPECT_EQ(&twice.env(2), &inner->env(2));
   EXPECT_THROW(twice.env(3), std::out_of_range);
   EXPECT_EQ(twice.name(), "VectorWrapper<VectorWrapper<" + inner->name() + ">>");

@@ -1,10 +1,11 @@
-// SharedContext: renderers that draw with one GL context, one after another, as the envs a
+// ContextGroup: renderers that draw with one GL context, one after another, as the envs a
 // vector env runs on one thread do. Every test compares bytes with renderers that have contexts
 // of their own, so any GL state one renderer leaves behind for the next shows up as a difference.
 #include <gtest/gtest.h>
 
 #include <cstdint>
 #include <memory>
+#include <stdexcept>
 #include <vector>
 
 #include "render/mesh_data.h"
@@ -90,18 +91,17 @@ std::vector<std::vector<Frame>> own_contexts(int frames) {
   return out;
 }
 
-// Renderers made while `shared` is in use on this thread.
-std::vector<std::unique_ptr<Renderer>> make_renderers(SharedContext& shared) {
-  const SharedContext::Use use(shared);
+// Renderers made with `group`.
+std::vector<std::unique_ptr<Renderer>> make_renderers(ContextGroup& group) {
   std::vector<std::unique_ptr<Renderer>> renderers;
-  for (int r = 0; r < kRenderers; ++r) renderers.push_back(std::make_unique<Renderer>());
+  for (int r = 0; r < kRenderers; ++r) renderers.push_back(std::make_unique<Renderer>(group));
   return renderers;
 }
 
-TEST(SharedContextTest, RenderersTakingTurnsGiveTheBytesOfRenderersWithTheirOwnContexts) {
+TEST(ContextGroupTest, RenderersTakingTurnsGiveTheBytesOfRenderersWithTheirOwnContexts) {
   constexpr int kFrames = 3;
   const auto expected = own_contexts(kFrames);
-  SharedContext shared;
+  ContextGroup shared;
   EXPECT_FALSE(shared.created());
   auto renderers = make_renderers(shared);
   EXPECT_TRUE(shared.created());
@@ -123,7 +123,7 @@ TEST(SharedContextTest, RenderersTakingTurnsGiveTheBytesOfRenderersWithTheirOwnC
   }
 }
 
-TEST(SharedContextTest, MoreCamerasThanKeptBackgroundsGiveTheBytesOfOneCameraEach) {
+TEST(ContextGroupTest, MoreCamerasThanKeptBackgroundsGiveTheBytesOfOneCameraEach) {
   // 20 cameras at one size take turns with one renderer, so backgrounds are evicted and redrawn;
   // every frame equals that camera's frame from a renderer that never saw another camera.
   constexpr int kCameras = 20;
@@ -150,37 +150,27 @@ TEST(SharedContextTest, MoreCamerasThanKeptBackgroundsGiveTheBytesOfOneCameraEac
   }
 }
 
-TEST(SharedContextTest, OnlyRenderersMadeWhileItIsInUseShareIt) {
-  EXPECT_EQ(SharedContext::in_use(), nullptr);
-  SharedContext outer;
-  SharedContext inner;
-  {
-    const SharedContext::Use use_outer(outer);
-    EXPECT_EQ(SharedContext::in_use(), &outer);
-    {
-      const SharedContext::Use use_inner(inner);
-      EXPECT_EQ(SharedContext::in_use(), &inner);
-      const Renderer renderer;
-      EXPECT_TRUE(inner.created());
-      EXPECT_FALSE(outer.created());
-    }
-    EXPECT_EQ(SharedContext::in_use(), &outer);
-  }
-  EXPECT_EQ(SharedContext::in_use(), nullptr);
+TEST(ContextGroupTest, OnlyRenderersGivenTheGroupShareIt) {
+  ContextGroup outer;
+  ContextGroup inner;
+  const Renderer renderer(inner);
+  EXPECT_TRUE(inner.created());
+  EXPECT_FALSE(outer.created());
   const Renderer alone;  // a context of its own
   EXPECT_FALSE(outer.created());
-  // In use on another thread is not in use here.
+  // Nothing is ambient: a renderer made on another thread while `outer` lives has its own too.
   WorkerThread worker;
-  const SharedContext::Use use(outer);
-  worker.run([] { EXPECT_EQ(SharedContext::in_use(), nullptr); });
+  worker.run([] { const Renderer elsewhere; });
+  EXPECT_FALSE(outer.created());
+  EXPECT_THROW(ContextGroup(-1), std::invalid_argument);
 }
 
-TEST(SharedContextTest, RenderersOutliveTheirSharedContextAndMoveBetweenThreads) {
+TEST(ContextGroupTest, RenderersOutliveTheirContextGroupAndMoveBetweenThreads) {
   constexpr int kFrames = 4;
   const auto expected = own_contexts(kFrames);
   std::vector<std::unique_ptr<Renderer>> renderers;
   {
-    SharedContext shared;
+    ContextGroup shared;
     renderers = make_renderers(shared);
   }
   // As AsyncVectorEnv's worker 0 envs: drawn here, then on a worker thread, never at once; then
@@ -208,13 +198,13 @@ TEST(SharedContextTest, RenderersOutliveTheirSharedContextAndMoveBetweenThreads)
   });
 }
 
-TEST(SharedContextTest, TwoSharedContextsDrawAtOnceOnTwoThreads) {
+TEST(ContextGroupTest, TwoContextGroupsDrawAtOnceOnTwoThreads) {
   constexpr int kFrames = 3;
   const auto expected = own_contexts(kFrames);
   WorkerThread a;
   WorkerThread b;
-  SharedContext shared_a;
-  SharedContext shared_b;
+  ContextGroup shared_a;
+  ContextGroup shared_b;
   std::vector<std::unique_ptr<Renderer>> on_a;
   std::vector<std::unique_ptr<Renderer>> on_b;
   a.run([&] { on_a = make_renderers(shared_a); });

@@ -1,0 +1,7 @@
+#include "envs/render_resources.h"
+
+namespace pixelgym {
+
+RenderResources::~RenderResources() = default;
+
+}  // namespace pixelgym
