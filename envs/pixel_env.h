@@ -47,6 +47,8 @@ class PixelEnv final : public Env {
   const engine::World& world() const { return *world_; }
   /// The render scene of world(), as of the last observation or render() (for tests and tools).
   const WorldScene& scene() const { return *scene_; }
+  /// The render resources it draws with, as given at construction; null: a context of its own.
+  const PixelRenderResources* render_resources() const { return render_resources_.get(); }
   /// Control steps taken in this episode.
   int control_steps() const { return control_steps_; }
   /// Frames drawn so far (observations and render()); stays 0 with obs_mode="state" until
