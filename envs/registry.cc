@@ -5,7 +5,6 @@
 #include <regex>
 #include <stdexcept>
 
-#include "envs/tasks/builtin.h"
 #include "envs/time_limit.h"
 
 namespace pixelgym {
@@ -172,26 +171,5 @@ std::vector<std::string> Registry::closest_ids(const std::string& id, std::size_
   for (std::size_t i = 0; i < ranked.size() && i < count; ++i) closest.push_back(ranked[i].second);
   return closest;
 }
-
-Registry& default_registry() {
-  static Registry* registry = [] {
-    static Registry instance;
-    register_builtin_envs(instance);
-    return &instance;
-  }();
-  return *registry;
-}
-
-std::unique_ptr<Env> make(const std::string& id, const Params& kwargs, const MakeOptions& options) {
-  return default_registry().make(id, kwargs, options);
-}
-
-void register_env(EnvSpec spec) { default_registry().register_env(std::move(spec)); }
-
-EnvDescription describe(const std::string& id, const Params& kwargs) {
-  return default_registry().describe(id, kwargs);
-}
-
-std::vector<std::string> registered_ids() { return default_registry().registered_ids(); }
 
 }  // namespace pixelgym

@@ -99,6 +99,11 @@ class Registry {
   std::vector<std::shared_ptr<const EnvSpec>> specs_;
 };
 
+// The process-wide registry, holding the built-in envs, and the free functions over it. They are
+// defined in pixelgym::tasks (envs/tasks/builtin.cc), the library of the built-in envs: link it to
+// use them. A program of its own envs alone can keep to pixelgym::envs with a Registry of its
+// own.
+
 /// The process-wide registry, holding the built-in envs.
 Registry& default_registry();
 

@@ -3,8 +3,8 @@
 #include <cmath>
 
 #include "engine/robot_model.h"
-#include "envs/pixel_env.h"
 #include "envs/spaces/box.h"
+#include "envs/tasks/pixel_env.h"
 #include "envs/tasks/reward.h"
 
 namespace pixelgym {

@@ -7,6 +7,7 @@
 #include "envs/tasks/grid_world.h"
 #include "envs/tasks/pendulum.h"
 #include "envs/tasks/reacher.h"
+#include "envs/vector/make_vec.h"
 
 namespace pixelgym {
 
@@ -20,5 +21,39 @@ void register_builtin_envs(Registry& registry) {
   registry.register_env(ArmReachTask::spec_v0());
   registry.register_env(ArmPushTask::spec_v0());
 }
+
+// The process-wide registry and its free functions (declared in envs/registry.h and
+// envs/vector/make_vec.h) live here, with the envs it holds, so that the protocol library
+// (pixelgym::envs) links no task.
+
+Registry& default_registry() {
+  static Registry* registry = [] {
+    static Registry instance;
+    register_builtin_envs(instance);
+    return &instance;
+  }();
+  return *registry;
+}
+
+std::unique_ptr<Env> make(const std::string& id, const Params& kwargs, const MakeOptions& options) {
+  return default_registry().make(id, kwargs, options);
+}
+
+void register_env(EnvSpec spec) { default_registry().register_env(std::move(spec)); }
+
+EnvDescription describe(const std::string& id, const Params& kwargs) {
+  return default_registry().describe(id, kwargs);
+}
+
+std::vector<std::string> registered_ids() { return default_registry().registered_ids(); }
+
+namespace vector {
+
+std::unique_ptr<VectorEnv> make_vec(const std::string& id, int num_envs, const Params& kwargs,
+                                    const EnvWrapping& wrap, const VectorOptions& options) {
+  return make_vec(default_registry(), id, num_envs, kwargs, wrap, options);
+}
+
+}  // namespace vector
 
 }  // namespace pixelgym

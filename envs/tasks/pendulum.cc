@@ -3,9 +3,9 @@
 #include <cmath>
 
 #include "engine/robot_model.h"
-#include "envs/pixel_env.h"
 #include "envs/spaces/box.h"
 #include "envs/tasks/angles.h"
+#include "envs/tasks/pixel_env.h"
 #include "envs/tasks/reward.h"
 
 namespace pixelgym {

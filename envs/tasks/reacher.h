@@ -2,7 +2,7 @@
 #pragma once
 
 #include "envs/registry.h"
-#include "envs/task.h"
+#include "envs/tasks/task.h"
 
 namespace pixelgym {
 

@@ -10,16 +10,17 @@
 
 namespace pixelgym::vector {
 
-std::unique_ptr<VectorEnv> make_vec(const std::string& id, int num_envs, const Params& kwargs,
-                                    const EnvWrapping& wrap, const VectorOptions& options) {
+std::unique_ptr<VectorEnv> make_vec(const Registry& registry, const std::string& id, int num_envs,
+                                    const Params& kwargs, const EnvWrapping& wrap,
+                                    const VectorOptions& options) {
   // Bad ids, kwargs and wrappings are reported here, on the calling thread, without building a
   // world or a GL context.
-  EnvDescription description = describe(id, kwargs);
+  EnvDescription description = registry.describe(id, kwargs);
   if (wrap) wrap(std::make_unique<DescribedEnv>(std::move(description)));
 
   const bool async = options.mode == VectorMode::kAsync;
   const int threads = async ? AsyncVectorEnv::threads_for(num_envs, options.num_threads) : 1;
-  const std::shared_ptr<const EnvSpec> spec = default_registry().spec(id);
+  const std::shared_ptr<const EnvSpec> spec = registry.spec(id);
   std::vector<MakeOptions> thread_options(static_cast<std::size_t>(threads));
   if (spec->make_render_resources) {
     for (int w = 0; w < threads; ++w) {
@@ -29,7 +30,7 @@ std::unique_ptr<VectorEnv> make_vec(const std::string& id, int num_envs, const P
   }
   const EnvFactory make_env = [&](int index) {
     std::unique_ptr<Env> env =
-        make(id, kwargs, thread_options[static_cast<std::size_t>(index % threads)]);
+        registry.make(id, kwargs, thread_options[static_cast<std::size_t>(index % threads)]);
     return wrap ? wrap(std::move(env)) : std::move(env);
   };
   if (async) {

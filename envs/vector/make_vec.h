@@ -6,6 +6,7 @@
 #include <string>
 
 #include "envs/params.h"
+#include "envs/registry.h"
 #include "envs/vector/vector_env.h"
 #include "envs/wrapper.h"
 
@@ -29,8 +30,8 @@ struct VectorOptions {
   bool share_gl_contexts = true;
 };
 
-/// `num_envs` copies of `make(id, kwargs, options)`, each passed through `wrap` (when set; see
-/// EnvWrapping, and wrappers::wrapping for the `--wrap` text form), run as `options` say.
+/// `num_envs` copies of `registry.make(id, kwargs, options)`, each passed through `wrap` (when set;
+/// see EnvWrapping, and wrappers::wrapping for the `--wrap` text form), run as `options` say.
 ///
 /// Rendering resources: make_vec owns what the envs share. For each thread that runs envs
 /// (SyncVectorEnv: one; AsyncVectorEnv: worker w runs env i when w = i % threads) it makes the
@@ -43,6 +44,12 @@ struct VectorOptions {
 /// the env, before any env is built (the id and kwargs are described, and `wrap` is applied to a
 /// DescribedEnv stand-in: a wrapping must not reset, step or render the env it wraps); then as
 /// the SyncVectorEnv / AsyncVectorEnv constructors.
+std::unique_ptr<VectorEnv> make_vec(const Registry& registry, const std::string& id, int num_envs,
+                                    const Params& kwargs = {}, const EnvWrapping& wrap = nullptr,
+                                    const VectorOptions& options = {});
+
+/// make_vec over default_registry() (the built-in envs; defined in pixelgym::tasks, as
+/// default_registry is).
 std::unique_ptr<VectorEnv> make_vec(const std::string& id, int num_envs, const Params& kwargs = {},
                                     const EnvWrapping& wrap = nullptr,
                                     const VectorOptions& options = {});

@@ -6,7 +6,7 @@
 
 #include "engine/robot_model.h"
 #include "engine/world.h"
-#include "envs/world_scene.h"
+#include "envs/tasks/world_scene.h"
 #include "examples/pixelgym/cli.h"
 #include "render/context.h"
 #include "render/renderer.h"

@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "envs/vector/vector_env.h"
-#include "envs/vector/wrappers/normalize_reward.h"
-#include "envs/vector/wrappers/record_episode_statistics.h"
 #include "examples/ppo/policy.h"
 #include "wrappers/running_statistics.h"
+#include "wrappers/vector/normalize_reward.h"
+#include "wrappers/vector/record_episode_statistics.h"
 
 namespace pixelgym::ppo {
 

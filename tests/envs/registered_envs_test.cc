@@ -7,8 +7,8 @@
 #include <map>
 
 #include "envs/checker.h"
-#include "envs/pixel_env.h"
 #include "envs/registry.h"
+#include "envs/tasks/pixel_env.h"
 #include "tests/envs/env_ids.h"
 #include "tests/golden.h"
 

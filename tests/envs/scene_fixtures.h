@@ -4,7 +4,7 @@
 #include <memory>
 
 #include "engine/world.h"
-#include "envs/world_scene.h"
+#include "envs/tasks/world_scene.h"
 
 namespace pixelgym::testing {
 

@@ -19,9 +19,9 @@
 #include <string>
 #include <vector>
 
-#include "envs/pixel_env.h"
 #include "envs/registry.h"
 #include "envs/rng.h"
+#include "envs/tasks/pixel_env.h"
 #include "render/renderer.h"
 #include "tests/envs/env_ids.h"
 

@@ -14,8 +14,8 @@
 #include <memory>
 #include <vector>
 
-#include "envs/pixel_env.h"
 #include "envs/registry.h"
+#include "envs/tasks/pixel_env.h"
 #include "tests/envs/env_ids.h"
 #include "tests/envs/step_allocation_counter.h"
 

@@ -18,7 +18,7 @@
 #include "engine/robot_model.h"
 #include "engine/world.h"
 #include "envs/registry.h"
-#include "envs/world_scene.h"
+#include "envs/tasks/world_scene.h"
 #include "render/image_io.h"
 #include "render/renderer.h"
 #include "tests/examples/cli_run.h"

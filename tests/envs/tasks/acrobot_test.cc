@@ -6,9 +6,9 @@
 #include <cmath>
 #include <iostream>
 
-#include "envs/pixel_env.h"
 #include "envs/registry.h"
 #include "envs/tasks/angles.h"
+#include "envs/tasks/pixel_env.h"
 #include "tests/envs/tasks/acrobot_mpc.h"
 #include "tests/envs/tasks/scripted.h"
 

@@ -7,8 +7,8 @@
 #include <optional>
 
 #include "engine/robot_model.h"
-#include "envs/pixel_env.h"
 #include "envs/registry.h"
+#include "envs/tasks/pixel_env.h"
 #include "tests/envs/tasks/scripted.h"
 
 namespace pixelgym {

@@ -6,8 +6,8 @@
 #include <iostream>
 
 #include "engine/robot_model.h"
-#include "envs/pixel_env.h"
 #include "envs/registry.h"
+#include "envs/tasks/pixel_env.h"
 #include "tests/envs/tasks/scripted.h"
 
 namespace pixelgym {

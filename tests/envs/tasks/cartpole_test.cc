@@ -10,9 +10,9 @@
 #include <iostream>
 #include <vector>
 
-#include "envs/pixel_env.h"
 #include "envs/registry.h"
 #include "envs/rng.h"
+#include "envs/tasks/pixel_env.h"
 #include "tests/envs/tasks/scripted.h"
 
 namespace pixelgym {

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <iostream>
 
-#include "envs/pixel_env.h"
 #include "envs/registry.h"
+#include "envs/tasks/pixel_env.h"
 #include "tests/envs/tasks/scripted.h"
 
 namespace pixelgym {

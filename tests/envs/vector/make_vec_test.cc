@@ -8,8 +8,8 @@
 #include <memory>
 #include <set>
 
-#include "envs/pixel_env.h"
 #include "envs/registry.h"
+#include "envs/tasks/pixel_env.h"
 
 namespace pixelgym::vector {
 namespace {

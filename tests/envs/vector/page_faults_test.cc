@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "envs/pixel_env.h"
 #include "envs/registry.h"
 #include "envs/rng.h"
+#include "envs/tasks/pixel_env.h"
 #include "render/mesa_copy.h"
 
 namespace pixelgym {

@@ -23,9 +23,9 @@
 #include "envs/spaces/box.h"
 #include "envs/spaces/discrete.h"
 #include "envs/vector/sync_vector_env.h"
-#include "envs/vector/wrappers/normalize_reward.h"
-#include "envs/vector/wrappers/record_episode_statistics.h"
 #include "tests/wrappers/scripted_env.h"
+#include "wrappers/vector/normalize_reward.h"
+#include "wrappers/vector/record_episode_statistics.h"
 
 namespace pixelgym::ppo {
 namespace {

@@ -4,7 +4,7 @@
 // Each env's frame is (env, episode, step, 7), so the test knows which frames every stacked row
 // must hold; each row is also compared byte for byte with a single env, wrapped the same way and
 // stepped (or reset) one call at a time as the mode says. This is why there is no vector-level
-// frame stack wrapper (see envs/vector/wrappers/vector_wrapper.h).
+// frame stack wrapper (see envs/vector/vector_wrapper.h).
 #include <gtest/gtest.h>
 
 #include <algorithm>

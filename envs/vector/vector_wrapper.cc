@@ -1,4 +1,4 @@
-#include "envs/vector/wrappers/vector_wrapper.h"
+#include "envs/vector/vector_wrapper.h"
 
 #include <stdexcept>
 #include <utility>

@@ -1,4 +1,4 @@
-#include "envs/pixel_env.h"
+#include "envs/tasks/pixel_env.h"
 
 #include <algorithm>
 #include <cmath>

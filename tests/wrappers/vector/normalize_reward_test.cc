@@ -5,7 +5,7 @@
 // its standard deviation. In each autoreset mode, for terminated and truncated episodes, in
 // SyncVectorEnv and AsyncVectorEnv (2 threads). A batch of one env is the per-env wrapper bit for
 // bit.
-#include "envs/vector/wrappers/normalize_reward.h"
+#include "wrappers/vector/normalize_reward.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

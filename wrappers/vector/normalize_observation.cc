@@ -1,4 +1,4 @@
-#include "envs/vector/wrappers/normalize_observation.h"
+#include "wrappers/vector/normalize_observation.h"
 
 #include <cmath>
 #include <cstdint>

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "envs/vector/wrappers/vector_wrapper.h"
+#include "envs/vector/vector_wrapper.h"
 #include "wrappers/running_statistics.h"
 
 namespace pixelgym::vector {

@@ -16,11 +16,11 @@
 #include <vector>
 
 #include "envs/vector/make_vec.h"
-#include "envs/vector/wrappers/normalize_observation.h"
-#include "envs/vector/wrappers/normalize_reward.h"
-#include "envs/vector/wrappers/record_episode_statistics.h"
 #include "tests/alloc_counter.h"
 #include "tests/envs/vector/vector_test_util.h"
+#include "wrappers/vector/normalize_observation.h"
+#include "wrappers/vector/normalize_reward.h"
+#include "wrappers/vector/record_episode_statistics.h"
 #include "wrappers/wrapper_spec.h"
 
 namespace pixelgym::vector {

@@ -11,8 +11,8 @@
 #include "envs/env.h"
 #include "envs/registry.h"
 #include "envs/render_resources.h"
-#include "envs/task.h"
-#include "envs/world_scene.h"
+#include "envs/tasks/task.h"
+#include "envs/tasks/world_scene.h"
 #include "render/renderer.h"
 
 namespace pixelgym {

@@ -1,4 +1,4 @@
-#include "envs/world_scene.h"
+#include "envs/tasks/world_scene.h"
 
 #include <gtest/gtest.h>
 

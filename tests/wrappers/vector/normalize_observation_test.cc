@@ -3,7 +3,7 @@
 // prior), and every row it returns is that row normalized with them, in each autoreset mode
 // (SameStep's final_obs included, Disabled's masked resets included), in SyncVectorEnv and
 // AsyncVectorEnv (2 threads). A batch of one env is the per-env wrapper bit for bit.
-#include "envs/vector/wrappers/normalize_observation.h"
+#include "wrappers/vector/normalize_observation.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

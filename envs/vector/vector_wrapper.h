@@ -1,23 +1,14 @@
 // VectorWrapper: a vector env that owns another and passes every call through to it
 // (gymnasium.vector.VectorWrapper), the base of the vector-aware wrappers.
 //
-// The vector wrappers (this folder, Gymnasium's gymnasium.wrappers.vector.*):
+// The vector wrappers (wrappers/vector/, Gymnasium's gymnasium.wrappers.vector.*):
 //   RecordEpisodeStatistics  each env's episode return, length and time in infos["episode"]
 //   NormalizeObservation     observations normalized with statistics shared across the batch
 //   NormalizeReward          rewards scaled by the return variance shared across the batch
 // They see the whole batch, so their statistics are the batch's (one set shared by every env),
-// where a per-env wrapper given to make_vec's `wrappers` keeps one set per env.
-//
-// Frame stacking has no vector wrapper, on purpose: give make_vec the per-env one
-// (`{"frame_stack=4"}`, wrappers::FrameStackObservation). Inside a vector env every env is reset
-// on its own, exactly when its episode restarts (the autoreset step under NextStep, inside the
-// step of the done under SameStep, the masked reset under Disabled), so each env's stack
-// restarts for exactly the envs that reset, whatever the mode (pinned by
-// tests/envs/vector/wrappers/frame_stack_test.cc). It writes its stacked frames straight into the
-// env's batch row on the worker thread that runs the env, and under SameStep the terminal
-// stack reaches final_obs like any observation. A vector-level frame stack would have to rebuild
-// which rows restarted from the flags and the autoreset mode, copy the same k frames per row
-// per step on the calling thread, and would bring no saving in memory or time.
+// where a per-env wrapper in make_vec's wrapping keeps one set per env. Frame stacking stays per
+// env (wrappers::FrameStackObservation in the wrapping): each env's stack restarts exactly when
+// that env resets, whatever the autoreset mode (tests/wrappers/vector/frame_stack_test.cc).
 #pragma once
 
 #include <cstdint>

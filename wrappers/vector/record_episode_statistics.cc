@@ -1,4 +1,4 @@
-#include "envs/vector/wrappers/record_episode_statistics.h"
+#include "wrappers/vector/record_episode_statistics.h"
 
 #include <optional>
 #include <stdexcept>

@@ -1,4 +1,4 @@
-#include "envs/vector/wrappers/normalize_reward.h"
+#include "wrappers/vector/normalize_reward.h"
 
 #include <cmath>
 #include <sstream>
