@@ -63,6 +63,11 @@ CLI::Validator png_path() {
       "");
 }
 
+void add_id_argument(CLI::App& command, std::string& id, const std::string& example) {
+  command.add_option("id", id, "Env id, e.g. " + example + " (`pixelgym list` shows them)")
+      ->required();
+}
+
 void add_set_option(CLI::App& command, std::vector<std::string>& sets) {
   command
       .add_option("--set", sets,
@@ -105,6 +110,11 @@ void add_wrap_option(CLI::App& command, std::vector<std::string>& wraps) {
                   "Wrapper as NAME or NAME=ARGS, e.g. resize=64x64 (repeatable, applied in order, "
                   "the first innermost); `pixelgym wrappers` lists them")
       ->type_name("SPEC");
+}
+
+void add_env_options(CLI::App& command, EnvArguments& env) {
+  add_set_option(command, env.sets);
+  add_wrap_option(command, env.wraps);
 }
 
 std::unique_ptr<Env> make_env(const std::string& id, const std::vector<std::string>& sets,

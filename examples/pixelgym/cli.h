@@ -39,6 +39,23 @@ void add_seed_option(CLI::App& command, std::uint64_t& seed, const std::string& 
 /// Accepts a path ending in ".png" (any case): pixelgym writes PNG only.
 CLI::Validator png_path();
 
+/// The env a subcommand works on: its id, and the --set and --wrap options that shape it.
+struct EnvArguments {
+  std::string id;
+  std::vector<std::string> sets;   // KEY=VALUE
+  std::vector<std::string> wraps;  // wrapper specs, the first innermost
+};
+
+/// Adds the required positional `id`: "Env id, e.g. {example} (`pixelgym list` shows them)".
+void add_id_argument(CLI::App& command, std::string& id, const std::string& example);
+
+/// Adds option `name`, its default shown in help and its value checked by `check`.
+template <typename T>
+CLI::Option* add_checked_option(CLI::App& command, const std::string& name, T& value,
+                                const std::string& description, const CLI::Validator& check) {
+  return command.add_option(name, value, description)->capture_default_str()->check(check);
+}
+
 /// Adds the repeatable `--set key=value` option to `command`.
 void add_set_option(CLI::App& command, std::vector<std::string>& sets);
 
@@ -50,6 +67,9 @@ Params parse_sets(const std::string& id, const std::vector<std::string>& sets);
 /// Adds the repeatable `--wrap NAME[=ARGS]` option to `command` (wrapper specs, applied in order;
 /// `pixelgym wrappers` lists them).
 void add_wrap_option(CLI::App& command, std::vector<std::string>& wraps);
+
+/// Adds --set then --wrap (add_set_option, add_wrap_option) into `env`.
+void add_env_options(CLI::App& command, EnvArguments& env);
 
 /// `make(id, parse_sets(id, sets))` wrapped by each of `wraps` in order (the first innermost); a
 /// config `make` refuses or a wrapper spec that does not apply (std::invalid_argument: an unknown
@@ -66,6 +86,19 @@ struct Command {
   CLI::App* app;
   std::function<int()> run;
 };
+
+/// Adds subcommand `name` to `app` whose options parse into an `Arguments` of its own, living as
+/// long as the returned Command: `declare` gives the subcommand its description and options,
+/// and choosing it runs `run` on what was parsed (its exit code).
+template <typename Arguments>
+Command add_command(CLI::App& app, const std::string& name,
+                    void (*declare)(CLI::App& command, Arguments& args),
+                    int (*run)(const Arguments& args)) {
+  auto args = std::make_shared<Arguments>();
+  CLI::App* command = app.add_subcommand(name);
+  declare(*command, *args);
+  return {command, [args, run] { return run(*args); }};
+}
 
 /// Adds list, wrappers, info, check, snapshot, rollout and bench to `app`. Each subcommand parses
 /// into options of its own, which live as long as the returned commands.

@@ -47,52 +47,46 @@ void print_table(std::ostream& out, const std::vector<std::vector<std::string>>&
   }
 }
 
-void add_id_argument(CLI::App& command, std::string& id, const std::string& example) {
-  command.add_option("id", id, "Env id, e.g. " + example + " (`pixelgym list` shows them)")
-      ->required();
-}
+// What list and wrappers take: nothing.
+struct NoArguments {};
 
 // --- list ---
 
-Command add_list(CLI::App& app) {
-  CLI::App* list =
-      app.add_subcommand("list", "List the registered env ids, one per line with a description");
-  return {list, [] {
-            std::vector<std::vector<std::string>> rows;
-            for (const std::string& id : registered_ids()) {
-              rows.push_back({id, default_registry().spec(id)->description});
-            }
-            print_table(std::cout, rows, "");
-            return 0;
-          }};
+void declare_list(CLI::App& list, NoArguments& /*args*/) {
+  list.description("List the registered env ids, one per line with a description");
+}
+
+int run_list(const NoArguments& /*args*/) {
+  std::vector<std::vector<std::string>> rows;
+  for (const std::string& id : registered_ids()) {
+    rows.push_back({id, default_registry().spec(id)->description});
+  }
+  print_table(std::cout, rows, "");
+  return 0;
 }
 
 // --- wrappers ---
 
-Command add_wrappers(CLI::App& app) {
-  CLI::App* command = app.add_subcommand(
-      "wrappers", "List the wrappers that --wrap accepts, with their arguments and defaults");
-  command->footer(
+void declare_wrappers(CLI::App& command, NoArguments& /*args*/) {
+  command.description("List the wrappers that --wrap accepts, with their arguments and defaults");
+  command.footer(
       "A spec is NAME or NAME=ARGS; ARGS are comma-separated, each a value (taken by the "
       "parameters in the order shown) or param=value. Examples: --wrap resize=64x64 --wrap "
       "grayscale --wrap time_limit=500");
-  return {command, [] {
-            std::vector<std::vector<std::string>> rows;
-            for (const wrappers::WrapperSpecHelp& help : wrappers::wrapper_spec_help()) {
-              rows.push_back({help.usage, help.summary});
-            }
-            print_table(std::cout, rows, "");
-            return 0;
-          }};
+}
+
+int run_wrappers(const NoArguments& /*args*/) {
+  std::vector<std::vector<std::string>> rows;
+  for (const wrappers::WrapperSpecHelp& help : wrappers::wrapper_spec_help()) {
+    rows.push_back({help.usage, help.summary});
+  }
+  print_table(std::cout, rows, "");
+  return 0;
 }
 
 // --- info ---
 
-struct InfoArguments {
-  std::string id;
-  std::vector<std::string> sets;
-  std::vector<std::string> wraps;
-};
+struct InfoArguments : EnvArguments {};
 
 std::string number(double value) {
   std::ostringstream out;
@@ -185,26 +179,19 @@ int run_info(const InfoArguments& args) {
   return 0;
 }
 
-Command add_info(CLI::App& app) {
-  auto args = std::make_shared<InfoArguments>();
-  CLI::App* info = app.add_subcommand(
-      "info",
+void declare_info(CLI::App& info, InfoArguments& args) {
+  info.description(
       "Show an env's spaces (under the --wrap wrappers, if any), metadata and config keys "
       "(types, defaults), without making the env");
-  add_id_argument(*info, args->id, "GridWorld-v0");
-  add_set_option(*info, args->sets);
-  add_wrap_option(*info, args->wraps);
-  return {info, [args] { return run_info(*args); }};
+  add_id_argument(info, args.id, "GridWorld-v0");
+  add_env_options(info, args);
 }
 
 // --- check ---
 
-struct CheckArguments {
-  std::string id;
+struct CheckArguments : EnvArguments {
   std::uint64_t seed = 0;
   int steps = 100;
-  std::vector<std::string> sets;
-  std::vector<std::string> wraps;
 };
 
 int run_check(const CheckArguments& args) {
@@ -224,32 +211,24 @@ int run_check(const CheckArguments& args) {
   return kExitFailure;
 }
 
-Command add_check(CLI::App& app) {
-  auto args = std::make_shared<CheckArguments>();
-  CLI::App* check = app.add_subcommand(
-      "check",
+void declare_check(CLI::App& check, CheckArguments& args) {
+  check.description(
       "Run the env checker; exit 0 when every check passes, 1 otherwise (failures printed)");
-  add_id_argument(*check, args->id, "GridWorld-v0");
-  add_seed_option(*check, args->seed, "Seed for resets and random actions");
-  check->add_option("--steps", args->steps, "Random steps per checked trajectory")
-      ->capture_default_str()
-      ->check(integer_in(1));
-  add_set_option(*check, args->sets);
-  add_wrap_option(*check, args->wraps);
-  return {check, [args] { return run_check(*args); }};
+  add_id_argument(check, args.id, "GridWorld-v0");
+  add_seed_option(check, args.seed, "Seed for resets and random actions");
+  add_checked_option(check, "--steps", args.steps, "Random steps per checked trajectory",
+                     integer_in(1));
+  add_env_options(check, args);
 }
 
 // --- snapshot ---
 
-struct SnapshotArguments {
-  std::string id;
+struct SnapshotArguments : EnvArguments {
   std::uint64_t seed = 0;
   int steps = 0;
   std::string out;
   std::string compare;
   bool observation = false;
-  std::vector<std::string> sets;
-  std::vector<std::string> wraps;
 };
 
 // The observation's image as an (H, W, 3) picture: the "pixels" entry of a Dict observation, or
@@ -342,44 +321,36 @@ int run_snapshot(const SnapshotArguments& args) {
   return status;
 }
 
-Command add_snapshot(CLI::App& app) {
-  auto args = std::make_shared<SnapshotArguments>();
-  CLI::App* snapshot = app.add_subcommand(
-      "snapshot",
+void declare_snapshot(CLI::App& snapshot, SnapshotArguments& args) {
+  snapshot.description(
       "Reset with a seed, take K seeded random actions, write render() (or the observation) as a "
       "PNG, or compare it with a golden PNG");
-  add_id_argument(*snapshot, args->id, "GridWorld-v0");
-  add_seed_option(*snapshot, args->seed, "Seed for the reset and the random actions");
-  snapshot->add_option("--out", args->out, "PNG file to write (folders are created; PNG only)")
+  add_id_argument(snapshot, args.id, "GridWorld-v0");
+  add_seed_option(snapshot, args.seed, "Seed for the reset and the random actions");
+  snapshot.add_option("--out", args.out, "PNG file to write (folders are created; PNG only)")
       ->check(png_path());
   snapshot
-      ->add_option("--compare", args->compare,
-                   "Golden PNG to compare the frame with (the default tolerance of "
-                   "testing/snapshot.h): exit 0 on a match, 1 with the figures and a diff image "
-                   "(in $PIXELGYM_SNAPSHOT_OUTPUT_DIR, else ./snapshot_output) otherwise; "
-                   "PIXELGYM_UPDATE_GOLDENS=1 writes the golden instead")
+      .add_option("--compare", args.compare,
+                  "Golden PNG to compare the frame with (the default tolerance of "
+                  "testing/snapshot.h): exit 0 on a match, 1 with the figures and a diff image "
+                  "(in $PIXELGYM_SNAPSHOT_OUTPUT_DIR, else ./snapshot_output) otherwise; "
+                  "PIXELGYM_UPDATE_GOLDENS=1 writes the golden instead")
       ->check(png_path());
-  snapshot->add_option("--steps", args->steps, "Random actions before the frame is taken")
-      ->capture_default_str()
-      ->check(integer_in(0));
-  snapshot->add_flag(
-      "--observation", args->observation,
+  add_checked_option(snapshot, "--steps", args.steps, "Random actions before the frame is taken",
+                     integer_in(0));
+  snapshot.add_flag(
+      "--observation", args.observation,
       "Take the observation's \"pixels\" (what the agent sees, after any --wrap) instead of "
       "render(); gray images as grey, stacked frames side by side, oldest leftmost");
-  add_set_option(*snapshot, args->sets);
-  add_wrap_option(*snapshot, args->wraps);
-  return {snapshot, [args] { return run_snapshot(*args); }};
+  add_env_options(snapshot, args);
 }
 
 // --- rollout ---
 
-struct RolloutArguments {
-  std::string id;
+struct RolloutArguments : EnvArguments {
   std::uint64_t seed = 0;
   int episodes = 5;
   std::string snapshot;
-  std::vector<std::string> sets;
-  std::vector<std::string> wraps;
 };
 
 int run_rollout(const RolloutArguments& args) {
@@ -401,35 +372,26 @@ int run_rollout(const RolloutArguments& args) {
   return 0;
 }
 
-Command add_rollout(CLI::App& app) {
-  auto args = std::make_shared<RolloutArguments>();
-  CLI::App* rollout = app.add_subcommand(
-      "rollout", "Run a uniform random policy for some episodes and print each return");
-  add_id_argument(*rollout, args->id, "GridWorld-v0");
-  add_seed_option(*rollout, args->seed, "Seed for the first reset and the random actions");
-  rollout->add_option("--episodes", args->episodes, "Episodes to run")
-      ->capture_default_str()
-      ->check(integer_in(1));
+void declare_rollout(CLI::App& rollout, RolloutArguments& args) {
+  rollout.description("Run a uniform random policy for some episodes and print each return");
+  add_id_argument(rollout, args.id, "GridWorld-v0");
+  add_seed_option(rollout, args.seed, "Seed for the first reset and the random actions");
+  add_checked_option(rollout, "--episodes", args.episodes, "Episodes to run", integer_in(1));
   rollout
-      ->add_option("--snapshot", args->snapshot,
-                   "Write the last episode's final frame to this PNG (PNG only)")
+      .add_option("--snapshot", args.snapshot,
+                  "Write the last episode's final frame to this PNG (PNG only)")
       ->check(png_path());
-  add_set_option(*rollout, args->sets);
-  add_wrap_option(*rollout, args->wraps);
-  return {rollout, [args] { return run_rollout(*args); }};
+  add_env_options(rollout, args);
 }
 
 // --- bench ---
 
-struct BenchArguments {
-  std::string id;
+struct BenchArguments : EnvArguments {
   std::uint64_t seed = 0;
   int steps = 2000;
   int num_envs = 0;  // 0: one Env in a loop; else a vector env
   int threads = 0;   // with num_envs: 0 for SyncVectorEnv, else AsyncVectorEnv's worker threads
   bool threads_given = false;
-  std::vector<std::string> sets;
-  std::vector<std::string> wraps;
 };
 
 // `num_envs` envs in a vector env, stepped with seeded random actions (a pool of batches drawn
@@ -493,41 +455,38 @@ int run_bench(const BenchArguments& args) {
   return 0;
 }
 
-Command add_bench(CLI::App& app) {
-  auto args = std::make_shared<BenchArguments>();
-  CLI::App* bench = app.add_subcommand(
-      "bench",
+void declare_bench(CLI::App& bench, BenchArguments& args) {
+  bench.description(
       "Step an env with seeded random actions (resetting when done) and print steps_per_s= for "
       "physics + render + observation, one env on this thread, or with --num-envs N a vector env "
       "of N (--threads T workers); --set obs_mode=state for physics alone");
-  add_id_argument(*bench, args->id, "CartPoleSwingup-v0");
-  bench->add_option("--steps", args->steps, "Steps to time")
-      ->capture_default_str()
-      ->check(integer_in(1));
-  add_seed_option(*bench, args->seed, "Seed for the reset and the random actions");
+  add_id_argument(bench, args.id, "CartPoleSwingup-v0");
+  add_checked_option(bench, "--steps", args.steps, "Steps to time", integer_in(1));
+  add_seed_option(bench, args.seed, "Seed for the reset and the random actions");
   bench
-      ->add_option("--num-envs", args->num_envs,
-                   "Step N envs as one vector env (make_vec) and count steps_per_s= over all of "
-                   "them; --steps is then the total of env steps")
+      .add_option("--num-envs", args.num_envs,
+                  "Step N envs as one vector env (make_vec) and count steps_per_s= over all of "
+                  "them; --steps is then the total of env steps")
       ->check(integer_in(1));
-  bench
-      ->add_option("--threads", args->threads,
-                   "With --num-envs: 0 for SyncVectorEnv (a loop on this thread), T for an "
-                   "AsyncVectorEnv on T threads, this one included (clamped to N); refused without "
-                   "--num-envs")
-      ->capture_default_str()
-      ->check(integer_in(0))
-      ->each([args](const std::string&) { args->threads_given = true; });
-  add_set_option(*bench, args->sets);
-  add_wrap_option(*bench, args->wraps);
-  return {bench, [args] { return run_bench(*args); }};
+  add_checked_option(bench, "--threads", args.threads,
+                     "With --num-envs: 0 for SyncVectorEnv (a loop on this thread), T for an "
+                     "AsyncVectorEnv on T threads, this one included (clamped to N); refused "
+                     "without --num-envs",
+                     integer_in(0))
+      ->each([&args](const std::string&) { args.threads_given = true; });
+  add_env_options(bench, args);
 }
 
 }  // namespace
 
 std::vector<Command> add_env_commands(CLI::App& app) {
-  return {add_list(app),     add_wrappers(app), add_info(app), add_check(app),
-          add_snapshot(app), add_rollout(app),  add_bench(app)};
+  return {add_command(app, "list", declare_list, run_list),
+          add_command(app, "wrappers", declare_wrappers, run_wrappers),
+          add_command(app, "info", declare_info, run_info),
+          add_command(app, "check", declare_check, run_check),
+          add_command(app, "snapshot", declare_snapshot, run_snapshot),
+          add_command(app, "rollout", declare_rollout, run_rollout),
+          add_command(app, "bench", declare_bench, run_bench)};
 }
 
 }  // namespace pixelgym::cli

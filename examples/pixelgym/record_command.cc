@@ -14,15 +14,35 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct RecordArguments {
-  std::string id;
+struct RecordArguments : EnvArguments {
   std::uint64_t seed = 0;
   int episodes = 1;
   std::string out;
   std::string policy = "random";
-  std::vector<std::string> sets;
-  std::vector<std::string> wraps;
 };
+
+void declare_record(CLI::App& record, RecordArguments& args) {
+  record.description(
+      "Run a seeded policy for some episodes and write each as an H.264 .mp4 of render() frames "
+      "(RecordVideo); print each file with its frame count and return");
+  add_id_argument(record, args.id, "CartPoleSwingup-v0");
+  record
+      .add_option("--out", args.out,
+                  "Folder for one FOLDER/ID-episode-N.mp4 per episode (created if missing), or a "
+                  "FILE.mp4 for a single episode. Each file is complete or absent: written under "
+                  "a temporary name, checked and renamed")
+      ->required()
+      ->type_name("FOLDER|FILE.mp4");
+  add_checked_option(record, "--episodes", args.episodes, "Episodes to record, one clip each",
+                     integer_in(1));
+  add_seed_option(record, args.seed,
+                  "Seed for the first reset and the policy's actions (later episodes continue "
+                  "the env's generator)");
+  add_checked_option(record, "--policy", args.policy,
+                     "Policy choosing the actions: random (uniform over the action space)",
+                     CLI::IsMember({"random"}));
+  add_env_options(record, args);
+}
 
 // The env that is recorded, before RecordVideo wraps it: every option that shapes the env is
 // applied here and only here.
@@ -73,34 +93,7 @@ int run_record(const RecordArguments& args) {
 }  // namespace
 
 std::vector<Command> add_record_commands(CLI::App& app) {
-  auto args = std::make_shared<RecordArguments>();
-  CLI::App* record = app.add_subcommand(
-      "record",
-      "Run a seeded policy for some episodes and write each as an H.264 .mp4 of render() frames "
-      "(RecordVideo); print each file with its frame count and return");
-  record->add_option("id", args->id, "Env id, e.g. CartPoleSwingup-v0 (`pixelgym list` shows them)")
-      ->required();
-  record
-      ->add_option("--out", args->out,
-                   "Folder for one FOLDER/ID-episode-N.mp4 per episode (created if missing), or a "
-                   "FILE.mp4 for a single episode. Each file is complete or absent: written under "
-                   "a temporary name, checked and renamed")
-      ->required()
-      ->type_name("FOLDER|FILE.mp4");
-  record->add_option("--episodes", args->episodes, "Episodes to record, one clip each")
-      ->capture_default_str()
-      ->check(integer_in(1));
-  add_seed_option(*record, args->seed,
-                  "Seed for the first reset and the policy's actions (later episodes continue "
-                  "the env's generator)");
-  record
-      ->add_option("--policy", args->policy,
-                   "Policy choosing the actions: random (uniform over the action space)")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"random"}));
-  add_set_option(*record, args->sets);
-  add_wrap_option(*record, args->wraps);
-  return {{record, [args] { return run_record(*args); }}};
+  return {add_command(app, "record", declare_record, run_record)};
 }
 
 }  // namespace pixelgym::cli
