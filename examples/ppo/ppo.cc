@@ -489,6 +489,119 @@ double Trainer::learning_rate() const {
   return config_.learning_rate * std::max(remaining, 0.0);
 }
 
+Trainer::UpdateBatch Trainer::update_batch() {
+  UpdateBatch batch;
+  batch.size = config_.num_steps * config_.num_envs;
+  batch.minibatch = batch.size / config_.num_minibatches;
+  batch.obs = storage_.flat_observations();
+  batch.actions = storage_.actions.flatten(0, 1);
+  batch.old_log_probs = storage_.log_probs.flatten(0, 1);
+  batch.old_values = storage_.values.flatten(0, 1);
+  batch.advantages = storage_.advantages.flatten(0, 1);
+  batch.returns = storage_.returns.flatten(0, 1);
+  if (!config_.augment) return batch;
+  batch.shifts =
+      torch::randint(0, 2 * config_.shift_pad + 1, {batch.size, 2}, augmentation_, torch::kInt64);
+  // Old log-probs and values of the shifted images, so that the ratio starts at 1.
+  torch::NoGradGuard no_grad;
+  batch.old_log_probs = torch::empty_like(batch.old_log_probs);
+  batch.old_values = torch::empty_like(batch.old_values);
+  for (std::int64_t begin = 0; begin < batch.size; begin += batch.minibatch) {
+    const torch::Tensor index = torch::arange(begin, begin + batch.minibatch, torch::kInt64);
+    const Evaluation old =
+        policy_->evaluate(select_rows(batch.obs, index), batch.actions.index_select(0, index),
+                          batch.shifts.index_select(0, index), config_.shift_pad);
+    batch.old_log_probs.index_copy_(0, index, old.log_prob);
+    batch.old_values.index_copy_(0, index, old.value);
+  }
+  return batch;
+}
+
+torch::Tensor Trainer::value_loss(const UpdateBatch& batch, const torch::Tensor& index,
+                                  const torch::Tensor& value) const {
+  const torch::Tensor target = batch.returns.index_select(0, index);
+  if (!config_.clip_value_loss) return 0.5 * (value - target).pow(2).mean();
+  const torch::Tensor old = batch.old_values.index_select(0, index);
+  const torch::Tensor clipped = old + (value - old).clamp(-config_.clip_range, config_.clip_range);
+  return 0.5 * torch::max((value - target).pow(2), (clipped - target).pow(2)).mean();
+}
+
+double Trainer::step_optimizer(const torch::Tensor& loss, double checked_loss,
+                               const std::string& losses, const MinibatchPosition& at) {
+  loss.backward();
+  const double grad_norm =
+      torch::nn::utils::clip_grad_norm_(policy_->parameters(), config_.max_grad_norm);
+  if (!std::isfinite(checked_loss) || !std::isfinite(grad_norm)) {
+    // A step would write NaN or infinite weights; the next rollout would then act with NaN.
+    throw std::runtime_error("Trainer::update: update " + std::to_string(updates_ + 1) +
+                             ", epoch " + std::to_string(at.epoch + 1) + ", minibatch " +
+                             std::to_string(at.minibatch + 1) + " diverged: " + losses +
+                             ", gradient norm " + std::to_string(grad_norm) +
+                             "; the parameters are left as the previous minibatch made them, not "
+                             "stepped");
+  }
+  optimizer_->step();
+  return grad_norm;
+}
+
+void Trainer::step_value_only(const UpdateBatch& batch, const torch::Tensor& index,
+                              const MinibatchPosition& at) {
+  const Evaluation now = policy_->evaluate(
+      select_rows(batch.obs, index), batch.actions.index_select(0, index),
+      batch.shifts.defined() ? batch.shifts.index_select(0, index) : torch::Tensor(),
+      config_.shift_pad);
+  const torch::Tensor loss = value_loss(batch, index, now.value);
+  // Gradients left undefined are skipped by Adam (a zero gradient would still move the policy's
+  // parameters through Adam's momentum).
+  for (const torch::Tensor& parameter : policy_->parameters()) parameter.mutable_grad().reset();
+  const double checked = loss.item<double>();
+  step_optimizer(config_.value_coef * loss, checked, "value loss " + std::to_string(checked), at);
+}
+
+double Trainer::step_minibatch(const UpdateBatch& batch, const torch::Tensor& index,
+                               const MinibatchPosition& at, UpdateStats& stats) {
+  const Evaluation now = policy_->evaluate(
+      select_rows(batch.obs, index), batch.actions.index_select(0, index),
+      batch.shifts.defined() ? batch.shifts.index_select(0, index) : torch::Tensor(),
+      config_.shift_pad);
+  const torch::Tensor value = value_loss(batch, index, now.value);
+  const torch::Tensor log_ratio = now.log_prob - batch.old_log_probs.index_select(0, index);
+  const torch::Tensor ratio = log_ratio.exp();
+  torch::Tensor advantage = batch.advantages.index_select(0, index);
+  if (config_.normalize_advantages && batch.minibatch > 1) {
+    advantage = (advantage - advantage.mean()) / (advantage.std() + 1e-8);
+  }
+  const torch::Tensor policy_loss =
+      torch::max(-advantage * ratio,
+                 -advantage * ratio.clamp(1.0 - config_.clip_range, 1.0 + config_.clip_range))
+          .mean();
+  const torch::Tensor entropy = now.entropy.mean();
+  const torch::Tensor loss =
+      policy_loss - config_.entropy_coef * entropy + config_.value_coef * value;
+
+  optimizer_->zero_grad();
+  const double grad_norm =
+      step_optimizer(loss, loss.item<double>(),
+                     "loss " + std::to_string(loss.item<double>()) + " (policy " +
+                         std::to_string(policy_loss.item<double>()) + ", value " +
+                         std::to_string(value.item<double>()) + ")",
+                     at);
+  double approx_kl;
+  {
+    torch::NoGradGuard no_grad;
+    approx_kl = ((ratio - 1.0) - log_ratio).mean().item<double>();
+    stats.clip_fraction +=
+        ((ratio - 1.0).abs() > config_.clip_range).to(torch::kFloat32).mean().item<double>();
+  }
+  stats.policy_loss += policy_loss.item<double>();
+  stats.value_loss += value.item<double>();
+  stats.entropy += entropy.item<double>();
+  stats.approx_kl += approx_kl;
+  stats.grad_norm += grad_norm;
+  stats.minibatches += 1;
+  return approx_kl;
+}
+
 UpdateStats Trainer::update() {
   if (!collected_) throw std::logic_error("Trainer::update: no rollout collected since the last");
   UpdateStats stats;
@@ -496,34 +609,7 @@ UpdateStats Trainer::update() {
   for (auto& group : optimizer_->param_groups()) {
     static_cast<torch::optim::AdamOptions&>(group.options()).lr(stats.learning_rate);
   }
-
-  const std::int64_t batch = config_.num_steps * config_.num_envs;
-  const std::int64_t minibatch = batch / config_.num_minibatches;
-  const ObservationTensors obs = storage_.flat_observations();
-  const torch::Tensor actions = storage_.actions.flatten(0, 1);
-  torch::Tensor old_log_probs = storage_.log_probs.flatten(0, 1);
-  torch::Tensor old_values = storage_.values.flatten(0, 1);
-  const torch::Tensor advantages = storage_.advantages.flatten(0, 1);
-  const torch::Tensor returns = storage_.returns.flatten(0, 1);
-
-  torch::Tensor shifts;
-  if (config_.augment) {
-    shifts = torch::randint(0, 2 * config_.shift_pad + 1, {batch, 2}, augmentation_, torch::kInt64);
-    // Old log-probs and values of the shifted images, so that the ratio starts at 1.
-    torch::NoGradGuard no_grad;
-    old_log_probs = torch::empty_like(old_log_probs);
-    old_values = torch::empty_like(old_values);
-    for (std::int64_t begin = 0; begin < batch; begin += minibatch) {
-      const torch::Tensor index = torch::arange(begin, begin + minibatch, torch::kInt64);
-      const Evaluation old =
-          policy_->evaluate(select_rows(obs, index), actions.index_select(0, index),
-                            shifts.index_select(0, index), config_.shift_pad);
-      old_log_probs.index_copy_(0, index, old.log_prob);
-      old_values.index_copy_(0, index, old.value);
-    }
-  }
-
-  const auto parameters = policy_->parameters();
+  const UpdateBatch batch = update_batch();
   // With a separate value network the KL stop ends only the policy's steps: the value's loss
   // reaches none of the policy's parameters, so the value network can go on through every epoch
   // without moving the policy.
@@ -531,87 +617,17 @@ UpdateStats Trainer::update() {
   bool stop = false;
   for (std::int64_t epoch = 0; epoch < config_.update_epochs && !(stop && !value_after_stop);
        ++epoch) {
-    const torch::Tensor order = torch::randperm(batch, sampling_, torch::kInt64);
+    const torch::Tensor order = torch::randperm(batch.size, sampling_, torch::kInt64);
     std::int64_t policy_steps_in_epoch = 0;
     for (std::int64_t m = 0; m < config_.num_minibatches; ++m) {
-      const torch::Tensor index = order.slice(0, m * minibatch, (m + 1) * minibatch);
-      const Evaluation now = policy_->evaluate(
-          select_rows(obs, index), actions.index_select(0, index),
-          shifts.defined() ? shifts.index_select(0, index) : torch::Tensor(), config_.shift_pad);
-      const torch::Tensor target = returns.index_select(0, index);
-      torch::Tensor value_loss;
-      if (config_.clip_value_loss) {
-        const torch::Tensor old = old_values.index_select(0, index);
-        const torch::Tensor clipped =
-            old + (now.value - old).clamp(-config_.clip_range, config_.clip_range);
-        value_loss =
-            0.5 * torch::max((now.value - target).pow(2), (clipped - target).pow(2)).mean();
-      } else {
-        value_loss = 0.5 * (now.value - target).pow(2).mean();
-      }
+      const torch::Tensor index = order.slice(0, m * batch.minibatch, (m + 1) * batch.minibatch);
+      const MinibatchPosition at{epoch, m};
       if (stop) {
-        // The value network alone. Gradients left undefined are skipped by Adam (a zero
-        // gradient would still move the policy's parameters through Adam's momentum).
-        for (const torch::Tensor& parameter : parameters) parameter.mutable_grad().reset();
-        (config_.value_coef * value_loss).backward();
-        const double grad_norm =
-            torch::nn::utils::clip_grad_norm_(parameters, config_.max_grad_norm);
-        if (!std::isfinite(value_loss.item<double>()) || !std::isfinite(grad_norm)) {
-          throw std::runtime_error("Trainer::update: update " + std::to_string(updates_ + 1) +
-                                   ", epoch " + std::to_string(epoch + 1) + ", minibatch " +
-                                   std::to_string(m + 1) + " diverged: value loss " +
-                                   std::to_string(value_loss.item<double>()) + ", gradient norm " +
-                                   std::to_string(grad_norm) +
-                                   "; the parameters are left as the previous minibatch made "
-                                   "them, not stepped");
-        }
-        optimizer_->step();
+        step_value_only(batch, index, at);
         stats.value_minibatches += 1;
         continue;
       }
-      const torch::Tensor log_ratio = now.log_prob - old_log_probs.index_select(0, index);
-      const torch::Tensor ratio = log_ratio.exp();
-      torch::Tensor advantage = advantages.index_select(0, index);
-      if (config_.normalize_advantages && minibatch > 1) {
-        advantage = (advantage - advantage.mean()) / (advantage.std() + 1e-8);
-      }
-      const torch::Tensor policy_loss =
-          torch::max(-advantage * ratio,
-                     -advantage * ratio.clamp(1.0 - config_.clip_range, 1.0 + config_.clip_range))
-              .mean();
-      const torch::Tensor entropy = now.entropy.mean();
-      const torch::Tensor loss =
-          policy_loss - config_.entropy_coef * entropy + config_.value_coef * value_loss;
-
-      optimizer_->zero_grad();
-      loss.backward();
-      const double grad_norm = torch::nn::utils::clip_grad_norm_(parameters, config_.max_grad_norm);
-      if (!std::isfinite(loss.item<double>()) || !std::isfinite(grad_norm)) {
-        // A step would write NaN or infinite weights; the next rollout would then act with NaN.
-        throw std::runtime_error(
-            "Trainer::update: update " + std::to_string(updates_ + 1) + ", epoch " +
-            std::to_string(epoch + 1) + ", minibatch " + std::to_string(m + 1) +
-            " diverged: loss " + std::to_string(loss.item<double>()) + " (policy " +
-            std::to_string(policy_loss.item<double>()) + ", value " +
-            std::to_string(value_loss.item<double>()) + "), gradient norm " +
-            std::to_string(grad_norm) +
-            "; the parameters are left as the previous minibatch made them, not stepped");
-      }
-      optimizer_->step();
-
-      double approx_kl;
-      {
-        torch::NoGradGuard no_grad;
-        approx_kl = ((ratio - 1.0) - log_ratio).mean().item<double>();
-        stats.clip_fraction +=
-            ((ratio - 1.0).abs() > config_.clip_range).to(torch::kFloat32).mean().item<double>();
-      }
-      stats.policy_loss += policy_loss.item<double>();
-      stats.value_loss += value_loss.item<double>();
-      stats.entropy += entropy.item<double>();
-      stats.approx_kl += approx_kl;
-      stats.grad_norm += grad_norm;
-      stats.minibatches += 1;
+      const double approx_kl = step_minibatch(batch, index, at, stats);
       policy_steps_in_epoch += 1;
       if (config_.target_kl > 0.0 && approx_kl > config_.target_kl) {
         stop = true;
@@ -620,6 +636,14 @@ UpdateStats Trainer::update() {
     }
     if (policy_steps_in_epoch > 0) stats.epochs += 1;
   }
+  finish_update_stats(stats);
+  policy_->update_observation_statistics(batch.obs);
+  updates_ += 1;
+  collected_ = false;
+  return stats;
+}
+
+void Trainer::finish_update_stats(UpdateStats& stats) const {
   const auto count = static_cast<double>(stats.minibatches);
   stats.policy_loss /= count;
   stats.value_loss /= count;
@@ -627,19 +651,12 @@ UpdateStats Trainer::update() {
   stats.approx_kl /= count;
   stats.clip_fraction /= count;
   stats.grad_norm /= count;
-  {
-    const torch::Tensor values = storage_.values.flatten();
-    const torch::Tensor targets = storage_.returns.flatten();
-    const double variance = targets.var(/*unbiased=*/false).item<double>();
-    stats.explained_variance =
-        variance == 0.0
-            ? 0.0
-            : 1.0 - (targets - values).var(/*unbiased=*/false).item<double>() / variance;
-  }
-  policy_->update_observation_statistics(obs);
-  updates_ += 1;
-  collected_ = false;
-  return stats;
+  const torch::Tensor values = storage_.values.flatten();
+  const torch::Tensor targets = storage_.returns.flatten();
+  const double variance = targets.var(/*unbiased=*/false).item<double>();
+  stats.explained_variance =
+      variance == 0.0 ? 0.0
+                      : 1.0 - (targets - values).var(/*unbiased=*/false).item<double>() / variance;
 }
 
 void Trainer::set_progress(std::int64_t env_steps, std::int64_t updates) {

@@ -270,6 +270,34 @@ class Trainer {
   std::uint64_t env_digest() const;
 
  private:
+  // The rollout flattened for an update, with the shifts of its augmentation (undefined
+  // without) and the old log-probs and values under them.
+  struct UpdateBatch {
+    std::int64_t size = 0;
+    std::int64_t minibatch = 0;
+    ObservationTensors obs;
+    torch::Tensor actions, old_log_probs, old_values, advantages, returns, shifts;
+  };
+  struct MinibatchPosition {
+    std::int64_t epoch = 0;
+    std::int64_t minibatch = 0;
+  };
+  UpdateBatch update_batch();
+  torch::Tensor value_loss(const UpdateBatch& batch, const torch::Tensor& index,
+                           const torch::Tensor& value) const;
+  // Backward of `loss`, gradient clipping, then the optimizer's step; throws (naming `at` and
+  // `losses`) without stepping when `checked_loss` or the gradient norm is not finite. Returns
+  // the gradient norm.
+  double step_optimizer(const torch::Tensor& loss, double checked_loss, const std::string& losses,
+                        const MinibatchPosition& at);
+  // A minibatch of the value loss alone (after the KL stop, with a separate value network).
+  void step_value_only(const UpdateBatch& batch, const torch::Tensor& index,
+                       const MinibatchPosition& at);
+  // A minibatch of the PPO loss; adds its figures to `stats`; returns its approximate KL.
+  double step_minibatch(const UpdateBatch& batch, const torch::Tensor& index,
+                        const MinibatchPosition& at, UpdateStats& stats);
+  // Averages the sums over the minibatches; the explained variance of the rollout.
+  void finish_update_stats(UpdateStats& stats) const;
   // The env the trainer steps: normalizer_ when it normalizes rewards, else episodes_.
   vector::VectorEnv& stepped();
   // Appends the episodes that `step` ended (episodes_'s infos) to `ended`.
