@@ -25,7 +25,7 @@ grey=(--wrap grayscale)
 [ "${FRAMES:-grey}" = rgb ] && grey=()
 "$pixelgym" train CartPoleBalance-v1 --set obs_mode=pixels --set width=64 --set height=64 \
   --set msaa=4 --set action_repeat=8 "${grey[@]}" --wrap frame_stack=3 \
-  --config examples/ppo/configs/action_repeat_8.json --steps "$steps" --eval-episodes 1 --quiet \
+  --config examples/trainer/ppo/configs/action_repeat_8.json --steps "$steps" --eval-episodes 1 --quiet \
   --out "$out/run" "$@" > "$out/log.txt"
 /usr/bin/python3 - "$out/run/progress.csv" <<'EOF'
 import csv, statistics, sys

@@ -113,7 +113,7 @@ std::vector<Command> add_render_commands(CLI::App& app);
 /// Adds record (episodes to .mp4 through wrappers::RecordVideo) to `app`.
 std::vector<Command> add_record_commands(CLI::App& app);
 
-/// Adds train and eval (PPO on LibTorch, examples/ppo).
+/// Adds train and eval (PPO on LibTorch, examples/trainer/ppo).
 std::vector<Command> add_train_commands(CLI::App& app);
 
 }  // namespace pixelgym::cli

@@ -1,4 +1,4 @@
-// pixelgym train / eval: the trainer's run (examples/ppo/run) with PPO (examples/ppo).
+// pixelgym train / eval: the trainer's run (examples/trainer/run) with PPO (examples/trainer/ppo).
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -8,10 +8,10 @@
 #include <vector>
 
 #include "examples/pixelgym/cli.h"
-#include "examples/ppo/ppo_algorithm.h"
-#include "examples/ppo/run/evaluation.h"
-#include "examples/ppo/run/process_tuning.h"
-#include "examples/ppo/run/training_run.h"
+#include "examples/trainer/ppo/ppo_algorithm.h"
+#include "examples/trainer/run/evaluation.h"
+#include "examples/trainer/run/process_tuning.h"
+#include "examples/trainer/run/training_run.h"
 
 namespace pixelgym::cli {
 namespace {
@@ -39,9 +39,9 @@ struct TrainArguments : EnvArguments {
 };
 
 // The settings of a new run: the flags, over the --config file's PPO settings.
-ppo::RunSettings new_run_settings(const TrainArguments& args,
-                                  const ppo::AlgorithmFactory& algorithm) {
-  ppo::RunSettings settings;
+trainer::RunSettings new_run_settings(const TrainArguments& args,
+                                      const trainer::AlgorithmFactory& algorithm) {
+  trainer::RunSettings settings;
   settings.env_id = args.id;
   settings.sets = args.sets;
   settings.wraps = args.wraps;
@@ -65,9 +65,9 @@ ppo::RunSettings new_run_settings(const TrainArguments& args,
 }
 
 // The run settings given on the command line, which a resume checks against the run's.
-ppo::ResumeChecks resume_checks(const TrainArguments& args) {
+trainer::ResumeChecks resume_checks(const TrainArguments& args) {
   const auto given = [&](const char* flag) { return args.command->count(flag) > 0; };
-  ppo::ResumeChecks checks;
+  trainer::ResumeChecks checks;
   if (args.seed_given) checks.seed = args.seed;
   if (args.num_envs > 0) checks.num_envs = args.num_envs;
   if (given("--threads")) checks.num_threads = args.threads;
@@ -88,21 +88,23 @@ int run_train(const TrainArguments& args) {
         "train --resume takes the env and settings from the run's config.json: give no id, "
         "--set, --wrap, --config or --out with it");
   }
-  ppo::tune_process_for_training();
+  trainer::tune_process_for_training();
   const ppo::PpoAlgorithmFactory ppo;
-  const ppo::TrainBudget budget{args.steps, args.minutes};
-  const ppo::RunOutput output{std::cout, std::cerr, ppo::ProgressLine::mode_for_stdout(args.quiet),
-                              ppo::ProgressLine::stdout_columns()};
+  const trainer::TrainBudget budget{args.steps, args.minutes};
+  const trainer::RunOutput output{std::cout, std::cerr,
+                                  trainer::ProgressLine::mode_for_stdout(args.quiet),
+                                  trainer::ProgressLine::stdout_columns()};
   try {
-    ppo::TrainingRun run =
-        args.resume.empty() ? ppo::TrainingRun::create(ppo, parse_sets, new_run_settings(args, ppo),
-                                                       args.out.empty() ? fs::path("runs") / args.id
-                                                                        : fs::path(args.out),
-                                                       budget, output)
-                            : ppo::TrainingRun::resume(ppo, parse_sets, args.resume, budget,
-                                                       resume_checks(args), output);
+    trainer::TrainingRun run =
+        args.resume.empty()
+            ? trainer::TrainingRun::create(
+                  ppo, parse_sets, new_run_settings(args, ppo),
+                  args.out.empty() ? fs::path("runs") / args.id : fs::path(args.out), budget,
+                  output)
+            : trainer::TrainingRun::resume(ppo, parse_sets, args.resume, budget,
+                                           resume_checks(args), output);
     run.train();
-  } catch (const ppo::RunRequestError& error) {
+  } catch (const trainer::RunRequestError& error) {
     throw UsageError(error.what());
   }
   return 0;
@@ -112,7 +114,7 @@ int run_train(const TrainArguments& args) {
 void add_run_options(CLI::App& train, TrainArguments& args) {
   train.add_option("--config", args.config_file,
                    "PPO settings as JSON (any subset of the fields; the rest keep their defaults: "
-                   "see examples/ppo/ppo.h, PpoConfig)");
+                   "see examples/trainer/ppo/ppo.h, PpoConfig)");
   train.add_option("--steps", args.steps,
                    "Env steps to train for, all envs together; with --set action_repeat=K "
                    "each is K control steps (default: the config's total_env_steps, 1,000,000)");
@@ -196,12 +198,12 @@ int run_eval(const EvalArguments& args) {
       (fs::path(args.video).extension() != ".mp4" || fs::path(args.video).stem().empty())) {
     throw UsageError("eval --video: expected a FILE.mp4, got \"" + args.video + "\"");
   }
-  ppo::tune_process_for_training();
-  ppo::EvaluationRequest request{args.episodes, args.seed, args.stochastic, std::nullopt};
+  trainer::tune_process_for_training();
+  trainer::EvaluationRequest request{args.episodes, args.seed, args.stochastic, std::nullopt};
   if (!args.video.empty()) request.video = fs::path(args.video);
-  const ppo::CheckpointEvaluation result = ppo::evaluate_checkpoint(
+  const trainer::CheckpointEvaluation result = trainer::evaluate_checkpoint(
       ppo::PpoAlgorithmFactory(), parse_sets, args.run, request, std::cerr);
-  const ppo::PolicyEvaluation& evaluation = result.evaluation;
+  const trainer::PolicyEvaluation& evaluation = result.evaluation;
   std::cout << result.checkpoint.string() << ": " << result.settings.env_id << ", " << args.episodes
             << " episodes from seed " << args.seed
             << (args.stochastic ? ", sampled actions" : ", deterministic actions") << "\n";

@@ -16,8 +16,8 @@
 #include <string>
 #include <thread>
 
-#include "examples/ppo/run/checkpoint_file.h"
-#include "examples/ppo/run/progress_csv.h"
+#include "examples/trainer/run/checkpoint_file.h"
+#include "examples/trainer/run/progress_csv.h"
 #include "tests/examples/cli_run.h"
 
 namespace pixelgym::testing {
@@ -81,7 +81,7 @@ TEST(TrainCliTest, AShortRunWritesACompleteRunFolder) {
   }
 
   // 320 steps of 2 envs x 16: 10 updates, one row each.
-  const ppo::ProgressTable progress = ppo::read_progress_csv(run / "progress.csv");
+  const trainer::ProgressTable progress = trainer::read_progress_csv(run / "progress.csv");
   ASSERT_EQ(progress.rows.size(), 10U);
   EXPECT_EQ(progress.column("steps").front(), 32.0);
   EXPECT_EQ(progress.column("steps").back(), 320.0);
@@ -90,7 +90,7 @@ TEST(TrainCliTest, AShortRunWritesACompleteRunFolder) {
 
   // Checkpoints after updates 4 and 8 (every 4) and at the end (10), all loadable.
   for (const char* name : {"ckpt-000004.pgck", "ckpt-000008.pgck", "ckpt-000010.pgck"}) {
-    const ppo::CheckpointBlobs blobs = ppo::read_checkpoint(run / name);
+    const trainer::CheckpointBlobs blobs = trainer::read_checkpoint(run / name);
     EXPECT_EQ(blobs.count("model"), 1U) << name;
     EXPECT_EQ(blobs.count("optimizer"), 1U) << name;
   }
@@ -126,16 +126,16 @@ TEST(TrainCliTest, AShortRunWritesACompleteRunFolder) {
   EXPECT_NE(alone.output.find(expected.str()), std::string::npos) << alone.output;
   // A checkpoint without the settings (written before they were kept) needs its folder's
   // config.json: away from it, it is refused by name; beside it, it evaluates the same.
-  ppo::CheckpointBlobs older = ppo::read_checkpoint(run / "ckpt-000010.pgck");
+  trainer::CheckpointBlobs older = trainer::read_checkpoint(run / "ckpt-000010.pgck");
   older.erase("config");
-  ppo::write_checkpoint(away / "older.pgck", older);
+  trainer::write_checkpoint(away / "older.pgck", older);
   const CliRun lost = run_cli("eval " + (away / "older.pgck").string() + " --episodes 1");
   EXPECT_EQ(lost.exit_code, 1) << lost.output;
   EXPECT_NE(lost.output.find("does not carry its run's settings, and there is no config.json in " +
                              away.string()),
             std::string::npos)
       << lost.output;
-  ppo::write_checkpoint(run / "older.pgck", older);
+  trainer::write_checkpoint(run / "older.pgck", older);
   const CliRun beside =
       run_cli("eval " + (run / "older.pgck").string() + " --episodes 1 --seed 1000000");
   ASSERT_EQ(beside.exit_code, 0) << beside.output;
@@ -152,7 +152,7 @@ TEST(TrainCliTest, AShortRunWritesACompleteRunFolder) {
   // A second run into the same folder is refused; the run is left as it was.
   const CliRun again = run_cli(train_arguments(folder, "--steps 32 --out " + run.string()));
   EXPECT_EQ(again.exit_code, 1) << again.output;
-  EXPECT_EQ(ppo::read_progress_csv(run / "progress.csv").rows.size(), 10U);
+  EXPECT_EQ(trainer::read_progress_csv(run / "progress.csv").rows.size(), 10U);
   fs::remove_all(folder);
 }
 
@@ -195,7 +195,7 @@ TEST(TrainCliTest, TorchThreadsAreRecordedAndKeptOnResume) {
 // The checkpoint files of a run folder, lowest update first.
 std::vector<std::string> checkpoint_names(const fs::path& run) {
   std::vector<std::string> names;
-  for (const fs::path& path : ppo::list_checkpoints(run)) names.push_back(path.filename());
+  for (const fs::path& path : trainer::list_checkpoints(run)) names.push_back(path.filename());
   return names;
 }
 
@@ -232,12 +232,12 @@ TEST(TrainCliTest, ResumeRefusesSettingsThatDifferFromTheRunsAndAcceptsTheSame) 
                                 "--minutes may change)"),
             std::string::npos)
       << refused.output;
-  EXPECT_EQ(ppo::read_progress_csv(run / "progress.csv").rows.size(), 1U);
+  EXPECT_EQ(trainer::read_progress_csv(run / "progress.csv").rows.size(), 1U);
   // The run's own values (and --seed 0, its seed) are accepted.
   const CliRun resumed = run_cli("train --resume " + run.string() +
                                  " --steps 64 --threads 2 --keep-checkpoints 3 --seed 0 --quiet");
   ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
-  EXPECT_EQ(ppo::read_progress_csv(run / "progress.csv").rows.size(), 2U);
+  EXPECT_EQ(trainer::read_progress_csv(run / "progress.csv").rows.size(), 2U);
   fs::remove_all(folder);
 }
 
@@ -253,7 +253,7 @@ TEST(TrainCliTest, ARunKilledMidTrainingResumesFromItsLastCheckpoint) {
   ASSERT_TRUE(fs::exists(run / "ckpt-000004.pgck")) << read_text(folder / "log.txt");
   ASSERT_TRUE(killed);
 
-  const ppo::CheckpointSearch latest = ppo::find_latest_checkpoint(run);
+  const trainer::CheckpointSearch latest = trainer::find_latest_checkpoint(run);
   ASSERT_TRUE(latest.latest.has_value());
   const std::int64_t resumed_update = latest.latest->update;
   EXPECT_GE(resumed_update, 4);
@@ -275,7 +275,7 @@ TEST(TrainCliTest, ARunKilledMidTrainingResumesFromItsLastCheckpoint) {
   EXPECT_EQ(summary.at("updates"), resumed_update + 2);
   // Rows logged after that checkpoint were dropped and logged again: one row per update, in
   // order, to the end.
-  const ppo::ProgressTable progress = ppo::read_progress_csv(run / "progress.csv");
+  const trainer::ProgressTable progress = trainer::read_progress_csv(run / "progress.csv");
   ASSERT_EQ(progress.rows.size(), static_cast<std::size_t>(resumed_update + 2));
   const std::vector<double> steps = progress.column("steps");
   for (std::size_t i = 0; i < steps.size(); ++i) {
@@ -309,7 +309,7 @@ TEST(TrainCliTest, AResumedRunIsTheRunThatDidNotStop) {
                             train_arguments(folder, settings + split.string(), config, obs_mode),
                             split / "ckpt-000004.pgck"))
       << read_text(folder / "log.txt");
-  const ppo::CheckpointSearch latest = ppo::find_latest_checkpoint(split);
+  const trainer::CheckpointSearch latest = trainer::find_latest_checkpoint(split);
   ASSERT_TRUE(latest.latest.has_value());
   const std::int64_t from = latest.latest->update;
   ASSERT_LT(from, 10) << "the run ended before it was killed";
@@ -322,9 +322,9 @@ TEST(TrainCliTest, AResumedRunIsTheRunThatDidNotStop) {
       << resumed.output;
 
   for (std::int64_t update = 2; update <= 10; update += 2) {
-    const std::string name = ppo::checkpoint_file_name(update);
-    const ppo::CheckpointBlobs a = ppo::read_checkpoint(straight / name);
-    const ppo::CheckpointBlobs b = ppo::read_checkpoint(split / name);
+    const std::string name = trainer::checkpoint_file_name(update);
+    const trainer::CheckpointBlobs a = trainer::read_checkpoint(straight / name);
+    const trainer::CheckpointBlobs b = trainer::read_checkpoint(split / name);
     // Not "optimizer": LibTorch keys the saved Adam state by each tensor's address, so its bytes
     // differ between processes. Its content is compared through the models: any difference in
     // it changes the parameters of the updates after the resume.
@@ -339,8 +339,8 @@ TEST(TrainCliTest, AResumedRunIsTheRunThatDidNotStop) {
     EXPECT_EQ(meta_a.at("reward_scaling"), meta_b.at("reward_scaling")) << name;
     EXPECT_EQ(meta_a.at("recent_returns"), meta_b.at("recent_returns")) << name;
   }
-  const ppo::ProgressTable a = ppo::read_progress_csv(straight / "progress.csv");
-  const ppo::ProgressTable b = ppo::read_progress_csv(split / "progress.csv");
+  const trainer::ProgressTable a = trainer::read_progress_csv(straight / "progress.csv");
+  const trainer::ProgressTable b = trainer::read_progress_csv(split / "progress.csv");
   for (const char* column :
        {"steps", "episode_return_mean", "policy_loss", "value_loss", "entropy", "approx_kl"}) {
     const std::vector<double> x = a.column(column);
@@ -363,7 +363,7 @@ TEST(TrainCliTest, AResumedRunIsTheRunThatDidNotStop) {
 TEST(TrainCliTest, AResumedRunKeepsItsTimeBudgetUnlessGivenMore) {
   const fs::path folder = fresh_folder("minutes");
   const fs::path run = folder / "run";
-  const auto rows = [&] { return ppo::read_progress_csv(run / "progress.csv").rows.size(); };
+  const auto rows = [&] { return trainer::read_progress_csv(run / "progress.csv").rows.size(); };
   // 0.6 ms: the run stops by time after its one update.
   const CliRun trained =
       run_cli(train_arguments(folder, "--steps 320 --minutes 0.00001 --out " + run.string()));
@@ -422,13 +422,13 @@ TEST(TrainCliTest, AResumedRunKeepsItsTimeBudgetUnlessGivenMore) {
 
   // A checkpoint whose envs the replay does not reproduce (here: its digest altered, as after
   // a change of code or library) resumes with a warning saying so.
-  const ppo::CheckpointSearch latest = ppo::find_latest_checkpoint(run);
+  const trainer::CheckpointSearch latest = trainer::find_latest_checkpoint(run);
   ASSERT_TRUE(latest.latest.has_value());
-  ppo::CheckpointBlobs blobs = latest.latest->blobs;
+  trainer::CheckpointBlobs blobs = latest.latest->blobs;
   json meta = json::parse(blobs.at("meta"));
   meta["env_digest"] = meta.at("env_digest").get<std::uint64_t>() + 1;
   blobs["meta"] = meta.dump();
-  ppo::write_checkpoint(latest.latest->path, blobs);
+  trainer::write_checkpoint(latest.latest->path, blobs);
   const CliRun changed = run_cli("train --resume " + run.string() + " --quiet --minutes 0.00001");
   ASSERT_EQ(changed.exit_code, 0) << changed.output;
   EXPECT_NE(changed.output.find("warning: the replayed envs are not where the checkpoint's were"),

@@ -1,0 +1,703 @@
+#include "examples/trainer/ppo/ppo.h"
+
+#include <ATen/CPUGeneratorImpl.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <utility>
+
+#include "examples/trainer/ppo/gae.h"
+
+namespace pixelgym::ppo {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// vector::NormalizeReward's default epsilon: rewards are divided by sqrt(var + epsilon).
+constexpr double kRewardEpsilon = 1e-8;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Rows `index` of every tensor of `obs` (dim 0).
+ObservationTensors select_rows(const ObservationTensors& obs, const torch::Tensor& index) {
+  ObservationTensors rows;
+  for (const auto& [key, tensor] : obs) rows.emplace(key, tensor.index_select(0, index));
+  return rows;
+}
+
+// from_json helpers: a member read into `field` with a clear error on a type mismatch.
+template <typename T>
+void read_member(const nlohmann::json& json, const char* name, T& field) {
+  auto found = json.find(name);
+  if (found == json.end()) return;
+  try {
+    field = found->get<T>();
+  } catch (const nlohmann::json::exception& error) {
+    throw std::invalid_argument(std::string("PpoConfig JSON: member \"") + name +
+                                "\" has the wrong type: " + error.what());
+  }
+}
+
+void require_known_members(const nlohmann::json& json, const std::vector<std::string>& known,
+                           const char* what) {
+  if (!json.is_object()) {
+    throw std::invalid_argument(std::string(what) + " JSON must be an object, got " +
+                                json.type_name());
+  }
+  for (const auto& item : json.items()) {
+    bool ok = false;
+    for (const std::string& name : known) ok = ok || item.key() == name;
+    if (!ok) {
+      std::string list;
+      for (const std::string& name : known) list += (list.empty() ? "" : ", ") + name;
+      throw std::invalid_argument(std::string(what) + " JSON: unknown member \"" + item.key() +
+                                  "\"; known: " + list);
+    }
+  }
+}
+
+}  // namespace
+
+// ---- PpoConfig -------------------------------------------------------------------------------
+
+void PpoConfig::validate() const {
+  auto fail = [](const std::string& what) { throw std::invalid_argument("PpoConfig: " + what); };
+  auto positive = [&](const char* name, double value) {
+    if (!(value > 0.0) || !std::isfinite(value)) {
+      fail(std::string(name) + " must be > 0 and finite, got " + std::to_string(value));
+    }
+  };
+  auto non_negative = [&](const char* name, double value) {
+    if (!(value >= 0.0) || !std::isfinite(value)) {
+      fail(std::string(name) + " must be >= 0 and finite, got " + std::to_string(value));
+    }
+  };
+  auto unit = [&](const char* name, double value) {
+    if (!(value >= 0.0 && value <= 1.0)) {
+      fail(std::string(name) + " must be in [0, 1], got " + std::to_string(value));
+    }
+  };
+  positive("num_envs", static_cast<double>(num_envs));
+  positive("num_steps", static_cast<double>(num_steps));
+  positive("total_env_steps", static_cast<double>(total_env_steps));
+  positive("learning_rate", learning_rate);
+  positive("adam_epsilon", adam_epsilon);
+  unit("gamma", gamma);
+  unit("gae_lambda", gae_lambda);
+  positive("update_epochs", static_cast<double>(update_epochs));
+  positive("num_minibatches", static_cast<double>(num_minibatches));
+  if (num_minibatches > 0 && (num_steps * num_envs) % num_minibatches != 0) {
+    fail("num_steps * num_envs (" + std::to_string(num_steps * num_envs) +
+         ") must be a multiple of num_minibatches (" + std::to_string(num_minibatches) + ")");
+  }
+  positive("clip_range", clip_range);
+  non_negative("entropy_coef", entropy_coef);
+  non_negative("value_coef", value_coef);
+  positive("max_grad_norm", max_grad_norm);
+  non_negative("target_kl", target_kl);
+  if (shift_pad < 0) fail("shift_pad must be >= 0, got " + std::to_string(shift_pad));
+  policy.validate();
+}
+
+void to_json(nlohmann::json& json, const PolicyConfig& config) {
+  json = nlohmann::json{{"cnn", to_string(config.cnn)},
+                        {"cnn_features", config.cnn_features},
+                        {"mlp_hidden", config.mlp_hidden},
+                        {"trunk_hidden", config.trunk_hidden},
+                        {"initial_log_std", config.initial_log_std},
+                        {"separate_value_network", config.separate_value_network},
+                        {"normalize_observations", config.normalize_observations},
+                        {"observation_clip", config.observation_clip}};
+}
+
+void from_json(const nlohmann::json& json, PolicyConfig& config) {
+  require_known_members(json,
+                        {"cnn", "cnn_features", "mlp_hidden", "trunk_hidden", "initial_log_std",
+                         "separate_value_network", "normalize_observations", "observation_clip"},
+                        "PolicyConfig");
+  std::string cnn = to_string(config.cnn);
+  read_member(json, "cnn", cnn);
+  config.cnn = parse_cnn_architecture(cnn);
+  read_member(json, "cnn_features", config.cnn_features);
+  read_member(json, "mlp_hidden", config.mlp_hidden);
+  read_member(json, "trunk_hidden", config.trunk_hidden);
+  read_member(json, "initial_log_std", config.initial_log_std);
+  read_member(json, "separate_value_network", config.separate_value_network);
+  read_member(json, "normalize_observations", config.normalize_observations);
+  read_member(json, "observation_clip", config.observation_clip);
+  config.validate();
+}
+
+void to_json(nlohmann::json& json, const PpoConfig& config) {
+  json = nlohmann::json{{"seed", config.seed},
+                        {"num_envs", config.num_envs},
+                        {"num_steps", config.num_steps},
+                        {"total_env_steps", config.total_env_steps},
+                        {"learning_rate", config.learning_rate},
+                        {"anneal_learning_rate", config.anneal_learning_rate},
+                        {"adam_epsilon", config.adam_epsilon},
+                        {"gamma", config.gamma},
+                        {"gae_lambda", config.gae_lambda},
+                        {"update_epochs", config.update_epochs},
+                        {"num_minibatches", config.num_minibatches},
+                        {"normalize_advantages", config.normalize_advantages},
+                        {"normalize_rewards", config.normalize_rewards},
+                        {"clip_range", config.clip_range},
+                        {"clip_value_loss", config.clip_value_loss},
+                        {"entropy_coef", config.entropy_coef},
+                        {"value_coef", config.value_coef},
+                        {"max_grad_norm", config.max_grad_norm},
+                        {"target_kl", config.target_kl},
+                        {"augment", config.augment},
+                        {"shift_pad", config.shift_pad},
+                        {"policy", config.policy}};
+}
+
+void from_json(const nlohmann::json& json, PpoConfig& config) {
+  require_known_members(json,
+                        {"seed",
+                         "num_envs",
+                         "num_steps",
+                         "total_env_steps",
+                         "learning_rate",
+                         "anneal_learning_rate",
+                         "adam_epsilon",
+                         "gamma",
+                         "gae_lambda",
+                         "update_epochs",
+                         "num_minibatches",
+                         "normalize_advantages",
+                         "normalize_rewards",
+                         "clip_range",
+                         "clip_value_loss",
+                         "entropy_coef",
+                         "value_coef",
+                         "max_grad_norm",
+                         "target_kl",
+                         "augment",
+                         "shift_pad",
+                         "policy"},
+                        "PpoConfig");
+  read_member(json, "seed", config.seed);
+  read_member(json, "num_envs", config.num_envs);
+  read_member(json, "num_steps", config.num_steps);
+  read_member(json, "total_env_steps", config.total_env_steps);
+  read_member(json, "learning_rate", config.learning_rate);
+  read_member(json, "anneal_learning_rate", config.anneal_learning_rate);
+  read_member(json, "adam_epsilon", config.adam_epsilon);
+  read_member(json, "gamma", config.gamma);
+  read_member(json, "gae_lambda", config.gae_lambda);
+  read_member(json, "update_epochs", config.update_epochs);
+  read_member(json, "num_minibatches", config.num_minibatches);
+  read_member(json, "normalize_advantages", config.normalize_advantages);
+  read_member(json, "normalize_rewards", config.normalize_rewards);
+  read_member(json, "clip_range", config.clip_range);
+  read_member(json, "clip_value_loss", config.clip_value_loss);
+  read_member(json, "entropy_coef", config.entropy_coef);
+  read_member(json, "value_coef", config.value_coef);
+  read_member(json, "max_grad_norm", config.max_grad_norm);
+  read_member(json, "target_kl", config.target_kl);
+  read_member(json, "augment", config.augment);
+  read_member(json, "shift_pad", config.shift_pad);
+  if (auto found = json.find("policy"); found != json.end()) {
+    PolicyConfig policy = config.policy;
+    from_json(*found, policy);
+    config.policy = policy;
+  }
+  config.validate();
+}
+
+std::string config_to_json(const PpoConfig& config) { return nlohmann::json(config).dump(2); }
+
+PpoConfig config_from_json(const std::string& text) {
+  nlohmann::json json;
+  try {
+    json = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& error) {
+    throw std::invalid_argument(std::string("PpoConfig JSON: ") + error.what());
+  }
+  PpoConfig config;
+  from_json(json, config);
+  return config;
+}
+
+// ---- RolloutStorage --------------------------------------------------------------------------
+
+RolloutStorage::RolloutStorage(const Policy& policy, std::int64_t steps, std::int64_t envs)
+    : num_steps(steps), num_envs(envs) {
+  for (const PolicyInput& input : policy.inputs()) {
+    std::vector<std::int64_t> shape{steps, envs};
+    shape.insert(shape.end(), input.shape.begin(), input.shape.end());
+    observations.emplace(input.key, torch::zeros(shape, torch_dtype(input.dtype)));
+  }
+  if (policy.discrete()) {
+    actions = torch::zeros({steps, envs}, torch::kInt64);
+  } else {
+    std::vector<std::int64_t> shape{steps, envs};
+    shape.insert(shape.end(), policy.action_shape().begin(), policy.action_shape().end());
+    actions = torch::zeros(shape, torch::kFloat32);
+  }
+  log_probs = torch::zeros({steps, envs});
+  values = torch::zeros({steps, envs});
+  rewards = torch::zeros({steps, envs});
+  terminated = torch::zeros({steps, envs}, torch::kUInt8);
+  truncated = torch::zeros({steps, envs}, torch::kUInt8);
+  final_values = torch::zeros({steps, envs});
+  last_values = torch::zeros({envs});
+  advantages = torch::zeros({steps, envs});
+  returns = torch::zeros({steps, envs});
+}
+
+void RolloutStorage::insert_observations(std::int64_t t, const ObservationTensors& obs) {
+  for (auto& [key, stored] : observations) {
+    auto found = obs.find(key);
+    if (found == obs.end()) {
+      throw std::invalid_argument("RolloutStorage: the observation batch has no key \"" + key +
+                                  "\"");
+    }
+    stored[t].copy_(found->second);
+  }
+}
+
+void RolloutStorage::compute_advantages(double gamma, double lambda) {
+  const torch::Tensor r = rewards.contiguous();
+  const torch::Tensor v = values.contiguous();
+  const torch::Tensor term = terminated.contiguous();
+  const torch::Tensor trunc = truncated.contiguous();
+  const torch::Tensor fv = final_values.contiguous();
+  const torch::Tensor lv = last_values.contiguous();
+  GaeInputs in;
+  in.num_steps = num_steps;
+  in.num_envs = num_envs;
+  in.rewards = r.data_ptr<float>();
+  in.values = v.data_ptr<float>();
+  in.terminated = term.data_ptr<std::uint8_t>();
+  in.truncated = trunc.data_ptr<std::uint8_t>();
+  in.final_values = fv.data_ptr<float>();
+  in.last_values = lv.data_ptr<float>();
+  const GaeOutputs out = compute_gae(in, gamma, lambda);
+  std::memcpy(advantages.data_ptr<float>(), out.advantages.data(),
+              out.advantages.size() * sizeof(float));
+  std::memcpy(returns.data_ptr<float>(), out.returns.data(), out.returns.size() * sizeof(float));
+}
+
+ObservationTensors RolloutStorage::flat_observations() const {
+  ObservationTensors flat;
+  for (const auto& [key, stored] : observations) flat.emplace(key, stored.flatten(0, 1));
+  return flat;
+}
+
+// ---- Trainer ---------------------------------------------------------------------------------
+
+namespace {
+
+// The stats key of the trainer's own RecordEpisodeStatistics (not "episode": the env given may
+// record its own).
+const char* const kEpisodeKey = "ppo_episode";
+
+std::shared_ptr<Policy> make_policy(const vector::VectorEnv& env, const PpoConfig& config) {
+  config.validate();
+  if (env.autoreset_mode() != vector::AutoresetMode::kSameStep) {
+    throw std::invalid_argument(
+        std::string("Trainer: the vector env must autoreset in SameStep mode (truncated steps "
+                    "bootstrap from infos[\"final_obs\"]), got ") +
+        vector::autoreset_mode_name(env.autoreset_mode()));
+  }
+  if (env.num_envs() != config.num_envs) {
+    throw std::invalid_argument("Trainer: config.num_envs is " + std::to_string(config.num_envs) +
+                                " but the vector env has " + std::to_string(env.num_envs()));
+  }
+  torch::manual_seed(config.seed);
+  return std::make_shared<Policy>(env.single_observation_space(), env.single_action_space(),
+                                  config.policy);
+}
+
+}  // namespace
+
+Trainer::Trainer(vector::VectorEnv& env, PpoConfig config)
+    : config_(std::move(config)),
+      policy_(make_policy(env, config_)),
+      optimizer_(std::make_unique<torch::optim::Adam>(
+          policy_->parameters(),
+          torch::optim::AdamOptions(config_.learning_rate).eps(config_.adam_epsilon))),
+      storage_(*policy_, config_.num_steps, config_.num_envs),
+      sampling_(at::detail::createCPUGenerator(config_.seed)),
+      augmentation_(at::detail::createCPUGenerator(config_.seed + 1)),
+      actions_(env.action_space().zeros()) {
+  if (!actions_.is_array()) {
+    throw std::invalid_argument("Trainer: the batched action space must be an array space, got " +
+                                env.action_space().to_string());
+  }
+  auto episodes = std::make_unique<vector::RecordEpisodeStatistics>(
+      std::make_unique<vector::VectorWrapper>(env), 1, kEpisodeKey);
+  episodes_ = episodes.get();
+  normalizer_ =
+      std::make_unique<vector::NormalizeReward>(std::move(episodes), config_.gamma, kRewardEpsilon);
+}
+
+vector::VectorEnv& Trainer::stepped() {
+  if (config_.normalize_rewards) return *normalizer_;
+  return *episodes_;
+}
+
+void Trainer::add_ended_episodes(const vector::VectorStepResult& step,
+                                 std::vector<Episode>& ended) const {
+  const std::string mask_key = std::string("_") + kEpisodeKey;
+  if (!step.infos.contains(mask_key)) return;
+  const bool* mask = step.infos.at(mask_key).array().data<bool>();
+  const ValueDict& stats = step.infos.at(kEpisodeKey).dict();
+  const double* returns = stats.at("r").array().data<double>();
+  const std::int64_t* lengths = stats.at("l").array().data<std::int64_t>();
+  for (std::int64_t i = 0; i < config_.num_envs; ++i) {
+    if (mask[i]) ended.push_back({returns[i], lengths[i]});
+  }
+}
+
+void Trainer::replay_env(const std::string& env_action_log) {
+  if (started_) {
+    throw std::logic_error("Trainer::replay_env: the envs were already reset or stepped");
+  }
+  Array& env_actions = actions_.array();
+  const std::size_t batch_bytes = env_actions.nbytes();
+  const auto batches = static_cast<std::size_t>(env_steps_ / config_.num_envs);
+  if (env_action_log.size() != batches * batch_bytes) {
+    throw std::invalid_argument("Trainer::replay_env: an action log of " + std::to_string(batches) +
+                                " batches of " + std::to_string(batch_bytes) + " bytes (" +
+                                std::to_string(batches * batch_bytes) + " bytes, for " +
+                                std::to_string(env_steps_) + " env steps) expected, got " +
+                                std::to_string(env_action_log.size()) + " bytes");
+  }
+  torch::NoGradGuard no_grad;
+  // Below the reward normalization, whose state comes from the checkpoint.
+  current_obs_ = observation_tensors(episodes_->reset(config_.seed).obs);
+  started_ = true;
+  for (std::size_t b = 0; b < batches; ++b) {
+    std::memcpy(env_actions.raw_data(), env_action_log.data() + b * batch_bytes, batch_bytes);
+    current_obs_ = observation_tensors(episodes_->step(actions_).obs);
+  }
+  env_action_log_ = env_action_log;
+}
+
+bool Trainer::env_action_log_complete() const {
+  const auto batches = static_cast<std::size_t>(env_steps_ / config_.num_envs);
+  return env_action_log_.size() == batches * actions_.array().nbytes();
+}
+
+std::uint64_t Trainer::env_digest() const {
+  if (!started_) return 0;
+  std::uint64_t digest = 14695981039346656037ULL;  // FNV-1a, 64-bit
+  const auto add = [&digest](const void* data, std::size_t size) {
+    const auto* bytes = static_cast<const unsigned char*>(data);
+    for (std::size_t k = 0; k < size; ++k) {
+      digest = (digest ^ bytes[k]) * 1099511628211ULL;
+    }
+  };
+  for (const auto& [key, tensor] : current_obs_) {  // std::map: in key order
+    add(key.data(), key.size());
+    const torch::Tensor contiguous = tensor.contiguous();
+    add(contiguous.data_ptr(), contiguous.nbytes());
+  }
+  const std::vector<double>& returns = episodes_->episode_returns();
+  const std::vector<std::int64_t>& lengths = episodes_->episode_lengths();
+  add(returns.data(), returns.size() * sizeof(double));
+  add(lengths.data(), lengths.size() * sizeof(std::int64_t));
+  return digest;
+}
+
+RolloutStats Trainer::collect() {
+  torch::NoGradGuard no_grad;
+  RolloutStats stats;
+  if (!started_) {
+    const auto start = Clock::now();
+    current_obs_ = observation_tensors(stepped().reset(config_.seed).obs);
+    stats.env_seconds += seconds_since(start);
+    started_ = true;
+  }
+  Array& env_actions = actions_.array();
+  const std::int64_t envs = config_.num_envs;
+  for (std::int64_t t = 0; t < config_.num_steps; ++t) {
+    auto start = Clock::now();
+    const ActResult act = policy_->act(current_obs_, /*deterministic=*/false, sampling_);
+    stats.policy_seconds += seconds_since(start);
+    storage_.insert_observations(t, current_obs_);
+    storage_.actions[t].copy_(act.action);
+    storage_.log_probs[t].copy_(act.log_prob);
+    storage_.values[t].copy_(act.value);
+    const torch::Tensor env_action =
+        act.env_action.to(torch_dtype(env_actions.dtype())).contiguous();
+    if (static_cast<std::size_t>(env_action.nbytes()) != env_actions.nbytes()) {
+      throw std::logic_error("Trainer: the policy's actions do not match the action batch " +
+                             env_actions.to_string());
+    }
+    std::memcpy(env_actions.raw_data(), env_action.data_ptr(), env_actions.nbytes());
+    env_action_log_.append(static_cast<const char*>(env_actions.raw_data()), env_actions.nbytes());
+
+    start = Clock::now();
+    const vector::VectorStepResult& step = stepped().step(actions_);
+    stats.env_seconds += seconds_since(start);
+    const double* rewards = step.rewards.data<double>();
+    const bool* terminated = step.terminated.data<bool>();
+    const bool* truncated = step.truncated.data<bool>();
+    add_ended_episodes(step, stats.episodes);
+    // The storage tensors are contiguous (T, N): row t starts at t * N.
+    float* stored_rewards = storage_.rewards.data_ptr<float>() + t * envs;
+    std::uint8_t* stored_terminated = storage_.terminated.data_ptr<std::uint8_t>() + t * envs;
+    std::uint8_t* stored_truncated = storage_.truncated.data_ptr<std::uint8_t>() + t * envs;
+    float* stored_final_values = storage_.final_values.data_ptr<float>() + t * envs;
+    std::vector<std::int64_t> bootstrap;  // envs truncated (not terminated) in this step
+    for (std::int64_t n = 0; n < envs; ++n) {
+      stored_rewards[n] = static_cast<float>(rewards[n]);
+      stored_terminated[n] = terminated[n] ? 1 : 0;
+      stored_truncated[n] = truncated[n] ? 1 : 0;
+      stored_final_values[n] = 0.0f;
+      if (truncated[n] && !terminated[n]) bootstrap.push_back(n);
+    }
+    if (!bootstrap.empty()) {
+      if (!step.infos.contains("final_obs")) {
+        throw std::logic_error("Trainer: a truncated step without infos[\"final_obs\"]");
+      }
+      start = Clock::now();
+      const torch::Tensor rows = torch::tensor(bootstrap, torch::kInt64);
+      const ObservationTensors final_obs =
+          select_rows(observation_tensors(step.infos.at("final_obs")), rows);
+      storage_.final_values[t].index_copy_(0, rows, policy_->value(final_obs));
+      stats.policy_seconds += seconds_since(start);
+    }
+    current_obs_ = observation_tensors(step.obs);
+  }
+  const auto start = Clock::now();
+  storage_.last_values.copy_(policy_->value(current_obs_));
+  stats.policy_seconds += seconds_since(start);
+  storage_.compute_advantages(config_.gamma, config_.gae_lambda);
+  env_steps_ += config_.num_steps * envs;
+  collected_ = true;
+  return stats;
+}
+
+double Trainer::learning_rate() const {
+  if (!config_.anneal_learning_rate) return config_.learning_rate;
+  // The steps done before the rollout being learned from: the first update uses the full rate.
+  const std::int64_t before =
+      collected_ ? env_steps_ - config_.num_steps * config_.num_envs : env_steps_;
+  const double remaining =
+      1.0 - static_cast<double>(before) / static_cast<double>(config_.total_env_steps);
+  return config_.learning_rate * std::max(remaining, 0.0);
+}
+
+Trainer::UpdateBatch Trainer::update_batch() {
+  UpdateBatch batch;
+  batch.size = config_.num_steps * config_.num_envs;
+  batch.minibatch = batch.size / config_.num_minibatches;
+  batch.obs = storage_.flat_observations();
+  batch.actions = storage_.actions.flatten(0, 1);
+  batch.old_log_probs = storage_.log_probs.flatten(0, 1);
+  batch.old_values = storage_.values.flatten(0, 1);
+  batch.advantages = storage_.advantages.flatten(0, 1);
+  batch.returns = storage_.returns.flatten(0, 1);
+  if (!config_.augment) return batch;
+  batch.shifts =
+      torch::randint(0, 2 * config_.shift_pad + 1, {batch.size, 2}, augmentation_, torch::kInt64);
+  // Old log-probs and values of the shifted images, so that the ratio starts at 1.
+  torch::NoGradGuard no_grad;
+  batch.old_log_probs = torch::empty_like(batch.old_log_probs);
+  batch.old_values = torch::empty_like(batch.old_values);
+  for (std::int64_t begin = 0; begin < batch.size; begin += batch.minibatch) {
+    const torch::Tensor index = torch::arange(begin, begin + batch.minibatch, torch::kInt64);
+    const Evaluation old =
+        policy_->evaluate(select_rows(batch.obs, index), batch.actions.index_select(0, index),
+                          batch.shifts.index_select(0, index), config_.shift_pad);
+    batch.old_log_probs.index_copy_(0, index, old.log_prob);
+    batch.old_values.index_copy_(0, index, old.value);
+  }
+  return batch;
+}
+
+torch::Tensor Trainer::value_loss(const UpdateBatch& batch, const torch::Tensor& index,
+                                  const torch::Tensor& value) const {
+  const torch::Tensor target = batch.returns.index_select(0, index);
+  if (!config_.clip_value_loss) return 0.5 * (value - target).pow(2).mean();
+  const torch::Tensor old = batch.old_values.index_select(0, index);
+  const torch::Tensor clipped = old + (value - old).clamp(-config_.clip_range, config_.clip_range);
+  return 0.5 * torch::max((value - target).pow(2), (clipped - target).pow(2)).mean();
+}
+
+double Trainer::step_optimizer(const torch::Tensor& loss, double checked_loss,
+                               const std::string& losses, const MinibatchPosition& at) {
+  loss.backward();
+  const double grad_norm =
+      torch::nn::utils::clip_grad_norm_(policy_->parameters(), config_.max_grad_norm);
+  if (!std::isfinite(checked_loss) || !std::isfinite(grad_norm)) {
+    // A step would write NaN or infinite weights; the next rollout would then act with NaN.
+    throw std::runtime_error("Trainer::update: update " + std::to_string(updates_ + 1) +
+                             ", epoch " + std::to_string(at.epoch + 1) + ", minibatch " +
+                             std::to_string(at.minibatch + 1) + " diverged: " + losses +
+                             ", gradient norm " + std::to_string(grad_norm) +
+                             "; the parameters are left as the previous minibatch made them, not "
+                             "stepped");
+  }
+  optimizer_->step();
+  return grad_norm;
+}
+
+void Trainer::step_value_only(const UpdateBatch& batch, const torch::Tensor& index,
+                              const MinibatchPosition& at) {
+  const Evaluation now = policy_->evaluate(
+      select_rows(batch.obs, index), batch.actions.index_select(0, index),
+      batch.shifts.defined() ? batch.shifts.index_select(0, index) : torch::Tensor(),
+      config_.shift_pad);
+  const torch::Tensor loss = value_loss(batch, index, now.value);
+  // Gradients left undefined are skipped by Adam (a zero gradient would still move the policy's
+  // parameters through Adam's momentum).
+  for (const torch::Tensor& parameter : policy_->parameters()) parameter.mutable_grad().reset();
+  const double checked = loss.item<double>();
+  step_optimizer(config_.value_coef * loss, checked, "value loss " + std::to_string(checked), at);
+}
+
+double Trainer::step_minibatch(const UpdateBatch& batch, const torch::Tensor& index,
+                               const MinibatchPosition& at, UpdateStats& stats) {
+  const Evaluation now = policy_->evaluate(
+      select_rows(batch.obs, index), batch.actions.index_select(0, index),
+      batch.shifts.defined() ? batch.shifts.index_select(0, index) : torch::Tensor(),
+      config_.shift_pad);
+  const torch::Tensor value = value_loss(batch, index, now.value);
+  const torch::Tensor log_ratio = now.log_prob - batch.old_log_probs.index_select(0, index);
+  const torch::Tensor ratio = log_ratio.exp();
+  torch::Tensor advantage = batch.advantages.index_select(0, index);
+  if (config_.normalize_advantages && batch.minibatch > 1) {
+    advantage = (advantage - advantage.mean()) / (advantage.std() + 1e-8);
+  }
+  const torch::Tensor policy_loss =
+      torch::max(-advantage * ratio,
+                 -advantage * ratio.clamp(1.0 - config_.clip_range, 1.0 + config_.clip_range))
+          .mean();
+  const torch::Tensor entropy = now.entropy.mean();
+  const torch::Tensor loss =
+      policy_loss - config_.entropy_coef * entropy + config_.value_coef * value;
+
+  optimizer_->zero_grad();
+  const double grad_norm =
+      step_optimizer(loss, loss.item<double>(),
+                     "loss " + std::to_string(loss.item<double>()) + " (policy " +
+                         std::to_string(policy_loss.item<double>()) + ", value " +
+                         std::to_string(value.item<double>()) + ")",
+                     at);
+  double approx_kl;
+  {
+    torch::NoGradGuard no_grad;
+    approx_kl = ((ratio - 1.0) - log_ratio).mean().item<double>();
+    stats.clip_fraction +=
+        ((ratio - 1.0).abs() > config_.clip_range).to(torch::kFloat32).mean().item<double>();
+  }
+  stats.policy_loss += policy_loss.item<double>();
+  stats.value_loss += value.item<double>();
+  stats.entropy += entropy.item<double>();
+  stats.approx_kl += approx_kl;
+  stats.grad_norm += grad_norm;
+  stats.minibatches += 1;
+  return approx_kl;
+}
+
+UpdateStats Trainer::update() {
+  if (!collected_) throw std::logic_error("Trainer::update: no rollout collected since the last");
+  UpdateStats stats;
+  stats.learning_rate = learning_rate();
+  for (auto& group : optimizer_->param_groups()) {
+    static_cast<torch::optim::AdamOptions&>(group.options()).lr(stats.learning_rate);
+  }
+  const UpdateBatch batch = update_batch();
+  // With a separate value network the KL stop ends only the policy's steps: the value's loss
+  // reaches none of the policy's parameters, so the value network can go on through every epoch
+  // without moving the policy.
+  const bool value_after_stop = policy_->config().separate_value_network;
+  bool stop = false;
+  for (std::int64_t epoch = 0; epoch < config_.update_epochs && !(stop && !value_after_stop);
+       ++epoch) {
+    const torch::Tensor order = torch::randperm(batch.size, sampling_, torch::kInt64);
+    std::int64_t policy_steps_in_epoch = 0;
+    for (std::int64_t m = 0; m < config_.num_minibatches; ++m) {
+      const torch::Tensor index = order.slice(0, m * batch.minibatch, (m + 1) * batch.minibatch);
+      const MinibatchPosition at{epoch, m};
+      if (stop) {
+        step_value_only(batch, index, at);
+        stats.value_minibatches += 1;
+        continue;
+      }
+      const double approx_kl = step_minibatch(batch, index, at, stats);
+      policy_steps_in_epoch += 1;
+      if (config_.target_kl > 0.0 && approx_kl > config_.target_kl) {
+        stop = true;
+        if (!value_after_stop) break;
+      }
+    }
+    if (policy_steps_in_epoch > 0) stats.epochs += 1;
+  }
+  finish_update_stats(stats);
+  policy_->update_observation_statistics(batch.obs);
+  updates_ += 1;
+  collected_ = false;
+  return stats;
+}
+
+void Trainer::finish_update_stats(UpdateStats& stats) const {
+  const auto count = static_cast<double>(stats.minibatches);
+  stats.policy_loss /= count;
+  stats.value_loss /= count;
+  stats.entropy /= count;
+  stats.approx_kl /= count;
+  stats.clip_fraction /= count;
+  stats.grad_norm /= count;
+  const torch::Tensor values = storage_.values.flatten();
+  const torch::Tensor targets = storage_.returns.flatten();
+  const double variance = targets.var(/*unbiased=*/false).item<double>();
+  stats.explained_variance =
+      variance == 0.0 ? 0.0
+                      : 1.0 - (targets - values).var(/*unbiased=*/false).item<double>() / variance;
+}
+
+void Trainer::set_progress(std::int64_t env_steps, std::int64_t updates) {
+  if (env_steps < 0 || updates < 0) {
+    throw std::invalid_argument("Trainer::set_progress: counts must be >= 0");
+  }
+  env_steps_ = env_steps;
+  updates_ = updates;
+}
+
+RewardScaling Trainer::reward_scaling() const {
+  return {normalizer_->statistics(), normalizer_->discounted_returns()};
+}
+
+void Trainer::set_reward_scaling(RewardScaling scaling) {
+  const std::string invalid = scaling.statistics.invalid_reason(1);
+  if (!invalid.empty()) {
+    throw std::invalid_argument("Trainer::set_reward_scaling: invalid statistics: " + invalid);
+  }
+  if (static_cast<std::int64_t>(scaling.returns.size()) != config_.num_envs) {
+    throw std::invalid_argument("Trainer::set_reward_scaling: " + std::to_string(config_.num_envs) +
+                                " discounted returns expected (num_envs), got " +
+                                std::to_string(scaling.returns.size()));
+  }
+  for (const double r : scaling.returns) {
+    if (!std::isfinite(r)) {
+      throw std::invalid_argument("Trainer::set_reward_scaling: a discounted return is " +
+                                  std::to_string(r));
+    }
+  }
+  normalizer_->set_statistics(std::move(scaling.statistics));
+  normalizer_->set_discounted_returns(std::move(scaling.returns));
+}
+
+TrainerRngState Trainer::rng_state() const {
+  return {sampling_.get_state(), augmentation_.get_state()};
+}
+
+void Trainer::set_rng_state(const TrainerRngState& state) {
+  sampling_.set_state(state.sampling);
+  augmentation_.set_state(state.augmentation);
+}
+
+}  // namespace pixelgym::ppo

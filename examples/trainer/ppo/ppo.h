@@ -1,0 +1,324 @@
+// PPO (Schulman et al. 2017) on a vector env: the config, the rollout storage, the clipped
+// update, and a Trainer that collects rollouts and updates a Policy.
+#pragma once
+
+#include <torch/torch.h>
+
+#include <cstdint>
+#include <memory>
+#include <nlohmann/json_fwd.hpp>
+#include <string>
+#include <vector>
+
+#include "envs/vector/vector_env.h"
+#include "examples/trainer/ppo/policy.h"
+#include "wrappers/running_statistics.h"
+#include "wrappers/vector/normalize_reward.h"
+#include "wrappers/vector/record_episode_statistics.h"
+
+namespace pixelgym::ppo {
+
+/// Every setting of a training run; `validate()` checks every field. The defaults are CleanRL's
+/// PPO for continuous control (lr 3e-4, 10 epochs, clip 0.2, no entropy bonus, normalized
+/// rewards) with 8 minibatches of 128, over CleanRL's Atari rollout shape (8 envs x 128 steps).
+/// Chosen by learning curves on CartPoleBalance-v0 at action_repeat 8 (README, Training): from
+/// state they reach an evaluation return of 999.7 in 200k env steps, where CleanRL's Atari
+/// settings (lr 2.5e-4, 4 epochs of 4 minibatches, clip 0.1, entropy 0.01) stall near 400.
+struct PpoConfig {
+  /// Seeds torch (weights, action sampling, minibatch order), the augmentation generator, and
+  /// the envs (env i resets with seed + i).
+  std::uint64_t seed = 0;
+  /// Envs stepped together (must equal the vector env's num_envs) and steps per env per
+  /// rollout: a rollout is num_steps * num_envs transitions.
+  std::int64_t num_envs = 8;
+  std::int64_t num_steps = 128;
+  /// The run's length in env steps (summed over envs): the learning rate anneals to 0 over it.
+  std::int64_t total_env_steps = 1'000'000;
+  /// Adam's learning rate at the start, annealed linearly to 0 over total_env_steps when
+  /// anneal_learning_rate.
+  double learning_rate = 3e-4;
+  bool anneal_learning_rate = true;
+  /// Adam's epsilon.
+  double adam_epsilon = 1e-5;
+  /// Discount and GAE lambda.
+  double gamma = 0.99;
+  double gae_lambda = 0.95;
+  /// Passes over the rollout per update, and minibatches per pass (num_steps * num_envs must
+  /// be a multiple of it).
+  std::int64_t update_epochs = 10;
+  std::int64_t num_minibatches = 8;
+  /// Standardize advantages within each minibatch.
+  bool normalize_advantages = true;
+  /// Learn from rewards divided by the running standard deviation of the discounted returns
+  /// (vector::NormalizeReward's rule, kept inside the trainer so that Episode returns stay the
+  /// env's own; see Trainer). Without it the value targets are on the env's scale (hundreds on
+  /// the 1000-step control tasks), and clip_value_loss lets the value move only clip_range per
+  /// update towards them.
+  bool normalize_rewards = true;
+  /// The surrogate's clip range epsilon: the ratio is clipped to [1 - eps, 1 + eps].
+  double clip_range = 0.2;
+  /// Clip the value loss around the rollout's values with the same range (CleanRL's clip_vloss).
+  bool clip_value_loss = true;
+  /// Loss = policy loss - entropy_coef * entropy + value_coef * value loss.
+  double entropy_coef = 0.0;
+  double value_coef = 0.5;
+  /// Gradients are rescaled to this global L2 norm at most.
+  double max_grad_norm = 0.5;
+  /// Stop an update's epochs early once a minibatch's approximate KL exceeds it; 0: never. With
+  /// policy.separate_value_network only the policy stops: the value network goes on through
+  /// every epoch (its loss reaches none of the policy's parameters).
+  double target_kl = 0.0;
+  /// DrQ's random shift of every image key during updates (see Trainer::update), by up to
+  /// shift_pad pixels each way.
+  bool augment = false;
+  std::int64_t shift_pad = 4;
+  /// The network, and the observation normalization of the vector keys
+  /// (policy.normalize_observations, policy.observation_clip).
+  PolicyConfig policy;
+
+  /// Throws std::invalid_argument naming the first field out of range and its value.
+  void validate() const;
+};
+
+/// JSON form of PpoConfig: an object with one member per field, named as the fields, the CNN by
+/// its name (to_string(CnnArchitecture)), `policy` a nested object. from_json takes any subset of
+/// the members (the rest keep their defaults) and throws std::invalid_argument for an unknown
+/// member (listing the known ones), a member of the wrong type, or a config that fails validate().
+void to_json(nlohmann::json& json, const PpoConfig& config);
+void from_json(const nlohmann::json& json, PpoConfig& config);
+void to_json(nlohmann::json& json, const PolicyConfig& config);
+void from_json(const nlohmann::json& json, PolicyConfig& config);
+/// The config as JSON text (2-space indent) and back (throws as from_json, or for bad JSON).
+std::string config_to_json(const PpoConfig& config);
+PpoConfig config_from_json(const std::string& text);
+
+/// One rollout of num_steps x num_envs transitions, as tensors (step-major: [t][n]).
+///
+/// The rollout is collected under SameStep autoreset (see GaeInputs): observations[t] is what
+/// step t acted in; after a step that ended an episode, observations[t + 1] is the next
+/// episode's first observation.
+struct RolloutStorage {
+  /// Allocates everything for `policy`'s inputs and actions.
+  RolloutStorage(const Policy& policy, std::int64_t num_steps, std::int64_t num_envs);
+
+  std::int64_t num_steps;
+  std::int64_t num_envs;
+  /// Per key: (T, N, *shape) in the key's dtype (images stay uint8).
+  ObservationTensors observations;
+  /// ActResult::action: int64 (T, N) or float32 (T, N, *shape).
+  torch::Tensor actions;
+  /// float32 (T, N): log pi_old(a_t | s_t), V_old(s_t), r_t.
+  torch::Tensor log_probs;
+  torch::Tensor values;
+  torch::Tensor rewards;
+  /// uint8 (T, N): the step's flags.
+  torch::Tensor terminated;
+  torch::Tensor truncated;
+  /// float32 (T, N): V(final observation) where truncated and not terminated, else 0.
+  torch::Tensor final_values;
+  /// float32 (N,): V(s_T).
+  torch::Tensor last_values;
+  /// float32 (T, N), filled by compute_advantages.
+  torch::Tensor advantages;
+  torch::Tensor returns;
+
+  /// Copies a batch of N observations (as observation_tensors gives) into step t.
+  void insert_observations(std::int64_t t, const ObservationTensors& obs);
+  /// compute_gae over the stored rollout into advantages and returns.
+  void compute_advantages(double gamma, double lambda);
+  /// Every stored observation flattened to (T N, *shape), sharing memory.
+  ObservationTensors flat_observations() const;
+};
+
+/// What an update did, averaged over the minibatches it ran (CleanRL's logged quantities).
+struct UpdateStats {
+  double policy_loss = 0.0;         // the clipped surrogate loss (minimized)
+  double value_loss = 0.0;          // 0.5 (V - return)^2 (clipped form when clip_value_loss)
+  double entropy = 0.0;             // mean policy entropy
+  double approx_kl = 0.0;           // mean of (ratio - 1) - log ratio (Schulman's k3 estimator)
+  double clip_fraction = 0.0;       // fraction of samples with |ratio - 1| > clip_range
+  double explained_variance = 0.0;  // 1 - Var(returns - values) / Var(returns) of the rollout
+  double grad_norm = 0.0;           // mean global gradient norm before clipping
+  double learning_rate = 0.0;       // the learning rate used
+  std::int64_t epochs = 0;          // epochs run (fewer than update_epochs after a target_kl stop)
+  std::int64_t minibatches = 0;     // minibatches run (the losses above are their means)
+  /// Minibatches of the value network alone after a target_kl stop (separate_value_network).
+  std::int64_t value_minibatches = 0;
+};
+
+/// An episode that ended during a rollout: the sum of the rewards the trainer was given (after
+/// any reward wrapper) and its length.
+struct Episode {
+  double episode_return = 0.0;
+  std::int64_t length = 0;
+};
+
+/// What a rollout did.
+struct RolloutStats {
+  std::vector<Episode> episodes;  // in the order they ended (step, then env index)
+  double env_seconds = 0.0;       // in VectorEnv::step / reset
+  double policy_seconds = 0.0;    // in forward passes (act, final and last values)
+};
+
+/// The generator states a resume needs beside the model, the optimizer and the env: the
+/// generator of action sampling and minibatch order, and the augmentation generator (CPU
+/// generator states, as at::Generator::get_state gives).
+struct TrainerRngState {
+  torch::Tensor sampling;
+  torch::Tensor augmentation;
+};
+
+/// The reward scaling of a Trainer (PpoConfig::normalize_rewards): the running statistics of the
+/// discounted returns (one element) and each env's discounted return of its current episode.
+struct RewardScaling {
+  wrappers::RunningStatistics statistics = wrappers::RunningStatistics::initial(1);
+  std::vector<double> returns;
+};
+
+/// Trains a Policy with PPO on a vector env: `collect()` steps the env for one rollout,
+/// `update()` learns from it; `iterate()` does both.
+///
+/// The env is any VectorEnv (a vector wrapper over one included: the trainer learns from the
+/// rewards it is given, and its Episode records sum those). It must
+/// autoreset in SameStep mode (make_vec's VectorOptions::autoreset =
+/// AutoresetMode::kSameStep): a truncated step's final observation comes from
+/// infos["final_obs"], whose value bootstraps the step's return (see compute_gae). Its
+/// num_envs must equal config.num_envs. The trainer keeps a reference to the env; the env must
+/// outlive it, and nobody else may step it in between.
+///
+/// Determinism: the constructor calls torch::manual_seed(config.seed) before building the
+/// policy (its weights come from torch's default generator); action sampling and minibatch
+/// order draw from a generator of the trainer's own seeded with config.seed, augmentation
+/// from another seeded with config.seed + 1; the envs reset with config.seed on the first
+/// collect(). Same seed, same env, same torch thread count: same parameters.
+///
+/// The trainer steps the env through vector wrappers of its own: a vector::RecordEpisodeStatistics
+/// (its Episode records and env_digest's episodes in progress), and, with config.normalize_rewards,
+/// a vector::NormalizeReward (gamma config.gamma, epsilon 1e-8) over that: the rollout stores
+/// r_i / sqrt(var + 1e-8) of the discounted returns R_i = gamma R_i + r_i, R_i restarting after a
+/// step that ends env i's episode. Values, advantages and returns are on that scale;
+/// RolloutStats's Episode returns are the env's.
+///
+/// Observation normalization: after each update the rollout's observations are merged into
+/// the policy's statistics (Policy::update_observation_statistics), so the next rollout acts
+/// and learns with the same statistics.
+class Trainer {
+ public:
+  /// Throws std::invalid_argument when config.validate() fails, when the env's autoreset mode
+  /// is not SameStep or its num_envs differs from config.num_envs, and as Policy's constructor.
+  Trainer(vector::VectorEnv& env, PpoConfig config);
+
+  /// Steps every env num_steps times with actions sampled from the policy (no gradients),
+  /// storing the transitions and the values GAE needs, then computes advantages and returns.
+  /// The first call resets the envs with config.seed (unless replay_env did).
+  RolloutStats collect();
+  /// config.update_epochs passes of minibatch PPO over the last rollout; then merges its
+  /// observations into the observation statistics. The learning rate is set first, from the
+  /// env steps done before the rollout (annealing). With augmentation, one random shift per
+  /// transition is drawn for the whole update and the rollout's old log-probs and values are
+  /// recomputed under it (no gradients), so the ratio starts at 1 on the shifted images.
+  /// Throws std::logic_error before any collect(), and std::runtime_error (naming the update,
+  /// epoch and minibatch, the losses and the gradient norm) when a minibatch's loss or gradient
+  /// norm is not finite; that minibatch's step is not taken.
+  UpdateStats update();
+
+  Policy& policy() { return *policy_; }
+  const std::shared_ptr<Policy>& policy_ptr() const { return policy_; }
+  torch::optim::Adam& optimizer() { return *optimizer_; }
+  const RolloutStorage& storage() const { return storage_; }
+  const PpoConfig& config() const { return config_; }
+  /// Env steps collected so far (summed over envs) and updates done; set them on resume.
+  std::int64_t env_steps() const { return env_steps_; }
+  std::int64_t updates() const { return updates_; }
+  void set_progress(std::int64_t env_steps, std::int64_t updates);
+  /// The learning rate the next update uses.
+  double learning_rate() const;
+
+  /// The reward normalization's state (checkpoints): its NormalizeReward's statistics and
+  /// discounted returns. Its restore throws std::invalid_argument when the statistics are not
+  /// valid statistics of one element or `returns` has not num_envs finite entries (nothing
+  /// changes then).
+  RewardScaling reward_scaling() const;
+  void set_reward_scaling(RewardScaling scaling);
+
+  TrainerRngState rng_state() const;
+  /// Throws std::invalid_argument (from torch) for a state that is not a CPU generator state.
+  void set_rng_state(const TrainerRngState& state);
+
+  /// Every action batch the trainer has sent to the env since its first reset, in order: the
+  /// raw bytes of the env's batched action arrays (env_steps() / num_envs batches). With the
+  /// config's seed they determine the envs' state exactly (the envs are deterministic under a
+  /// seed and their actions), which is how a checkpoint carries the envs: see replay_env. Its
+  /// size is env_steps() x the bytes of one env's action (4 MB per million env steps of a
+  /// one-dimensional float32 action).
+  const std::string& env_action_log() const { return env_action_log_; }
+  /// Whether env_action_log covers every env step done (false after set_progress without
+  /// replay_env: a resume from a checkpoint that kept no actions).
+  bool env_action_log_complete() const;
+  /// Brings the envs to where they were when `env_action_log` was taken, for a resume: resets
+  /// them with config.seed, as the first collect() does, and steps them with the logged
+  /// batches (no policy, no gradients, no reward statistics: those come from the checkpoint),
+  /// so that the next collect() continues the episodes in progress and the run goes on exactly
+  /// as if it had not stopped. Call it after set_progress, before collect(). Throws
+  /// std::invalid_argument, naming both sizes, when the log is not env_steps() / num_envs
+  /// batches, and std::logic_error after a collect().
+  void replay_env(const std::string& env_action_log);
+  /// A 64-bit digest (FNV-1a) of where the envs are: the bytes of the current observation
+  /// batch and the returns and lengths of the episodes in progress; 0 before the envs are reset.
+  /// A checkpoint keeps it, so that a resume can tell whether replay_env brought the envs back
+  /// to the same place (it does not when the code, Bullet or Mesa changed in between).
+  std::uint64_t env_digest() const;
+
+ private:
+  // The rollout flattened for an update, with the shifts of its augmentation (undefined
+  // without) and the old log-probs and values under them.
+  struct UpdateBatch {
+    std::int64_t size = 0;
+    std::int64_t minibatch = 0;
+    ObservationTensors obs;
+    torch::Tensor actions, old_log_probs, old_values, advantages, returns, shifts;
+  };
+  struct MinibatchPosition {
+    std::int64_t epoch = 0;
+    std::int64_t minibatch = 0;
+  };
+  UpdateBatch update_batch();
+  torch::Tensor value_loss(const UpdateBatch& batch, const torch::Tensor& index,
+                           const torch::Tensor& value) const;
+  // Backward of `loss`, gradient clipping, then the optimizer's step; throws (naming `at` and
+  // `losses`) without stepping when `checked_loss` or the gradient norm is not finite. Returns
+  // the gradient norm.
+  double step_optimizer(const torch::Tensor& loss, double checked_loss, const std::string& losses,
+                        const MinibatchPosition& at);
+  // A minibatch of the value loss alone (after the KL stop, with a separate value network).
+  void step_value_only(const UpdateBatch& batch, const torch::Tensor& index,
+                       const MinibatchPosition& at);
+  // A minibatch of the PPO loss; adds its figures to `stats`; returns its approximate KL.
+  double step_minibatch(const UpdateBatch& batch, const torch::Tensor& index,
+                        const MinibatchPosition& at, UpdateStats& stats);
+  // Averages the sums over the minibatches; the explained variance of the rollout.
+  void finish_update_stats(UpdateStats& stats) const;
+  // The env the trainer steps: normalizer_ when it normalizes rewards, else episodes_.
+  vector::VectorEnv& stepped();
+  // Appends the episodes that `step` ended (episodes_'s infos) to `ended`.
+  void add_ended_episodes(const vector::VectorStepResult& step, std::vector<Episode>& ended) const;
+
+  // The trainer's wrappers over the given env: normalizer_ owns episodes_, which borrows the env.
+  std::unique_ptr<vector::NormalizeReward> normalizer_;
+  vector::RecordEpisodeStatistics* episodes_;
+  PpoConfig config_;
+  std::shared_ptr<Policy> policy_;
+  std::unique_ptr<torch::optim::Adam> optimizer_;
+  RolloutStorage storage_;
+  at::Generator sampling_;
+  at::Generator augmentation_;
+  Value actions_;                   // laid out as env_.action_space()
+  ObservationTensors current_obs_;  // views of the env's observation batch
+  std::string env_action_log_;
+  bool started_ = false;
+  bool collected_ = false;
+  std::int64_t env_steps_ = 0;
+  std::int64_t updates_ = 0;
+};
+
+}  // namespace pixelgym::ppo

@@ -1,0 +1,165 @@
+#include "examples/trainer/ppo/ppo_algorithm.h"
+
+#include <sched.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <functional>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+namespace pixelgym::ppo {
+
+using trainer::ActCounts;
+using trainer::Actor;
+using trainer::Algorithm;
+using trainer::CheckpointBlobs;
+using trainer::IterationStats;
+using trainer::LoadedCheckpoint;
+
+namespace {
+
+using nlohmann::json;
+
+std::string to_bytes(const std::function<void(std::ostream&)>& save) {
+  std::ostringstream out(std::ios::binary);
+  save(out);
+  return out.str();
+}
+
+template <typename T>
+void load_blob(const LoadedCheckpoint& checkpoint, const std::string& name, T& into) {
+  const auto found = checkpoint.blobs.find(name);
+  if (found == checkpoint.blobs.end()) {
+    throw std::runtime_error(checkpoint.path.string() + ": the checkpoint has no \"" + name +
+                             "\" entry");
+  }
+  std::istringstream in(found->second, std::ios::binary);
+  torch::load(into, in);
+}
+
+}  // namespace
+
+PpoActor::PpoActor(std::shared_ptr<Policy> policy) : policy_(std::move(policy)) {
+  if (!policy_) throw std::invalid_argument("PpoActor: the policy is null");
+}
+
+ActCounts PpoActor::act(const Value& observations, bool deterministic, Value& actions) {
+  torch::NoGradGuard no_grad;
+  const ActResult act = policy_->act(observation_tensors(observations), deterministic);
+  Array& action = actions.array();
+  const torch::Tensor chosen = act.env_action.to(torch_dtype(action.dtype())).contiguous();
+  std::memcpy(action.raw_data(), chosen.data_ptr(), action.nbytes());
+  ActCounts counts;
+  if (act.action.is_floating_point()) {
+    counts.clipped_elements = act.clipped_elements();
+    counts.float_elements = act.action.numel();
+  }
+  return counts;
+}
+
+PpoAlgorithm::PpoAlgorithm(vector::VectorEnv& env, PpoConfig config)
+    : trainer_(env, std::move(config)), actor_(trainer_.policy_ptr()) {}
+
+IterationStats PpoAlgorithm::iterate() {
+  const RolloutStats rollout = trainer_.collect();
+  const auto update_start = std::chrono::steady_clock::now();
+  const UpdateStats update = trainer_.update();
+  const double update_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - update_start).count();
+  IterationStats stats;
+  for (const Episode& episode : rollout.episodes) {
+    stats.episode_returns.push_back(episode.episode_return);
+  }
+  stats.policy_loss = update.policy_loss;
+  stats.value_loss = update.value_loss;
+  stats.entropy = update.entropy;
+  stats.approx_kl = update.approx_kl;
+  stats.clip_fraction = update.clip_fraction;
+  stats.extra = {{"explained_variance", update.explained_variance},
+                 {"grad_norm", update.grad_norm},
+                 {"learning_rate", update.learning_rate},
+                 {"env_s", rollout.env_seconds},
+                 {"act_s", rollout.policy_seconds},
+                 {"update_s", update_s}};
+  return stats;
+}
+
+void PpoAlgorithm::set_progress(std::int64_t env_steps, std::int64_t updates) {
+  trainer_.set_progress(env_steps, updates);
+}
+
+std::vector<std::string> PpoAlgorithm::progress_columns() const {
+  return {"explained_variance", "grad_norm", "learning_rate", "env_s", "act_s", "update_s"};
+}
+
+void PpoAlgorithm::save(CheckpointBlobs& blobs, json& meta) {
+  blobs["model"] = to_bytes([&](std::ostream& out) { torch::save(trainer_.policy_ptr(), out); });
+  blobs["optimizer"] = to_bytes([&](std::ostream& out) { torch::save(trainer_.optimizer(), out); });
+  const TrainerRngState rng = trainer_.rng_state();
+  blobs["rng_sampling"] = to_bytes([&](std::ostream& out) { torch::save(rng.sampling, out); });
+  blobs["rng_augmentation"] =
+      to_bytes([&](std::ostream& out) { torch::save(rng.augmentation, out); });
+  const RewardScaling scaling = trainer_.reward_scaling();
+  meta["reward_scaling"] = {{"mean", scaling.statistics.mean[0]},
+                            {"var", scaling.statistics.var[0]},
+                            {"count", scaling.statistics.count},
+                            {"returns", scaling.returns}};
+}
+
+void PpoAlgorithm::restore(const LoadedCheckpoint& checkpoint, const json& meta) {
+  load_blob(checkpoint, "model", trainer_.policy_ptr());
+  load_blob(checkpoint, "optimizer", trainer_.optimizer());
+  TrainerRngState rng;
+  load_blob(checkpoint, "rng_sampling", rng.sampling);
+  load_blob(checkpoint, "rng_augmentation", rng.augmentation);
+  trainer_.set_rng_state(rng);
+  const json& scaling_json = meta.at("reward_scaling");
+  RewardScaling scaling;
+  scaling.statistics.mean = {scaling_json.at("mean").get<double>()};
+  scaling.statistics.var = {scaling_json.at("var").get<double>()};
+  scaling.statistics.count = scaling_json.at("count").get<double>();
+  scaling.returns = scaling_json.at("returns").get<std::vector<double>>();
+  trainer_.set_reward_scaling(std::move(scaling));
+}
+
+void PpoAlgorithm::replay_env(const std::string& env_action_log) {
+  trainer_.replay_env(env_action_log);
+}
+
+json PpoAlgorithmFactory::parse_config(const std::string& text) const {
+  return json::parse(config_to_json(config_from_json(text)));
+}
+
+int PpoAlgorithmFactory::set_threads(int requested) const {
+  if (requested == 0 && std::getenv("OMP_NUM_THREADS") != nullptr) return torch::get_num_threads();
+  int threads = requested;
+  if (threads == 0) {
+    cpu_set_t cpus;
+    CPU_ZERO(&cpus);
+    threads = sched_getaffinity(0, sizeof(cpus), &cpus) == 0 ? CPU_COUNT(&cpus) : 1;
+  }
+  torch::set_num_threads(std::max(threads, 1));
+  return torch::get_num_threads();
+}
+
+std::unique_ptr<Algorithm> PpoAlgorithmFactory::make(vector::VectorEnv& env,
+                                                     const json& config) const {
+  return std::make_unique<PpoAlgorithm>(env, config_from_json(config.dump()));
+}
+
+std::unique_ptr<Actor> PpoAlgorithmFactory::load_actor(const Space& observation_space,
+                                                       const Space& action_space,
+                                                       const json& config,
+                                                       const LoadedCheckpoint& checkpoint) const {
+  auto policy = std::make_shared<Policy>(observation_space, action_space,
+                                         config_from_json(config.dump()).policy);
+  load_blob(checkpoint, "model", policy);
+  policy->eval();
+  return std::make_unique<PpoActor>(std::move(policy));
+}
+
+}  // namespace pixelgym::ppo

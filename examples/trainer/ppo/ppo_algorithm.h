@@ -1,0 +1,78 @@
+// PPO behind the run's Algorithm interface (examples/trainer/run/algorithm.h): a Trainer and its
+// Policy as a TrainingRun drives them, and the factory that builds them from config.json's "ppo".
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "examples/trainer/ppo/policy.h"
+#include "examples/trainer/ppo/ppo.h"
+#include "examples/trainer/run/algorithm.h"
+
+namespace pixelgym::ppo {
+
+/// A Policy acting for evaluation: ActResult::env_action written into the env's actions.
+class PpoActor final : public trainer::Actor {
+ public:
+  /// Throws std::invalid_argument for a null policy.
+  explicit PpoActor(std::shared_ptr<Policy> policy);
+  trainer::ActCounts act(const Value& observations, bool deterministic, Value& actions) override;
+
+ private:
+  std::shared_ptr<Policy> policy_;
+};
+
+/// A Trainer on a vector env as an Algorithm: iterate() is collect() then update().
+///
+/// Checkpoint: blobs "model" (the policy's parameters and buffers, torch::save), "optimizer"
+/// (Adam's state), "rng_sampling" and "rng_augmentation" (TrainerRngState), and meta
+/// "reward_scaling" {"mean", "var", "count", "returns"} (RewardScaling; JSON numbers keep a
+/// double exactly). progress.csv's extra columns: explained_variance, grad_norm, learning_rate,
+/// and where the iteration's time went: env_s in the vector env's step/reset, act_s in the
+/// policy's forward passes while collecting, update_s in the PPO epochs.
+class PpoAlgorithm final : public trainer::Algorithm {
+ public:
+  /// Throws as Trainer's constructor.
+  PpoAlgorithm(vector::VectorEnv& env, PpoConfig config);
+
+  trainer::IterationStats iterate() override;
+  std::int64_t env_steps() const override { return trainer_.env_steps(); }
+  std::int64_t updates() const override { return trainer_.updates(); }
+  void set_progress(std::int64_t env_steps, std::int64_t updates) override;
+  std::vector<std::string> progress_columns() const override;
+  void save(trainer::CheckpointBlobs& blobs, nlohmann::json& meta) override;
+  void restore(const trainer::LoadedCheckpoint& checkpoint, const nlohmann::json& meta) override;
+  const std::string& env_action_log() const override { return trainer_.env_action_log(); }
+  bool env_action_log_complete() const override { return trainer_.env_action_log_complete(); }
+  void replay_env(const std::string& env_action_log) override;
+  std::uint64_t env_digest() const override { return trainer_.env_digest(); }
+  trainer::Actor& actor() override { return actor_; }
+
+  Trainer& trainer() { return trainer_; }
+
+ private:
+  Trainer trainer_;
+  PpoActor actor_;
+};
+
+/// PPO's AlgorithmFactory: name "ppo", the config a PpoConfig (to_json / from_json).
+class PpoAlgorithmFactory final : public trainer::AlgorithmFactory {
+ public:
+  std::string name() const override { return "ppo"; }
+  nlohmann::json parse_config(const std::string& text) const override;
+  /// LibTorch's intra-op threads: `requested`, or when 0 one per core this process may run on
+  /// (sched_getaffinity); OMP_NUM_THREADS, when set, wins over that default (not over
+  /// `requested`).
+  int set_threads(int requested) const override;
+  std::unique_ptr<trainer::Algorithm> make(vector::VectorEnv& env,
+                                           const nlohmann::json& config) const override;
+  /// A Policy of config["policy"] with the checkpoint's "model", in eval mode.
+  std::unique_ptr<trainer::Actor> load_actor(
+      const Space& observation_space, const Space& action_space, const nlohmann::json& config,
+      const trainer::LoadedCheckpoint& checkpoint) const override;
+};
+
+}  // namespace pixelgym::ppo

@@ -1,0 +1,130 @@
+// The learning algorithm as a training run sees it (TrainingRun): what every algorithm offers the
+// run — iterate, its state for checkpoints, its config and progress.csv columns, and an Actor for
+// evaluation — without torch, so that the run stays algorithm- and torch-free.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "envs/space.h"
+#include "envs/value.h"
+#include "envs/vector/vector_env.h"
+#include "examples/trainer/run/checkpoint_file.h"
+#include "examples/trainer/run/progress_csv.h"
+
+namespace pixelgym::trainer {
+
+/// What one Actor::act call sent to the env, for the evaluation's clipped-action figure.
+struct ActCounts {
+  /// Float (Box) actions: the action elements the policy put outside the action space's bounds
+  /// (sent to the env clipped) and all the action elements; both 0 for integer actions.
+  std::int64_t clipped_elements = 0;
+  std::int64_t float_elements = 0;
+};
+
+/// A policy choosing actions for a vector env: what evaluation needs of an algorithm.
+class Actor {
+ public:
+  virtual ~Actor() = default;
+  /// Writes into `actions` (laid out as the vector env's action_space()) the actions for
+  /// `observations` (the vector env's observation batch): the policy's most likely action when
+  /// `deterministic`, else one sampled from it. Computes no gradients.
+  virtual ActCounts act(const Value& observations, bool deterministic, Value& actions) = 0;
+};
+
+/// What one Algorithm::iterate did.
+struct IterationStats {
+  /// The returns of the episodes that ended during it (the sum of the rewards the algorithm was
+  /// given), in the order they ended.
+  std::vector<double> episode_returns;
+  /// progress.csv's loss columns; NaN (ProgressRow::kNone) where the algorithm has no such figure.
+  double policy_loss = ProgressRow::kNone;
+  double value_loss = ProgressRow::kNone;
+  double entropy = ProgressRow::kNone;
+  double approx_kl = ProgressRow::kNone;
+  double clip_fraction = ProgressRow::kNone;
+  /// One value per column of Algorithm::progress_columns(), no others.
+  std::map<std::string, double> extra;
+};
+
+/// A learning algorithm on a vector env, driven by a TrainingRun: the run calls iterate() until
+/// its budget is spent, and checkpoints, resumes and evaluates through the calls below. The
+/// algorithm keeps a reference to the env it was built on (AlgorithmFactory::make) and is the
+/// only one to step it.
+class Algorithm {
+ public:
+  virtual ~Algorithm() = default;
+
+  /// Collects experience from the env and learns from it (PPO: one rollout, one update).
+  virtual IterationStats iterate() = 0;
+
+  /// Env steps done (all envs together) and iterations done (the run names and spaces its
+  /// checkpoints by them, and records them as "updates").
+  virtual std::int64_t env_steps() const = 0;
+  virtual std::int64_t updates() const = 0;
+  /// Sets both on resume, before restore() and replay_env().
+  virtual void set_progress(std::int64_t env_steps, std::int64_t updates) = 0;
+
+  /// The names of its progress.csv columns after the base ones, in order.
+  virtual std::vector<std::string> progress_columns() const = 0;
+
+  /// Adds its learning state to a checkpoint: blobs of its own (the run writes "config", "meta"
+  /// and "env_actions") and members of the checkpoint's meta object (the run writes "env_steps",
+  /// "updates", "wall_time_s", "recent_returns" and "env_digest").
+  virtual void save(CheckpointBlobs& blobs, nlohmann::json& meta) = 0;
+  /// Restores what save() wrote. Throws std::runtime_error naming checkpoint.path for a blob it
+  /// needs that is not there.
+  virtual void restore(const LoadedCheckpoint& checkpoint, const nlohmann::json& meta) = 0;
+
+  /// Every action batch sent to the env since its first reset, as bytes: with the config's seed
+  /// it determines where the envs are (see ppo::Trainer::env_action_log).
+  virtual const std::string& env_action_log() const = 0;
+  /// Whether env_action_log covers every env step done (false after set_progress without
+  /// replay_env).
+  virtual bool env_action_log_complete() const = 0;
+  /// Brings the envs to where they were when `env_action_log` was taken (reset with the config's
+  /// seed, then the logged batches). Call it after set_progress, before iterate(). Throws
+  /// std::invalid_argument when the log does not match env_steps().
+  virtual void replay_env(const std::string& env_action_log) = 0;
+  /// A digest of where the envs are (observations and episodes in progress); 0 before the first
+  /// reset. Equal digests after a replay: the envs are where the checkpoint's were.
+  virtual std::uint64_t env_digest() const = 0;
+
+  /// The policy as trained so far, for evaluation.
+  virtual Actor& actor() = 0;
+};
+
+/// An algorithm's kind: its config, and how to build it to train or to act. Implemented once per
+/// algorithm (ppo::PpoAlgorithmFactory).
+class AlgorithmFactory {
+ public:
+  virtual ~AlgorithmFactory() = default;
+
+  /// The member of config.json that holds the algorithm's config ("ppo").
+  virtual std::string name() const = 0;
+  /// The config given as JSON text, completed and validated: an object with every member (the
+  /// ones not given at their defaults; "{}" gives the defaults), among them "seed" (seeds the
+  /// algorithm and the envs: env i resets with seed + i), "num_envs" (envs stepped together) and
+  /// "total_env_steps" (the run's length), which the run reads. Throws std::invalid_argument
+  /// for bad JSON, an unknown member or a value out of range, naming it.
+  virtual nlohmann::json parse_config(const std::string& text) const = 0;
+  /// Sets the threads the algorithm computes with in this process, `requested` or, when 0, its
+  /// default; returns the count in use.
+  virtual int set_threads(int requested) const = 0;
+  /// The algorithm, to train on `env` (SameStep autoreset, config["num_envs"] envs) with
+  /// `config` (as parse_config gives it). Throws std::invalid_argument for an env it cannot
+  /// train on.
+  virtual std::unique_ptr<Algorithm> make(vector::VectorEnv& env,
+                                          const nlohmann::json& config) const = 0;
+  /// The policy saved in `checkpoint`, for an env of these spaces, to act only. Throws
+  /// std::runtime_error naming checkpoint.path when a blob it needs is not there.
+  virtual std::unique_ptr<Actor> load_actor(const Space& observation_space,
+                                            const Space& action_space, const nlohmann::json& config,
+                                            const LoadedCheckpoint& checkpoint) const = 0;
+};
+
+}  // namespace pixelgym::trainer

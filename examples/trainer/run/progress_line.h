@@ -1,0 +1,81 @@
+// The trainer's progress on the terminal: a bar redrawn in place on a TTY, plain lines otherwise.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <ostream>
+#include <string>
+
+namespace pixelgym::trainer {
+
+/// Where training stands, for the progress line.
+struct ProgressStatus {
+  static constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
+  std::int64_t steps = 0;
+  std::int64_t total_steps = 0;  // the step budget; 0: none
+  double elapsed_s = 0.0;
+  double time_limit_s = 0.0;           // the wall-time budget in seconds; 0: none
+  double fps = kNone;                  // recent env steps per second
+  double episode_return_mean = kNone;  // NaN before the first episode ends
+};
+
+/// How far along training is, in [0, 1]: the larger of steps / total_steps and
+/// elapsed_s / time_limit_s (whichever budget ends training first); 0 with neither budget.
+double progress_fraction(const ProgressStatus& status);
+
+/// Seconds until the first budget runs out: the remaining steps at `fps`, or the remaining wall
+/// time, whichever is less. NaN when unknown (no budget, or a step budget only and no fps yet).
+double eta_seconds(const ProgressStatus& status);
+
+/// A duration as "m:ss" under an hour ("0:07", "12:05"), "h:mm:ss" under 100 hours ("1:02:03"),
+/// whole hours beyond ("123h"); "--:--" for NaN, infinite or negative.
+std::string format_eta(double seconds);
+
+/// A count in at most about 5 characters: 999, "12.3k", "100k", "1.23M", "12.3M".
+std::string format_count(std::int64_t count);
+
+/// A bar of exactly `width` characters (at least 3): "[####......]", the inside filled in
+/// proportion to `fraction` (clamped to [0, 1]). Throws std::invalid_argument for width < 3.
+std::string format_bar(double fraction, int width);
+
+/// The terminal line: "[#####.....] 12.3k/100k  345 fps  return 123.4  ETA 4:05", at most
+/// `columns` - 1 characters (no wrap): the bar takes the room the figures leave, and is left out
+/// below 8 characters.
+std::string format_bar_line(const ProgressStatus& status, int columns);
+
+/// The plain line (no newline): "steps 12288/100000 (12.3%)  fps 345  return 123.4  elapsed
+/// 0:36  ETA 4:05".
+std::string format_plain_line(const ProgressStatus& status);
+
+/// Writes the progress to a stream once per update.
+class ProgressLine {
+ public:
+  enum class Mode {
+    kBar,    // redraw one line in place ('\r', then erase to the end of the line)
+    kPlain,  // a plain line every `every_n_updates` updates
+  };
+
+  /// Throws std::invalid_argument for every_n_updates < 1 or columns < 20.
+  ProgressLine(std::ostream& out, Mode mode, int every_n_updates, int columns = 100);
+
+  /// kBar when stdout is a terminal and not `quiet`, else kPlain.
+  static Mode mode_for_stdout(bool quiet);
+  /// The width of the terminal on stdout, or 100 when it is not one.
+  static int stdout_columns();
+
+  /// Reports one update (flushes what it writes).
+  void update(const ProgressStatus& status);
+  /// Reports the end: the bar's last state and a newline, or the final plain line (unless the
+  /// last update wrote that state already).
+  void finish(const ProgressStatus& status);
+
+ private:
+  std::ostream& out_;
+  Mode mode_;
+  int every_n_updates_;
+  int columns_;
+  std::int64_t updates_ = 0;
+  bool last_written_ = false;  // the last update wrote a plain line
+};
+
+}  // namespace pixelgym::trainer

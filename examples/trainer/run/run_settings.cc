@@ -1,0 +1,74 @@
+#include "examples/trainer/run/run_settings.h"
+
+#include <stdexcept>
+
+#include "envs/registry.h"
+#include "envs/vector/make_vec.h"
+#include "wrappers/wrapper_spec.h"
+
+namespace pixelgym::trainer {
+
+using nlohmann::json;
+
+std::uint64_t RunSettings::seed() const { return algorithm_config.at("seed").get<std::uint64_t>(); }
+
+std::int64_t RunSettings::num_envs() const {
+  return algorithm_config.at("num_envs").get<std::int64_t>();
+}
+
+std::int64_t RunSettings::total_env_steps() const {
+  return algorithm_config.at("total_env_steps").get<std::int64_t>();
+}
+
+json settings_to_json(const RunSettings& settings) {
+  json out;
+  out["env_id"] = settings.env_id;
+  out["set"] = settings.sets;
+  out["wrap"] = settings.wraps;
+  out["num_threads"] = settings.num_threads;
+  out["torch_threads"] = settings.torch_threads;
+  out["checkpoint_every"] = settings.checkpoint_every;
+  out["keep_checkpoints"] = settings.keep_checkpoints;
+  out["minutes"] = settings.minutes;
+  out["eval_episodes"] = settings.eval_episodes;
+  out[settings.algorithm] = settings.algorithm_config;
+  return out;
+}
+
+RunSettings settings_from_json(const json& in, const std::filesystem::path& where,
+                               const AlgorithmFactory& algorithm) {
+  try {
+    RunSettings settings;
+    settings.env_id = in.at("env_id").get<std::string>();
+    settings.sets = in.at("set").get<std::vector<std::string>>();
+    settings.wraps = in.at("wrap").get<std::vector<std::string>>();
+    settings.num_threads = in.at("num_threads").get<int>();
+    if (in.contains("torch_threads")) settings.torch_threads = in.at("torch_threads").get<int>();
+    settings.checkpoint_every = in.at("checkpoint_every").get<std::int64_t>();
+    settings.keep_checkpoints =
+        in.contains("keep_checkpoints") ? in.at("keep_checkpoints").get<std::int64_t>() : 0;
+    settings.minutes = in.at("minutes").get<double>();
+    settings.eval_episodes = in.at("eval_episodes").get<std::int64_t>();
+    settings.algorithm = algorithm.name();
+    settings.algorithm_config = algorithm.parse_config(in.at(settings.algorithm).dump());
+    return settings;
+  } catch (const json::exception& e) {
+    throw std::runtime_error(where.string() + ": not a pixelgym train config: " + e.what());
+  }
+}
+
+std::unique_ptr<vector::VectorEnv> make_training_env(const RunSettings& settings,
+                                                     const EnvKwargsParser& parse_sets) {
+  const vector::VectorOptions options{vector::VectorMode::kAsync, settings.num_threads,
+                                      vector::AutoresetMode::kSameStep, true};
+  return vector::make_vec(settings.env_id, static_cast<int>(settings.num_envs()),
+                          parse_sets(settings.env_id, settings.sets),
+                          wrappers::wrapping(settings.wraps), options);
+}
+
+std::unique_ptr<Env> make_run_env(const RunSettings& settings, const EnvKwargsParser& parse_sets) {
+  return wrappers::apply_wrappers(make(settings.env_id, parse_sets(settings.env_id, settings.sets)),
+                                  settings.wraps);
+}
+
+}  // namespace pixelgym::trainer

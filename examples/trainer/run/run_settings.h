@@ -1,0 +1,66 @@
+// What a training run is (config.json): the env, the run's own settings and the algorithm's
+// config; and the envs built from it.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "envs/env.h"
+#include "envs/params.h"
+#include "envs/vector/vector_env.h"
+#include "examples/trainer/run/algorithm.h"
+
+namespace pixelgym::trainer {
+
+/// Turns a run's `sets` (KEY=VALUE strings, as `--set` takes them) into env `id`'s kwargs.
+/// The command line's parser, so that its errors are the command line's.
+using EnvKwargsParser =
+    std::function<Params(const std::string& id, const std::vector<std::string>& sets)>;
+
+/// The settings of a run, as config.json holds them (with the same names, but `env_id`'s
+/// "env_id", `sets`' "set", `wraps`' "wrap", and the algorithm's config under `algorithm`).
+struct RunSettings {
+  std::string env_id;
+  std::vector<std::string> sets;       // KEY=VALUE
+  std::vector<std::string> wraps;      // wrapper specs, the first innermost
+  int num_threads = 2;                 // the training env's worker threads (AsyncVectorEnv)
+  int torch_threads = 0;               // the algorithm's threads (AlgorithmFactory::set_threads)
+  std::int64_t checkpoint_every = 10;  // updates
+  std::int64_t keep_checkpoints = 3;   // the newest kept, 0: all
+  double minutes = 0.0;                // the run's first wall-time budget; 0: no time limit
+  std::int64_t eval_episodes = 5;      // episodes of the final evaluation
+  /// The algorithm's name (AlgorithmFactory::name) and its config (AlgorithmFactory::
+  /// parse_config: every member present, "seed", "num_envs" and "total_env_steps" among them).
+  std::string algorithm;
+  nlohmann::json algorithm_config = nlohmann::json::object();
+
+  /// The config's "seed", "num_envs" and "total_env_steps".
+  std::uint64_t seed() const;
+  std::int64_t num_envs() const;
+  std::int64_t total_env_steps() const;
+};
+
+/// config.json's settings object.
+nlohmann::json settings_to_json(const RunSettings& settings);
+
+/// The settings of config.json's object `in` (read from `where`) for `algorithm`: its config
+/// is the member algorithm.name(), read by algorithm.parse_config. Absent "torch_threads": 0;
+/// absent "keep_checkpoints": 0 (keep all). Throws std::runtime_error "{where}: not a pixelgym
+/// train config: ..." for a missing or ill-typed member, and what parse_config throws.
+RunSettings settings_from_json(const nlohmann::json& in, const std::filesystem::path& where,
+                               const AlgorithmFactory& algorithm);
+
+/// The training env: num_envs() copies of the run's env in an AsyncVectorEnv on num_threads
+/// threads, SameStep autoreset.
+std::unique_ptr<vector::VectorEnv> make_training_env(const RunSettings& settings,
+                                                     const EnvKwargsParser& parse_sets);
+
+/// One env built as the run's: make(env_id, parse_sets(env_id, sets)) under `wraps`.
+std::unique_ptr<Env> make_run_env(const RunSettings& settings, const EnvKwargsParser& parse_sets);
+
+}  // namespace pixelgym::trainer

@@ -1,0 +1,332 @@
+#include "examples/trainer/run/training_run.h"
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "examples/trainer/run/evaluation.h"
+
+namespace pixelgym::trainer {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// Episodes whose returns the progress rows summarize (as Stable-Baselines3's ep_info_buffer).
+constexpr std::size_t kReturnWindow = 100;
+
+// The seed of the final evaluation's first episode: seed + this.
+constexpr std::uint64_t kEvaluationSeedOffset = 1'000'000;
+
+double mean_of(const std::deque<double>& values) {
+  if (values.empty()) return std::nan("");
+  double sum = 0.0;
+  for (const double v : values) sum += v;
+  return sum / static_cast<double>(values.size());
+}
+
+double std_of(const std::deque<double>& values) {
+  if (values.empty()) return std::nan("");
+  const double mean = mean_of(values);
+  double squares = 0.0;
+  for (const double v : values) squares += (v - mean) * (v - mean);
+  return std::sqrt(squares / static_cast<double>(values.size()));
+}
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+json read_meta(const LoadedCheckpoint& checkpoint) {
+  const auto found = checkpoint.blobs.find("meta");
+  if (found == checkpoint.blobs.end()) {
+    throw std::runtime_error(checkpoint.path.string() + ": the checkpoint has no \"meta\" entry");
+  }
+  return json::parse(found->second);
+}
+
+// RunRequestError naming each setting of `given` that differs from the run's.
+void check_resume_settings(const ResumeChecks& given, const RunSettings& run,
+                           const fs::path& folder) {
+  std::string differ;
+  // Integers of one signedness each: compared and printed exactly.
+  const auto check = [&](const char* flag, const auto& value, auto run_value) {
+    if (!value || *value == run_value) return;
+    differ += (differ.empty() ? "" : ", ") + std::string(flag) + " " + std::to_string(*value) +
+              " (the run's: " + std::to_string(run_value) + ")";
+  };
+  check("--seed", given.seed, run.seed());
+  check("--num-envs", given.num_envs, run.num_envs());
+  check("--threads", given.num_threads, run.num_threads);
+  check("--torch-threads", given.torch_threads, run.torch_threads);
+  check("--checkpoint-every", given.checkpoint_every, run.checkpoint_every);
+  check("--keep-checkpoints", given.keep_checkpoints, run.keep_checkpoints);
+  check("--eval-episodes", given.eval_episodes, run.eval_episodes);
+  if (!differ.empty()) {
+    throw RunRequestError("train --resume continues with the settings in " + folder.string() +
+                          "/config.json, and these differ from them: " + differ +
+                          " (only --steps and --minutes may change)");
+  }
+}
+
+}  // namespace
+
+TrainingRun::TrainingRun(const AlgorithmFactory& algorithm, EnvKwargsParser parse_sets,
+                         RunSettings settings, fs::path folder, RunOutput output)
+    : factory_(&algorithm),
+      parse_sets_(std::move(parse_sets)),
+      settings_(std::move(settings)),
+      folder_(std::move(folder)),
+      output_(output) {}
+
+TrainingRun TrainingRun::create(const AlgorithmFactory& algorithm, EnvKwargsParser parse_sets,
+                                RunSettings settings, fs::path folder, TrainBudget budget,
+                                RunOutput output) {
+  settings.algorithm = algorithm.name();
+  TrainingRun run(algorithm, std::move(parse_sets), std::move(settings), std::move(folder), output);
+  if (budget.minutes > 0.0) run.settings_.minutes = budget.minutes;  // the run's first budget
+  run.apply_budget(budget);
+  return run;
+}
+
+TrainingRun TrainingRun::resume(const AlgorithmFactory& algorithm, EnvKwargsParser parse_sets,
+                                fs::path folder, TrainBudget budget, const ResumeChecks& given,
+                                RunOutput output) {
+  std::ifstream config_file(folder / "config.json");
+  if (!config_file) {
+    throw std::runtime_error("--resume " + folder.string() + ": no config.json there");
+  }
+  const json config = json::parse(config_file);
+  RunSettings settings = settings_from_json(config, folder / "config.json", algorithm);
+  check_resume_settings(given, settings, folder);
+  TrainingRun run(algorithm, std::move(parse_sets), std::move(settings), std::move(folder), output);
+  run.load_resume_point(config);
+  run.apply_budget(budget);
+  return run;
+}
+
+void TrainingRun::load_resume_point(const json& config) {
+  // The budget as the latest resume left it (a --steps or --minutes given then holds on).
+  budget_minutes_ = settings_.minutes;
+  if (config.contains("resumes") && config.at("resumes").is_array() &&
+      !config.at("resumes").empty()) {
+    const json& latest = config.at("resumes").back();
+    settings_.algorithm_config["total_env_steps"] =
+        latest.value("total_env_steps", settings_.total_env_steps());
+    budget_minutes_ = latest.value("minutes", budget_minutes_);
+  }
+  CheckpointSearch search = find_latest_checkpoint(folder_);
+  for (const auto& skipped : search.skipped) {
+    output_.errors << "train: skipping " << skipped.path.string() << ": " << skipped.reason << "\n";
+  }
+  if (!search.latest) {
+    throw std::runtime_error("--resume " + folder_.string() + ": no valid checkpoint there");
+  }
+  checkpoint_ = std::move(search.latest);
+  meta_ = read_meta(*checkpoint_);
+  wall_before_s_ = meta_.at("wall_time_s").get<double>();
+}
+
+void TrainingRun::apply_budget(const TrainBudget& budget) {
+  if (budget.steps > 0) settings_.algorithm_config["total_env_steps"] = budget.steps;
+  minutes_given_ = budget.minutes;
+  if (budget.minutes > 0.0) budget_minutes_ = wall_before_s_ / 60.0 + budget.minutes;
+  settings_.algorithm_config = factory_->parse_config(settings_.algorithm_config.dump());
+  if (!checkpoint_) return;
+  const auto steps_done = meta_.at("env_steps").get<std::int64_t>();
+  if (budget.steps > 0 && budget.steps <= steps_done) {
+    throw RunRequestError("train --resume --steps " + std::to_string(budget.steps) +
+                          ": the run has " + std::to_string(steps_done) +
+                          " env steps done; give more to train on");
+  }
+}
+
+bool TrainingRun::nothing_to_do() const {
+  const auto steps_done = meta_.at("env_steps").get<std::int64_t>();
+  const bool steps_spent = steps_done >= settings_.total_env_steps();
+  const bool time_spent = budget_minutes_ > 0.0 && wall_before_s_ >= budget_minutes_ * 60.0;
+  // Nothing is left to do once the run's summary is of its last checkpoint. (A run killed
+  // between its last checkpoint and its evaluation goes on to evaluate and write final.mp4 and
+  // summary.json.)
+  bool summarized = false;
+  if (std::ifstream summary_file(folder_ / "summary.json"); summary_file) {
+    const json summary = json::parse(summary_file, nullptr, /*allow_exceptions=*/false);
+    summarized = summary.is_object() && summary.contains("env_steps") &&
+                 summary.at("env_steps") == steps_done;
+  }
+  if (!(steps_spent || time_spent) || !summarized) return false;
+  std::ostringstream message;
+  message << "--resume " << folder_.string() << ": nothing to do, the run has spent its ";
+  if (steps_spent) {
+    message << "env steps (" << steps_done << " of " << settings_.total_env_steps()
+            << "): give --steps N (more than " << steps_done << ") to train on\n";
+  } else {
+    message << "time (" << std::fixed << std::setprecision(1) << wall_before_s_ / 60.0 << " of "
+            << budget_minutes_ << " minutes): give --minutes M to train M more\n";
+  }
+  output_.out << message.str();
+  return true;
+}
+
+std::optional<json> TrainingRun::train() {
+  if (checkpoint_ && nothing_to_do()) return std::nullopt;
+  // The count in use goes into config.json, so that a resume runs with it (results depend on it).
+  settings_.torch_threads = factory_->set_threads(settings_.torch_threads);
+  env_ = make_training_env(settings_, parse_sets_);
+  algorithm_ = factory_->make(*env_, settings_.algorithm_config);
+  if (checkpoint_) {
+    restore_from_checkpoint();
+  } else {
+    run_.emplace(
+        RunFolder::create(folder_, settings_to_json(settings_), algorithm_->progress_columns()));
+  }
+  train_until_spent();
+  save_checkpoint();
+  env_->close();
+  return evaluate_and_summarize();
+}
+
+void TrainingRun::restore_from_checkpoint() {
+  algorithm_->set_progress(meta_.at("env_steps").get<std::int64_t>(),
+                           meta_.at("updates").get<std::int64_t>());
+  algorithm_->restore(*checkpoint_, meta_);
+  for (const double r : meta_.at("recent_returns").get<std::vector<double>>()) {
+    returns_.push_back(r);
+  }
+  // The budget from here on: the env steps, and the minutes of wall time over the whole run
+  // (0: none), with the minutes this resume was given, when it was.
+  json budget = {{"total_env_steps", settings_.total_env_steps()}, {"minutes", budget_minutes_}};
+  if (minutes_given_ > 0.0) budget["minutes_given"] = minutes_given_;
+  run_.emplace(RunFolder::resume(folder_, algorithm_->env_steps(), budget));
+  output_.out << "resuming " << folder_.string() << " from "
+              << checkpoint_->path.filename().string() << " (" << algorithm_->env_steps()
+              << " env steps, " << algorithm_->updates() << " updates)\n"
+              << "torch_threads=" << settings_.torch_threads << " (as the run began)\n";
+  replay_env_actions();
+}
+
+void TrainingRun::replay_env_actions() {
+  const auto actions = checkpoint_->blobs.find("env_actions");
+  if (actions == checkpoint_->blobs.end()) {
+    output_.out << "the checkpoint has no env actions (written before they were kept): the envs "
+                   "start new episodes\n";
+    return;
+  }
+  // The envs continue their episodes where the checkpoint left them, so the resumed run is the
+  // run that did not stop (same parameters, update for update).
+  const auto replay_start = std::chrono::steady_clock::now();
+  algorithm_->replay_env(actions->second);
+  output_.out << "replayed the " << algorithm_->env_steps() << " env steps of the checkpoint in "
+              << std::fixed << std::setprecision(1) << seconds_since(replay_start)
+              << std::defaultfloat << " s: the envs continue their episodes\n";
+  // Absent or 0 (a checkpoint taken before the envs were first reset): nothing to compare.
+  const std::uint64_t digest = meta_.value("env_digest", std::uint64_t{0});
+  if (digest != 0 && digest != algorithm_->env_digest()) {
+    output_.out << "warning: the replayed envs are not where the checkpoint's were (their "
+                   "observations or episodes differ): the code or a library changed since "
+                   "the run began, or the envs are not deterministic. Training goes on from "
+                   "here, but it is no longer the run that did not stop.\n";
+  }
+}
+
+double TrainingRun::elapsed_s() const { return wall_before_s_ + seconds_since(start_); }
+
+void TrainingRun::train_until_spent() {
+  const std::string title = settings_.env_id + " (" + folder_.filename().string() + ")";
+  ProgressLine progress(output_.out, output_.progress_mode, 10, output_.columns);
+  start_ = std::chrono::steady_clock::now();
+  // The time budget counts the run's whole wall time, as of its latest checkpoint: a killed
+  // 10-minute run, resumed, trains for what was left of its 10 minutes. Minutes given to this
+  // process add to the wall time so far, and always allow one update.
+  const double time_limit_s = budget_minutes_ * 60.0;
+  bool one_update_due = minutes_given_ > 0.0;
+  const std::int64_t total_steps = settings_.total_env_steps();
+  // Where the run stands before any update of this process (what the line shows should none be
+  // left to do).
+  ProgressStatus status{algorithm_->env_steps(), total_steps,      elapsed_s(), time_limit_s,
+                        ProgressStatus::kNone,   mean_of(returns_)};
+  while (algorithm_->env_steps() < total_steps &&
+         (time_limit_s <= 0.0 || one_update_due || elapsed_s() < time_limit_s)) {
+    one_update_due = false;
+    const ProgressRow row = iterate_once();
+    run_->write_curve(title);
+    if (algorithm_->updates() % settings_.checkpoint_every == 0) save_checkpoint();
+    status = {algorithm_->env_steps(), total_steps, elapsed_s(), time_limit_s, row.fps,
+              row.episode_return_mean};
+    progress.update(status);
+  }
+  progress.finish(status);
+}
+
+ProgressRow TrainingRun::iterate_once() {
+  const auto iteration_start = std::chrono::steady_clock::now();
+  const std::int64_t steps_before = algorithm_->env_steps();
+  IterationStats stats = algorithm_->iterate();
+  for (const double episode_return : stats.episode_returns) {
+    returns_.push_back(episode_return);
+    if (returns_.size() > kReturnWindow) returns_.pop_front();
+  }
+  const double seconds = seconds_since(iteration_start);
+  ProgressRow row;
+  row.steps = algorithm_->env_steps();
+  row.wall_time_s = elapsed_s();
+  row.fps = static_cast<double>(algorithm_->env_steps() - steps_before) / seconds;
+  row.episode_return_mean = mean_of(returns_);
+  row.episode_return_std = std_of(returns_);
+  row.policy_loss = stats.policy_loss;
+  row.value_loss = stats.value_loss;
+  row.entropy = stats.entropy;
+  row.approx_kl = stats.approx_kl;
+  row.clip_fraction = stats.clip_fraction;
+  row.extra = std::move(stats.extra);
+  run_->append_progress(row);
+  return row;
+}
+
+void TrainingRun::save_checkpoint() {
+  CheckpointBlobs blobs;
+  // The run's settings, so that a checkpoint file evaluates on its own (away from its folder).
+  blobs["config"] = settings_to_json(settings_).dump();
+  json meta;
+  algorithm_->save(blobs, meta);
+  meta["env_steps"] = algorithm_->env_steps();
+  meta["updates"] = algorithm_->updates();
+  meta["wall_time_s"] = elapsed_s();
+  meta["recent_returns"] = std::vector<double>(returns_.begin(), returns_.end());
+  // Where the envs are, for a resume to check its replay of the actions below against.
+  meta["env_digest"] = algorithm_->env_digest();
+  blobs["meta"] = meta.dump();
+  // The envs' state, as the actions that led to it; none when the log does not go back to the
+  // first reset.
+  if (algorithm_->env_action_log_complete()) blobs["env_actions"] = algorithm_->env_action_log();
+  write_checkpoint(run_->checkpoint_path(algorithm_->updates()), blobs);
+  prune_checkpoints(run_->path(), settings_.keep_checkpoints);
+}
+
+json TrainingRun::evaluate_and_summarize() {
+  const fs::path video = run_->path() / "final.mp4";
+  const EvaluationRequest request{settings_.eval_episodes, settings_.seed() + kEvaluationSeedOffset,
+                                  false, video};
+  const PolicyEvaluation evaluation =
+      evaluate(algorithm_->actor(), settings_, parse_sets_, request);
+  json summary;
+  summary["env_id"] = settings_.env_id;
+  summary["env_steps"] = algorithm_->env_steps();
+  summary["updates"] = algorithm_->updates();
+  summary["wall_time_s"] = elapsed_s();
+  summary["evaluation"] = evaluation_json(evaluation, request);
+  summary["video"] = video.filename().string();
+  run_->write_summary(summary);
+  output_.out << "evaluation: return " << evaluation.mean << " +/- " << evaluation.std << " over "
+              << evaluation.returns.size() << " episodes\n"
+              << "wrote " << run_->path().string() << "/{config.json, progress.csv, curve.png, "
+              << run_->checkpoint_path(algorithm_->updates()).filename().string()
+              << ", final.mp4, summary.json}\n";
+  return summary;
+}
+
+}  // namespace pixelgym::trainer

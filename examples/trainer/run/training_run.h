@@ -1,0 +1,139 @@
+// A training run, shared by every algorithm: create or resume a run folder, train under a step
+// and time budget, checkpoint, evaluate, write final.mp4 and summary.json.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <ostream>
+#include <stdexcept>
+
+#include "examples/trainer/run/algorithm.h"
+#include "examples/trainer/run/checkpoint_file.h"
+#include "examples/trainer/run/progress_line.h"
+#include "examples/trainer/run/run_folder.h"
+#include "examples/trainer/run/run_settings.h"
+
+namespace pixelgym::trainer {
+
+/// A request that does not fit the run (a budget below what is done, a setting that differs
+/// from the run's on resume): the caller's input is at fault, not the run.
+class RunRequestError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+/// How much to train.
+struct TrainBudget {
+  /// The run's length in env steps, all envs together; 0: the config's total_env_steps (a
+  /// resumed run: as its latest resume left it). On resume it must exceed the steps done.
+  std::int64_t steps = 0;
+  /// Wall time in minutes (>= 0) on top of the run's so far, and at least one update; 0: none
+  /// given (a new run has no time limit, a resumed run keeps the budget it had).
+  double minutes = 0.0;
+};
+
+/// Settings given again for a resume; each must equal the run's (RunRequestError otherwise,
+/// naming the flag, the value and the run's). Absent: not given.
+struct ResumeChecks {
+  std::optional<std::uint64_t> seed;
+  std::optional<std::int64_t> num_envs;
+  std::optional<int> num_threads;
+  std::optional<int> torch_threads;
+  std::optional<std::int64_t> checkpoint_every;
+  std::optional<std::int64_t> keep_checkpoints;
+  std::optional<std::int64_t> eval_episodes;
+};
+
+/// Where a run reports: messages and the progress line to `out`, skipped checkpoints to `errors`.
+struct RunOutput {
+  std::ostream& out;
+  std::ostream& errors;
+  ProgressLine::Mode progress_mode = ProgressLine::Mode::kPlain;  // kPlain: a line every 10 updates
+  int columns = 100;                                              // the terminal's width
+};
+
+/// One training run of an algorithm, in a run folder (RunFolder): built by `create` or `resume`
+/// (which read and check, and write nothing), then `train()`.
+///
+/// Budget: training stops once the env steps reach total_env_steps or the run's whole wall time
+/// (resumed runs included, as of their latest checkpoint) reaches its time budget. Checkpoints
+/// are written every checkpoint_every updates and at the end, keeping the newest
+/// keep_checkpoints. A resumed run restores the algorithm from the latest valid checkpoint and
+/// replays the checkpoint's env actions, so that the envs continue their episodes: with the
+/// same total_env_steps the result is the run that did not stop.
+class TrainingRun {
+ public:
+  /// A new run of `settings` (settings.algorithm_config as algorithm.parse_config gives it) in
+  /// `folder`, which must not hold a run. budget.steps replaces total_env_steps; budget.minutes
+  /// becomes settings.minutes. Throws std::invalid_argument when the config, so changed, fails
+  /// algorithm.parse_config.
+  static TrainingRun create(const AlgorithmFactory& algorithm, EnvKwargsParser parse_sets,
+                            RunSettings settings, std::filesystem::path folder, TrainBudget budget,
+                            RunOutput output);
+
+  /// More of the run in `folder`, from its config.json and its latest valid checkpoint (newer
+  /// invalid ones are reported to output.errors as "train: skipping {path}: {reason}"). Without
+  /// budget.steps / budget.minutes the budget is the one the latest resume left. Throws
+  /// RunRequestError for a `given` setting that differs from the run's or budget.steps not
+  /// above the steps done; std::runtime_error when there is no config.json or no valid
+  /// checkpoint, or config.json is not a run's.
+  static TrainingRun resume(const AlgorithmFactory& algorithm, EnvKwargsParser parse_sets,
+                            std::filesystem::path folder, TrainBudget budget,
+                            const ResumeChecks& given, RunOutput output);
+
+  /// Trains until the budget is spent, writes the last checkpoint, evaluates the policy
+  /// (eval_episodes deterministic episodes from seed + 1,000,000, the first recorded to
+  /// final.mp4) and writes summary.json, which it returns. A resumed run whose budget is spent
+  /// and whose summary.json is of its latest checkpoint has nothing to do: it says so to
+  /// output.out, changes nothing and returns nullopt.
+  std::optional<nlohmann::json> train();
+
+  const RunSettings& settings() const { return settings_; }
+  const std::filesystem::path& folder() const { return folder_; }
+
+ private:
+  TrainingRun(const AlgorithmFactory& algorithm, EnvKwargsParser parse_sets, RunSettings settings,
+              std::filesystem::path folder, RunOutput output);
+
+  // Resume: the budget from config.json's latest resume, the checkpoint and its meta.
+  void load_resume_point(const nlohmann::json& config);
+  // Applies `budget` to the settings and the time limit; validates the config.
+  void apply_budget(const TrainBudget& budget);
+  // With a checkpoint: RunRequestError for too few steps; true (after saying so) when the
+  // budget is spent and summary.json is of the checkpoint.
+  bool nothing_to_do() const;
+  // The algorithm restored from the checkpoint, its envs replayed, the run folder reopened.
+  void restore_from_checkpoint();
+  void replay_env_actions();
+  void train_until_spent();
+  // One iterate() and its progress.csv row; returns the row.
+  ProgressRow iterate_once();
+  void save_checkpoint();
+  nlohmann::json evaluate_and_summarize();
+  double elapsed_s() const;
+
+  const AlgorithmFactory* factory_;
+  EnvKwargsParser parse_sets_;
+  RunSettings settings_;
+  std::filesystem::path folder_;
+  RunOutput output_;
+  std::optional<LoadedCheckpoint> checkpoint_;
+  nlohmann::json meta_;          // the checkpoint's
+  double budget_minutes_ = 0.0;  // of wall time over the whole run; 0: none
+  double minutes_given_ = 0.0;   // TrainBudget::minutes
+  double wall_before_s_ = 0.0;   // the run's wall time before this process: its checkpoint's
+
+  // While training.
+  std::unique_ptr<vector::VectorEnv> env_;
+  std::unique_ptr<Algorithm> algorithm_;
+  std::optional<RunFolder> run_;
+  std::deque<double> returns_;  // the latest episodes' returns (kReturnWindow at most)
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace pixelgym::trainer

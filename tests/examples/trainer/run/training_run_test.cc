@@ -1,0 +1,377 @@
+// TrainingRun driving an algorithm that is not PPO and needs no torch: a counting algorithm on
+// GridWorld-v0 whose actions follow a fixed pattern, so that the run's budget, checkpoints,
+// resume (replay of the env actions included), evaluation and summary can be checked exactly.
+#include "examples/trainer/run/training_run.h"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "envs/tasks/grid_world.h"
+#include "examples/trainer/run/checkpoint_file.h"
+#include "examples/trainer/run/progress_csv.h"
+#include "tests/examples/trainer/run/test_folders.h"
+
+namespace pixelgym::trainer {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// Always GridWorld's action 1 (down): an episode stays in the left column until truncated
+// after 50 steps, a return of 50 x -0.04.
+class DownActor final : public Actor {
+ public:
+  ActCounts act(const Value& observations, bool deterministic, Value& actions) override {
+    EXPECT_TRUE(deterministic);
+    EXPECT_EQ(observations.array().shape()[0], 1);
+    ++calls;
+    actions.array().data<std::int64_t>()[0] = 1;
+    return {};
+  }
+  std::int64_t calls = 0;
+};
+
+// A pseudo-random action for env i at step t (SplitMix64 of t * 2 + i), down or right two times
+// in three: walks that reach the goal after different numbers of steps, so that episode returns
+// differ.
+std::int64_t walk_action(std::int64_t t, int i) {
+  std::uint64_t z = static_cast<std::uint64_t>(t * 2 + i) + 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  constexpr std::int64_t kMoves[] = {GridWorld::kDown,  GridWorld::kRight, GridWorld::kDown,
+                                     GridWorld::kRight, GridWorld::kLeft,  GridWorld::kUp};
+  return kMoves[(z ^ (z >> 31)) % 6];
+}
+
+// Steps its env steps_per_iteration times an iteration, env i taking walk_action(t, i) at step
+// t (counted from the first reset); "learns" a counter of its iterations, saved in a blob
+// "counter". Its figures: policy_loss = the counter, extra column "counter" too.
+class CountingAlgorithm final : public Algorithm {
+ public:
+  CountingAlgorithm(vector::VectorEnv& env, const json& config)
+      : env_(env),
+        seed_(config.at("seed").get<std::uint64_t>()),
+        steps_per_iteration_(config.at("steps_per_iteration").get<std::int64_t>()),
+        actions_(env.action_space().zeros()),
+        episode_returns_(static_cast<std::size_t>(env.num_envs()), 0.0) {}
+
+  IterationStats iterate() override {
+    IterationStats stats;
+    if (!started_) reset();
+    for (std::int64_t k = 0; k < steps_per_iteration_; ++k) {
+      auto* action = actions_.array().data<std::int64_t>();
+      for (int i = 0; i < env_.num_envs(); ++i) action[i] = walk_action(batches_, i);
+      step(&stats.episode_returns);
+    }
+    counter_ += 1;
+    updates_ += 1;
+    stats.policy_loss = static_cast<double>(counter_);
+    stats.extra = {{"counter", static_cast<double>(counter_)}};
+    return stats;
+  }
+  std::int64_t env_steps() const override { return batches_ * env_.num_envs(); }
+  std::int64_t updates() const override { return updates_; }
+  void set_progress(std::int64_t env_steps, std::int64_t updates) override {
+    batches_ = env_steps / env_.num_envs();
+    updates_ = updates;
+    log_complete_ = false;
+  }
+  std::vector<std::string> progress_columns() const override { return {"counter"}; }
+  void save(CheckpointBlobs& blobs, json& meta) override {
+    blobs["counter"] = std::to_string(counter_);
+    meta["counter"] = counter_;
+  }
+  void restore(const LoadedCheckpoint& checkpoint, const json& meta) override {
+    counter_ = std::stoll(checkpoint.blobs.at("counter"));
+    EXPECT_EQ(meta.at("counter"), counter_);
+  }
+  const std::string& env_action_log() const override { return log_; }
+  bool env_action_log_complete() const override { return log_complete_; }
+  void replay_env(const std::string& log) override {
+    const std::int64_t batches = batches_;
+    batches_ = 0;
+    reset();
+    const std::size_t bytes = actions_.array().nbytes();
+    for (std::size_t at = 0; at < log.size(); at += bytes) {
+      std::memcpy(actions_.array().raw_data(), log.data() + at, bytes);
+      step(nullptr);
+    }
+    EXPECT_EQ(batches_, batches);
+    log_complete_ = true;
+  }
+  std::uint64_t env_digest() const override {
+    if (!started_) return 0;
+    std::uint64_t hash = 14695981039346656037ULL;
+    const auto mix = [&](const void* data, std::size_t size) {
+      for (std::size_t b = 0; b < size; ++b) {
+        hash = (hash ^ static_cast<const unsigned char*>(data)[b]) * 1099511628211ULL;
+      }
+    };
+    mix(obs_->array().raw_data(), obs_->array().nbytes());
+    mix(episode_returns_.data(), episode_returns_.size() * sizeof(double));
+    return hash;
+  }
+  Actor& actor() override { return actor_; }
+
+  DownActor actor_;
+
+ private:
+  void reset() {
+    obs_ = &env_.reset(seed_).obs;
+    started_ = true;
+  }
+  // One step of every env with actions_; appends the returns of the episodes that ended.
+  void step(std::vector<double>* ended) {
+    log_.append(static_cast<const char*>(actions_.array().raw_data()), actions_.array().nbytes());
+    const vector::VectorStepResult& result = env_.step(actions_);
+    obs_ = &result.obs;
+    for (std::size_t i = 0; i < episode_returns_.size(); ++i) {
+      episode_returns_[i] += result.rewards.data<double>()[i];
+      if (result.terminated.data<bool>()[i] || result.truncated.data<bool>()[i]) {
+        if (ended != nullptr) ended->push_back(episode_returns_[i]);
+        episode_returns_[i] = 0.0;
+      }
+    }
+    batches_ += 1;
+  }
+
+  vector::VectorEnv& env_;
+  std::uint64_t seed_;
+  std::int64_t steps_per_iteration_;
+  Value actions_;
+  const Value* obs_ = nullptr;
+  std::vector<double> episode_returns_;
+  std::string log_;
+  bool log_complete_ = true;
+  bool started_ = false;
+  std::int64_t batches_ = 0;
+  std::int64_t updates_ = 0;
+  std::int64_t counter_ = 0;
+};
+
+class CountingFactory final : public AlgorithmFactory {
+ public:
+  std::string name() const override { return "counting"; }
+  json parse_config(const std::string& text) const override {
+    json config = {
+        {"seed", 0}, {"num_envs", 2}, {"total_env_steps", 40}, {"steps_per_iteration", 4}};
+    const json given = json::parse(text);
+    for (const auto& [key, value] : given.items()) {
+      if (!config.contains(key)) throw std::invalid_argument("counting: unknown member " + key);
+      config[key] = value;
+    }
+    if (config.at("total_env_steps").get<std::int64_t>() < 1) {
+      throw std::invalid_argument("counting: total_env_steps must be >= 1");
+    }
+    return config;
+  }
+  int set_threads(int requested) const override { return requested == 0 ? 3 : requested; }
+  std::unique_ptr<Algorithm> make(vector::VectorEnv& env, const json& config) const override {
+    auto algorithm = std::make_unique<CountingAlgorithm>(env, config);
+    last = algorithm.get();
+    return algorithm;
+  }
+  std::unique_ptr<Actor> load_actor(const Space&, const Space&, const json&,
+                                    const LoadedCheckpoint&) const override {
+    return std::make_unique<DownActor>();
+  }
+  mutable CountingAlgorithm* last = nullptr;  // the latest made (valid while its run lives)
+};
+
+Params integer_kwargs(const std::string&, const std::vector<std::string>& sets) {
+  Params params;
+  for (const std::string& entry : sets) {
+    const std::size_t equals = entry.find('=');
+    params.emplace(entry.substr(0, equals), parse_param(ParamType::kInt, entry.substr(equals + 1)));
+  }
+  return params;
+}
+
+RunSettings grid_settings(std::int64_t checkpoint_every = 2, std::int64_t keep_checkpoints = 2) {
+  const CountingFactory factory;
+  RunSettings settings;
+  settings.env_id = "GridWorld-v0";
+  settings.sets = {"render_width=32", "render_height=32"};
+  settings.num_threads = 1;
+  settings.checkpoint_every = checkpoint_every;
+  settings.keep_checkpoints = keep_checkpoints;
+  settings.eval_episodes = 2;
+  settings.algorithm_config = factory.parse_config(R"({"seed": 7})");
+  return settings;
+}
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// A new run trains to its step budget (8 env steps an iteration: 5 iterations for 40), writes
+// its rows with the algorithm's column, checkpoints every 2 updates and at the end keeping the
+// newest 2, evaluates with the algorithm's actor and writes the summary.
+TEST(TrainingRunTest, ANewRunTrainsToItsStepBudgetAndWritesTheRunFolder) {
+  const fs::path folder = test_folders::fresh_folder("training_run_new") / "run";
+  const CountingFactory factory;
+  std::ostringstream out;
+  std::ostringstream errors;
+  TrainingRun run = TrainingRun::create(factory, integer_kwargs, grid_settings(), folder,
+                                        TrainBudget{}, RunOutput{out, errors});
+  const std::optional<json> summary = run.train();
+  ASSERT_TRUE(summary.has_value()) << out.str();
+
+  const ProgressTable progress = read_progress_csv(folder / "progress.csv");
+  EXPECT_EQ(progress.columns.back(), "counter");
+  EXPECT_EQ(progress.column("steps"), (std::vector<double>{8, 16, 24, 32, 40}));
+  EXPECT_EQ(progress.column("counter"), (std::vector<double>{1, 2, 3, 4, 5}));
+  EXPECT_EQ(progress.column("policy_loss"), progress.column("counter"));
+  EXPECT_EQ(test_folders::entries(folder),
+            (std::vector<std::string>{"ckpt-000004.pgck", "ckpt-000005.pgck", "config.json",
+                                      "curve.png", "final.mp4", "progress.csv", "summary.json"}));
+  const CheckpointBlobs blobs = read_checkpoint(folder / "ckpt-000005.pgck");
+  EXPECT_EQ(blobs.at("counter"), "5");
+  EXPECT_EQ(blobs.at("env_actions").size(), 20U * 2U * sizeof(std::int64_t));
+  const json meta = json::parse(blobs.at("meta"));
+  EXPECT_EQ(meta.at("env_steps"), 40);
+  EXPECT_EQ(meta.at("updates"), 5);
+  EXPECT_EQ(meta.at("counter"), 5);
+  EXPECT_EQ(meta.at("env_digest"), factory.last->env_digest());
+  const json config = json::parse(read_text(folder / "config.json"));
+  EXPECT_EQ(config.at("counting").at("seed"), 7);
+  EXPECT_EQ(config.at("torch_threads"), 3);  // the count set_threads reported
+  EXPECT_EQ(json::parse(blobs.at("config")).at("counting"), config.at("counting"));
+
+  EXPECT_EQ(summary->at("env_steps"), 40);
+  EXPECT_EQ(summary->at("updates"), 5);
+  const json& evaluation = summary->at("evaluation");
+  EXPECT_EQ(evaluation.at("seed"), 1'000'007);
+  EXPECT_EQ(evaluation.at("returns").size(), 2U);
+  EXPECT_NEAR(evaluation.at("return_mean").get<double>(), -2.0, 1e-9);
+  EXPECT_EQ(factory.last->actor_.calls, 100);  // 2 truncated episodes of 50 steps
+  EXPECT_EQ(json::parse(read_text(folder / "summary.json")), *summary);
+  EXPECT_GT(fs::file_size(folder / "final.mp4"), 0U);
+  EXPECT_NE(out.str().find("evaluation: return -2 +/- 0 over 2 episodes"), std::string::npos)
+      << out.str();
+}
+
+// Stopped by its budget at 96 env steps and resumed to 192, a run is the run that trained to 192
+// at once: the same rows (returns over episodes from before the stop included), the same learned
+// state, the same envs (no digest warning).
+TEST(TrainingRunTest, AResumedRunIsTheRunThatDidNotStop) {
+  const fs::path base = test_folders::fresh_folder("training_run_resume");
+  const CountingFactory factory;
+  std::ostringstream out;
+  std::ostringstream errors;
+  RunSettings settings = grid_settings(3, 0);
+  settings.algorithm_config["steps_per_iteration"] = 16;  // 32 env steps an iteration
+  settings.sets.push_back("max_episode_steps=12");        // episodes end, at the goal or truncated
+  TrainingRun whole = TrainingRun::create(factory, integer_kwargs, settings, base / "whole",
+                                          TrainBudget{192, 0.0}, {out, errors});
+  ASSERT_TRUE(whole.train().has_value());
+  TrainingRun first = TrainingRun::create(factory, integer_kwargs, settings, base / "stopped",
+                                          TrainBudget{96, 0.0}, {out, errors});
+  ASSERT_TRUE(first.train().has_value());
+  std::ostringstream resumed_out;
+  TrainingRun resumed = TrainingRun::resume(factory, integer_kwargs, base / "stopped",
+                                            TrainBudget{192, 0.0}, {}, {resumed_out, errors});
+  ASSERT_TRUE(resumed.train().has_value());
+  EXPECT_NE(resumed_out.str().find("resuming " + (base / "stopped").string() +
+                                   " from ckpt-000003.pgck (96 env steps, 3 updates)"),
+            std::string::npos)
+      << resumed_out.str();
+  EXPECT_NE(resumed_out.str().find("replayed the 96 env steps of the checkpoint"),
+            std::string::npos)
+      << resumed_out.str();
+  EXPECT_EQ(resumed_out.str().find("warning"), std::string::npos) << resumed_out.str();
+
+  const ProgressTable a = read_progress_csv(base / "whole" / "progress.csv");
+  const ProgressTable b = read_progress_csv(base / "stopped" / "progress.csv");
+  // Episodes ended before the stop, and their returns differ: the window of returns matters.
+  ASSERT_EQ(a.rows.size(), 6U);
+  EXPECT_GT(a.column("episode_return_std")[2], 0.0);
+  for (const char* column : {"steps", "episode_return_mean", "episode_return_std", "counter"}) {
+    const std::vector<double> x = a.column(column);
+    const std::vector<double> y = b.column(column);
+    ASSERT_EQ(x.size(), 6U) << column;
+    ASSERT_EQ(y.size(), 6U) << column;
+    for (std::size_t row = 0; row < x.size(); ++row) {
+      EXPECT_TRUE(x[row] == y[row] || (std::isnan(x[row]) && std::isnan(y[row])))
+          << column << " row " << row << ": " << x[row] << " vs " << y[row];
+    }
+  }
+  const CheckpointBlobs x = read_checkpoint(base / "whole" / "ckpt-000006.pgck");
+  const CheckpointBlobs y = read_checkpoint(base / "stopped" / "ckpt-000006.pgck");
+  for (const char* blob : {"counter", "env_actions"}) EXPECT_EQ(x.at(blob), y.at(blob)) << blob;
+  const json meta_x = json::parse(x.at("meta"));
+  const json meta_y = json::parse(y.at("meta"));
+  for (const char* member : {"env_digest", "recent_returns", "env_steps", "updates"}) {
+    EXPECT_EQ(meta_x.at(member), meta_y.at(member)) << member;
+  }
+  const json config = json::parse(read_text(base / "stopped" / "config.json"));
+  ASSERT_EQ(config.at("resumes").size(), 1U);
+  EXPECT_EQ(config.at("resumes")[0].at("total_env_steps"), 192);
+}
+
+// A resume with its budget spent and summarized says so and changes nothing; a budget below the
+// steps done and a setting that differs from the run's are refused; a time budget given to a
+// resume allows one more update, and later resumes keep it.
+TEST(TrainingRunTest, AResumeKeepsTheRunsBudgetAndRefusesWhatDoesNotFit) {
+  const fs::path folder = test_folders::fresh_folder("training_run_budget") / "run";
+  const CountingFactory factory;
+  std::ostringstream out;
+  std::ostringstream errors;
+  ASSERT_TRUE(TrainingRun::create(factory, integer_kwargs, grid_settings(), folder,
+                                  TrainBudget{16, 0.0}, {out, errors})
+                  .train()
+                  .has_value());
+  const auto rows = [&] { return read_progress_csv(folder / "progress.csv").rows.size(); };
+  ASSERT_EQ(rows(), 2U);
+
+  std::ostringstream spent;
+  EXPECT_FALSE(
+      TrainingRun::resume(factory, integer_kwargs, folder, {}, {}, {spent, errors}).train());
+  EXPECT_NE(spent.str().find("nothing to do, the run has spent its env steps (16 of 16): give "
+                             "--steps N (more than 16) to train on"),
+            std::string::npos)
+      << spent.str();
+  EXPECT_EQ(rows(), 2U);
+
+  EXPECT_THROW(
+      TrainingRun::resume(factory, integer_kwargs, folder, TrainBudget{16, 0.0}, {}, {out, errors}),
+      RunRequestError);
+  ResumeChecks given;
+  given.num_threads = 1;  // the run's
+  given.eval_episodes = 3;
+  try {
+    TrainingRun::resume(factory, integer_kwargs, folder, TrainBudget{24, 0.0}, given,
+                        {out, errors});
+    ADD_FAILURE() << "a differing --eval-episodes was accepted";
+  } catch (const RunRequestError& error) {
+    EXPECT_NE(std::string(error.what())
+                  .find("these differ from them: --eval-episodes 3 (the "
+                        "run's: 2) (only --steps and --minutes may change)"),
+              std::string::npos)
+        << error.what();
+  }
+
+  // A picosecond more: spent before the first update, which given minutes allow all the same.
+  ASSERT_TRUE(TrainingRun::resume(factory, integer_kwargs, folder, TrainBudget{400, 1e-14}, {},
+                                  {out, errors})
+                  .train()
+                  .has_value());
+  EXPECT_EQ(rows(), 3U);
+  std::ostringstream again;
+  EXPECT_FALSE(
+      TrainingRun::resume(factory, integer_kwargs, folder, {}, {}, {again, errors}).train());
+  EXPECT_NE(again.str().find("nothing to do, the run has spent its time"), std::string::npos)
+      << again.str();
+  EXPECT_EQ(rows(), 3U);
+}
+
+}  // namespace
+}  // namespace pixelgym::trainer
