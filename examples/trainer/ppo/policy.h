@@ -39,15 +39,12 @@ ObservationTensors observation_tensors(const Value& batch);
 enum class CnnArchitecture : std::uint8_t {
   /// Mnih et al. 2015 ("Nature"): conv 32 8x8/4, conv 64 4x4/2, conv 64 3x3/1, linear.
   kNature,
-  /// Mnih et al. 2013 (NIPS DQN): conv 16 8x8/4, conv 32 4x4/2, linear; 0.6x the Nature CNN's
-  /// forward + backward time at 64x64 and 84x84 (ppo_bench, 2 threads, batch 128, OpenBLAS;
-  /// README, Training, has the table).
+  /// Mnih et al. 2013 (NIPS DQN): conv 16 8x8/4, conv 32 4x4/2, linear (costs:
+  /// docs/design-notes.md, "The CNNs").
   kSmall,
   /// Three conv 32 3x3/2 (the first layer of DrQ's encoder, repeated): no pixel is skipped, so
   /// positions of thin things (a pole's tip) survive to the linear layer finer than in the small
   /// CNN (7x7 cells at 64x64 where every input pixel was seen, against 6x6 after 8x8/4 strides).
-  /// Forward + backward per sample (ppo_bench, 2 threads, batch 128): 1.7x the small CNN's at
-  /// 64x64, 1.6x at 84x84.
   kFine,
   /// The fine CNN with a last convolution of stride 1: 13x13 cells at 64x64 (a 5408-wide linear
   /// layer).
