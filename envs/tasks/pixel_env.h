@@ -107,6 +107,8 @@ class PixelRenderResources final : public RenderResources {
 
   int mesa_copy() const { return group_.mesa_copy(); }
   bool shares_context() const { return share_context_; }
+  /// Whether a renderer made with these resources has created the shared GL context yet.
+  bool context_created() const { return group_.created(); }
   /// A renderer for one env: with the group's context when shared, else with one of its own in
   /// the copy. Throws as render::Renderer's constructors.
   std::unique_ptr<render::Renderer> make_renderer();
