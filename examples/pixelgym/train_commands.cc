@@ -1,16 +1,23 @@
-// pixelgym train / eval: the trainer's run (examples/trainer/run) with PPO (examples/trainer/ppo).
+// pixelgym train / eval: the trainer's run (examples/trainer/run) with an algorithm: PPO
+// (examples/trainer/ppo) or DrQ-v2 (examples/trainer/drqv2).
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "examples/pixelgym/cli.h"
+#include "examples/trainer/drqv2/drqv2_algorithm.h"
 #include "examples/trainer/ppo/ppo_algorithm.h"
+#include "examples/trainer/run/atomic_file.h"
+#include "examples/trainer/run/curve_plot.h"
 #include "examples/trainer/run/evaluation.h"
 #include "examples/trainer/run/process_tuning.h"
+#include "examples/trainer/run/progress_csv.h"
 #include "examples/trainer/run/training_run.h"
 
 namespace pixelgym::cli {
@@ -18,9 +25,33 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// The algorithms `train --algo` offers, PPO first (the default).
+const ppo::PpoAlgorithmFactory kPpo;
+const drqv2::DrqV2AlgorithmFactory kDrqV2;
+const trainer::AlgorithmFactories kAlgorithms = {&kPpo, &kDrqV2};
+
+const trainer::AlgorithmFactory& algorithm_named(const std::string& name) {
+  for (const trainer::AlgorithmFactory* algorithm : kAlgorithms) {
+    if (algorithm->name() == name) return *algorithm;
+  }
+  throw UsageError("train --algo: unknown algorithm \"" + name + "\"");
+}
+
+// The algorithm of the run in `folder` (its config.json names it).
+const trainer::AlgorithmFactory& algorithm_of_run(const fs::path& folder) {
+  std::ifstream config_file(folder / "config.json");
+  if (!config_file) {
+    throw std::runtime_error("--resume " + folder.string() + ": no config.json there");
+  }
+  const nlohmann::json config = nlohmann::json::parse(config_file, nullptr, false);
+  return trainer::algorithm_of(config, folder / "config.json", kAlgorithms);
+}
+
 // --- train ---
 
 struct TrainArguments : EnvArguments {
+  std::string algo = "ppo";
+  bool algo_given = false;
   std::string config_file;
   std::int64_t steps = 0;  // 0: the config's total_env_steps
   double minutes = 0.0;
@@ -35,10 +66,12 @@ struct TrainArguments : EnvArguments {
   std::int64_t checkpoint_every = 10;
   std::int64_t keep_checkpoints = 3;
   std::int64_t eval_episodes = 5;
+  std::int64_t eval_every = 0;
+  std::int64_t eval_every_episodes = 5;
   const CLI::App* command = nullptr;  // the parsed subcommand: which flags were given
 };
 
-// The settings of a new run: the flags, over the --config file's PPO settings.
+// The settings of a new run: the flags, over the --config file's settings of the algorithm.
 trainer::RunSettings new_run_settings(const TrainArguments& args,
                                       const trainer::AlgorithmFactory& algorithm) {
   trainer::RunSettings settings;
@@ -61,6 +94,12 @@ trainer::RunSettings new_run_settings(const TrainArguments& args,
   settings.checkpoint_every = args.checkpoint_every;
   settings.keep_checkpoints = args.keep_checkpoints;
   settings.eval_episodes = args.eval_episodes;
+  // Ten evaluations over the run unless --eval-every says otherwise.
+  const std::int64_t total = args.steps > 0 ? args.steps : settings.total_env_steps();
+  settings.eval_every = args.command->count("--eval-every") > 0
+                            ? args.eval_every
+                            : std::max<std::int64_t>(total / 10, 1);
+  settings.eval_every_episodes = args.eval_every_episodes;
   return settings;
 }
 
@@ -75,6 +114,8 @@ trainer::ResumeChecks resume_checks(const TrainArguments& args) {
   if (given("--checkpoint-every")) checks.checkpoint_every = args.checkpoint_every;
   if (given("--keep-checkpoints")) checks.keep_checkpoints = args.keep_checkpoints;
   if (given("--eval-episodes")) checks.eval_episodes = args.eval_episodes;
+  if (given("--eval-every")) checks.eval_every = args.eval_every;
+  if (given("--eval-every-episodes")) checks.eval_every_episodes = args.eval_every_episodes;
   return checks;
 }
 
@@ -83,13 +124,14 @@ int run_train(const TrainArguments& args) {
     throw UsageError("train: give an env id, or --resume RUN_FOLDER");
   }
   if (!args.resume.empty() && (!args.id.empty() || !args.sets.empty() || !args.wraps.empty() ||
-                               !args.config_file.empty() || !args.out.empty())) {
+                               !args.config_file.empty() || !args.out.empty() || args.algo_given)) {
     throw UsageError(
         "train --resume takes the env and settings from the run's config.json: give no id, "
-        "--set, --wrap, --config or --out with it");
+        "--set, --wrap, --algo, --config or --out with it");
   }
   trainer::tune_process_for_training();
-  const ppo::PpoAlgorithmFactory ppo;
+  const trainer::AlgorithmFactory& algorithm =
+      args.resume.empty() ? algorithm_named(args.algo) : algorithm_of_run(args.resume);
   const trainer::TrainBudget budget{args.steps, args.minutes};
   const trainer::RunOutput output{std::cout, std::cerr,
                                   trainer::ProgressLine::mode_for_stdout(args.quiet),
@@ -98,10 +140,10 @@ int run_train(const TrainArguments& args) {
     trainer::TrainingRun run =
         args.resume.empty()
             ? trainer::TrainingRun::create(
-                  ppo, parse_sets, new_run_settings(args, ppo),
+                  algorithm, parse_sets, new_run_settings(args, algorithm),
                   args.out.empty() ? fs::path("runs") / args.id : fs::path(args.out), budget,
                   output)
-            : trainer::TrainingRun::resume(ppo, parse_sets, args.resume, budget,
+            : trainer::TrainingRun::resume(algorithm, parse_sets, args.resume, budget,
                                            resume_checks(args), output);
     run.train();
   } catch (const trainer::RunRequestError& error) {
@@ -112,12 +154,33 @@ int run_train(const TrainArguments& args) {
 
 // What to train and for how long: --config, --steps, --minutes, --out, --resume, --quiet.
 void add_run_options(CLI::App& train, TrainArguments& args) {
+  train
+      .add_option("--algo", args.algo,
+                  "The learning algorithm: ppo (PPO, on-policy; the default) or drqv2 (DrQ-v2: "
+                  "off-policy DDPG with a twin critic, n-step returns from a replay buffer, "
+                  "random-shift augmentation and scheduled exploration noise; Box actions only, "
+                  "and images as --wrap frame_stack=3 stacks). The run's config.json names it; "
+                  "--resume and eval read it from there")
+      ->check(CLI::IsMember({"ppo", "drqv2"}))
+      ->each([&args](const std::string&) { args.algo_given = true; });
   train.add_option("--config", args.config_file,
-                   "PPO settings as JSON (any subset of the fields; the rest keep their defaults: "
-                   "see examples/trainer/ppo/ppo.h, PpoConfig)");
+                   "The algorithm's settings as JSON (any subset of the fields; the rest keep "
+                   "their defaults). ppo: examples/trainer/ppo/ppo.h, PpoConfig. drqv2: "
+                   "examples/trainer/drqv2/drqv2.h, DrqV2Config: seed, num_envs (1), "
+                   "total_env_steps (100,000), iteration_env_steps (500, one progress.csv row), "
+                   "frame_stack (3), replay_capacity (100,000 steps), batch_size (128), n_step "
+                   "(3), gamma (0.99), learning_rate (1e-4), critic_tau (0.01), encoder (mrq "
+                   "or drqv2), feature_dim (50), hidden_dim (256), seed_env_steps (1000 steps of "
+                   "random actions), updates_per_env_step (1), noise_start (1), noise_end (0.1), "
+                   "noise_schedule_env_steps (25,000), noise_clip (0.3), shift_pad (4), "
+                   "bfloat16 (true: autocast the encoder where the CPU has AVX512-BF16 or AMX), "
+                   "channels_last (true). drqv2's replay buffer is not in its checkpoints: "
+                   "--resume refills it by replaying the run's env actions, which puts the "
+                   "same transitions back");
   train.add_option("--steps", args.steps,
                    "Env steps to train for, all envs together; with --set action_repeat=K "
-                   "each is K control steps (default: the config's total_env_steps, 1,000,000)");
+                   "each is K control steps (default: the config's total_env_steps: ppo "
+                   "1,000,000, drqv2 100,000)");
   train
       .add_option("--minutes", args.minutes,
                   "Stop after this much wall time (then checkpoint, evaluate, write the video); "
@@ -167,13 +230,25 @@ void add_run_setting_options(CLI::App& train, TrainArguments& args) {
   add_checked_option(train, "--eval-episodes", args.eval_episodes,
                      "Seeded episodes of the final evaluation (deterministic actions)",
                      CLI::Range(std::int64_t{1}, std::int64_t{1} << 20));
+  add_checked_option(train, "--eval-every", args.eval_every,
+                     "Evaluate the policy during training each time the env steps pass a "
+                     "multiple of this (0: never; default: a tenth of --steps, ten evaluations), "
+                     "over --eval-every-episodes deterministic episodes with the final "
+                     "evaluation's seeds; each adds a row to eval.csv (steps, wall_time_s, "
+                     "return_mean, return_std, episodes, eval_s). An evaluation is skipped when "
+                     "this process's evaluations have taken a tenth of its wall time",
+                     CLI::Range(std::int64_t{0}, std::int64_t{1} << 50));
+  add_checked_option(train, "--eval-every-episodes", args.eval_every_episodes,
+                     "Episodes of each evaluation during training",
+                     CLI::Range(std::int64_t{1}, std::int64_t{1} << 20));
 }
 
 void declare_train(CLI::App& train, TrainArguments& args) {
   args.command = &train;
   train.description(
-      "Train a PPO policy from the env's observations (pixels included) and write a run folder: "
-      "config.json, progress.csv, curve.png, checkpoints, and at the end final.mp4 and "
+      "Train a policy (PPO, or DrQ-v2 with --algo drqv2) from the env's observations (pixels "
+      "included) and write a run folder: "
+      "config.json, progress.csv, eval.csv, curve.png, checkpoints, and at the end final.mp4 and "
       "summary.json (an evaluation over seeded episodes)");
   train.add_option("id", args.id, "Env id, e.g. CartPoleBalance-v0 (`pixelgym list` shows them)");
   add_env_options(train, args);
@@ -201,8 +276,8 @@ int run_eval(const EvalArguments& args) {
   trainer::tune_process_for_training();
   trainer::EvaluationRequest request{args.episodes, args.seed, args.stochastic, std::nullopt};
   if (!args.video.empty()) request.video = fs::path(args.video);
-  const trainer::CheckpointEvaluation result = trainer::evaluate_checkpoint(
-      ppo::PpoAlgorithmFactory(), parse_sets, args.run, request, std::cerr);
+  const trainer::CheckpointEvaluation result =
+      trainer::evaluate_checkpoint(kAlgorithms, parse_sets, args.run, request, std::cerr);
   const trainer::PolicyEvaluation& evaluation = result.evaluation;
   std::cout << result.checkpoint.string() << ": " << result.settings.env_id << ", " << args.episodes
             << " episodes from seed " << args.seed
@@ -231,11 +306,104 @@ void declare_eval(CLI::App& eval, EvalArguments& args) {
                 "Sample actions from the policy instead of taking its mean / most likely one");
 }
 
+// --- compare ---
+
+struct CompareArguments {
+  std::vector<std::string> runs;
+  std::string out;
+  std::string curve = "eval";
+  std::string title;
+  int width = 1100;
+  int height = 500;
+};
+
+// The control steps per env step of a run: its --set action_repeat=K (1 without).
+double action_repeat_of(const nlohmann::json& config) {
+  double repeat = 1.0;
+  for (const auto& set : config.value("set", std::vector<std::string>{})) {
+    const std::string key = "action_repeat=";
+    if (set.rfind(key, 0) == 0) repeat = std::stod(set.substr(key.size()));
+  }
+  return repeat;
+}
+
+int run_compare(const CompareArguments& args) {
+  std::vector<trainer::ComparedCurve> curves;
+  std::cout << "run,control_steps,wall_minutes,return_mean,return_std\n";
+  for (const std::string& spec : args.runs) {
+    const std::size_t equals = spec.find('=');
+    const fs::path folder = spec.substr(0, equals);
+    trainer::ComparedCurve curve;
+    curve.label =
+        equals == std::string::npos ? folder.filename().string() : spec.substr(equals + 1);
+    std::ifstream config_file(folder / "config.json");
+    if (!config_file) throw UsageError("compare: " + folder.string() + " has no config.json");
+    const double repeat = action_repeat_of(nlohmann::json::parse(config_file));
+    if (args.curve == "eval") {
+      const fs::path file = folder / "eval.csv";
+      if (!fs::exists(file)) {
+        throw UsageError("compare: " + file.string() +
+                         " does not exist (a run without evaluations during training; "
+                         "--curve train plots its training returns)");
+      }
+      for (const trainer::EvalRow& row :
+           trainer::parse_eval_csv(trainer::read_whole_file(file, "compare"), file.string())) {
+        curve.x.push_back(static_cast<double>(row.steps) * repeat);
+        curve.wall_minutes.push_back(row.wall_time_s / 60.0);
+        curve.mean.push_back(row.return_mean);
+        curve.std.push_back(row.return_std);
+      }
+    } else {
+      const trainer::ProgressTable table = trainer::read_progress_csv(folder / "progress.csv");
+      for (const double steps : table.column("steps")) curve.x.push_back(steps * repeat);
+      for (const double seconds : table.column("wall_time_s")) {
+        curve.wall_minutes.push_back(seconds / 60.0);
+      }
+      curve.mean = table.column("episode_return_mean");
+      curve.std = table.column("episode_return_std");
+    }
+    if (!curve.x.empty()) {
+      std::cout << curve.label << "," << curve.x.back() << "," << curve.wall_minutes.back() << ","
+                << curve.mean.back() << "," << curve.std.back() << "\n";
+    }
+    curves.push_back(std::move(curve));
+  }
+  trainer::CurvePlotOptions options;
+  options.title = args.title.empty()
+                      ? (args.curve == "eval" ? "evaluation return" : "training return")
+                      : args.title;
+  options.width = args.width;
+  options.height = args.height;
+  options.x_label = "control steps (env steps x action_repeat)";
+  const render::Image image = trainer::draw_comparison(curves, options);
+  render::write_png(args.out, image.view());
+  std::cout << "wrote " << args.out << "\n";
+  return 0;
+}
+
+void declare_compare(CLI::App& compare, CompareArguments& args) {
+  compare.description(
+      "Draw the learning curves of several run folders side by side into a PNG: return against "
+      "control steps (env steps times the run's --set action_repeat) and against wall minutes; "
+      "print each run's last point as CSV");
+  compare.add_option("runs", args.runs, "Run folders, each optionally FOLDER=LABEL")->required();
+  compare.add_option("--out", args.out, "The PNG to write")->required();
+  compare
+      .add_option("--curve", args.curve,
+                  "eval: the evaluations during training (eval.csv: deterministic episodes); "
+                  "train: the training episodes' returns (progress.csv)")
+      ->check(CLI::IsMember({"eval", "train"}));
+  compare.add_option("--title", args.title, "The plot's title");
+  add_checked_option(compare, "--width", args.width, "Width in pixels", CLI::Range(400, 8000));
+  add_checked_option(compare, "--height", args.height, "Height in pixels", CLI::Range(250, 8000));
+}
+
 }  // namespace
 
 std::vector<Command> add_train_commands(CLI::App& app) {
   return {add_command(app, "train", declare_train, run_train),
-          add_command(app, "eval", declare_eval, run_eval)};
+          add_command(app, "eval", declare_eval, run_eval),
+          add_command(app, "compare", declare_compare, run_compare)};
 }
 
 }  // namespace pixelgym::cli

@@ -476,5 +476,96 @@ TEST(TrainCliTest, TruncatedAndCorruptCheckpointsAreRefused) {
   fs::remove_all(folder);
 }
 
+// The off-policy learner through the same run machinery: a run folder with its own columns and
+// eval.csv, `eval` reading its checkpoint, a resume that refills the replay buffer from the
+// env actions and continues as the run that did not stop, and its refusals.
+TEST(TrainCliTest, DrqV2WritesARunThatEvalReadsAndResumesAsIfItHadNotStopped) {
+  const fs::path folder = fresh_folder("drqv2");
+  const std::string config =
+      R"({"seed_env_steps": 24, "iteration_env_steps": 16, "batch_size": 8, "hidden_dim": 16,
+          "feature_dim": 8, "replay_capacity": 400, "n_step": 2})";
+  std::ofstream(folder / "drqv2.json") << config;
+  const auto arguments = [&](const fs::path& run, std::int64_t steps) {
+    return "train CartPoleBalance-v1 --algo drqv2 --set obs_mode=pixels+state --set width=32 "
+           "--set height=32 --set max_episode_steps=24 --wrap grayscale --wrap frame_stack=3 "
+           "--threads 1 --config " +
+           (folder / "drqv2.json").string() + " --steps " + std::to_string(steps) +
+           " --checkpoint-every 2 --keep-checkpoints 0 --eval-every 32 --eval-every-episodes 1 "
+           "--eval-episodes 1 --quiet --out " +
+           run.string();
+  };
+  const fs::path straight = folder / "straight";
+  const CliRun trained = run_cli(arguments(straight, 96));
+  ASSERT_EQ(trained.exit_code, 0) << trained.output;
+  for (const char* file : {"config.json", "progress.csv", "eval.csv", "curve.png", "final.mp4",
+                           "summary.json", "ckpt-000006.pgck"}) {
+    EXPECT_TRUE(fs::exists(straight / file)) << file;
+  }
+  const json run_config = json::parse(read_text(straight / "config.json"));
+  EXPECT_EQ(run_config.at("drqv2").at("batch_size"), 8);
+  EXPECT_EQ(run_config.at("eval_every"), 32);
+  const trainer::ProgressTable progress = trainer::read_progress_csv(straight / "progress.csv");
+  ASSERT_EQ(progress.rows.size(), 6U);
+  const std::vector<double> critic = progress.column("critic_loss");
+  EXPECT_TRUE(std::isnan(critic[0])) << "an update during the seed steps";
+  EXPECT_TRUE(std::isfinite(critic[5]));
+  EXPECT_GT(progress.column("gradient_updates").back(), 0.0);
+  const std::string evals = read_text(straight / "eval.csv");
+  EXPECT_EQ(evals.rfind("steps,wall_time_s,return_mean,return_std,episodes,eval_s\n32,", 0), 0U)
+      << evals;
+
+  const CliRun evaluated = run_cli("eval " + straight.string() + " --episodes 1");
+  ASSERT_EQ(evaluated.exit_code, 0) << evaluated.output;
+  EXPECT_NE(evaluated.output.find("return_mean="), std::string::npos) << evaluated.output;
+
+  // Stopped after 32 steps, resumed to 96: the same checkpoints as the straight run.
+  const fs::path split = folder / "split";
+  const CliRun first = run_cli(arguments(split, 32));
+  ASSERT_EQ(first.exit_code, 0) << first.output;
+  const CliRun resumed = run_cli("train --resume " + split.string() + " --steps 96 --quiet");
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  EXPECT_NE(resumed.output.find("replayed the 32 env steps"), std::string::npos) << resumed.output;
+  for (std::int64_t update = 4; update <= 6; update += 2) {
+    const std::string name = trainer::checkpoint_file_name(update);
+    const trainer::CheckpointBlobs a = trainer::read_checkpoint(straight / name);
+    const trainer::CheckpointBlobs b = trainer::read_checkpoint(split / name);
+    for (const char* blob :
+         {"agent", "rng_augmentation", "rng_exploration", "rng_noise", "env_actions"}) {
+      ASSERT_EQ(a.count(blob), 1U) << name << " " << blob;
+      EXPECT_TRUE(a.at(blob) == b.at(blob)) << name << ": \"" << blob << "\" differs";
+    }
+    EXPECT_EQ(json::parse(a.at("meta")).at("drqv2"), json::parse(b.at("meta")).at("drqv2"));
+  }
+
+  // compare draws both runs' evaluations (control steps: env steps x no action_repeat).
+  const CliRun compared = run_cli("compare " + straight.string() + "=straight " + split.string() +
+                                  " --out " + (folder / "compare.png").string());
+  ASSERT_EQ(compared.exit_code, 0) << compared.output;
+  EXPECT_TRUE(fs::exists(folder / "compare.png"));
+  EXPECT_NE(compared.output.find("\nstraight,96,"), std::string::npos) << compared.output;
+  EXPECT_NE(compared.output.find("\nsplit,96,"), std::string::npos) << compared.output;
+  const CliRun no_evals = run_cli("compare " + folder.string() + " --out " +
+                                  (folder / "none.png").string());
+  EXPECT_NE(no_evals.exit_code, 0);
+  EXPECT_FALSE(fs::exists(folder / "none.png"));
+
+  // Refusals: a Discrete action space (naming the env and the space), a bad config member.
+  const CliRun discrete = run_cli(
+      "train CartPoleBalanceDiscrete-v0 --algo drqv2 --set obs_mode=state --quiet --steps 16 "
+      "--out " +
+      (folder / "discrete").string());
+  EXPECT_NE(discrete.exit_code, 0);
+  EXPECT_NE(discrete.output.find("CartPoleBalanceDiscrete-v0"), std::string::npos)
+      << discrete.output;
+  EXPECT_NE(discrete.output.find("Discrete(3)"), std::string::npos) << discrete.output;
+  std::ofstream(folder / "bad.json") << R"({"batch_size": 0})";
+  const CliRun bad =
+      run_cli("train CartPoleBalance-v1 --algo drqv2 --config " + (folder / "bad.json").string() +
+              " --quiet --out " + (folder / "bad").string());
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("batch_size"), std::string::npos) << bad.output;
+  fs::remove_all(folder);
+}
+
 }  // namespace
 }  // namespace pixelgym::testing

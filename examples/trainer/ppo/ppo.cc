@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "examples/trainer/ppo/gae.h"
+#include "examples/trainer/run/config_members.h"
 
 namespace pixelgym::ppo {
 namespace {
@@ -30,36 +31,12 @@ ObservationTensors select_rows(const ObservationTensors& obs, const torch::Tenso
   return rows;
 }
 
-// from_json helpers: a member read into `field` with a clear error on a type mismatch.
+// PpoConfig's members and PolicyConfig's (nested in it): errors name PpoConfig.
 template <typename T>
 void read_member(const nlohmann::json& json, const char* name, T& field) {
-  auto found = json.find(name);
-  if (found == json.end()) return;
-  try {
-    field = found->get<T>();
-  } catch (const nlohmann::json::exception& error) {
-    throw std::invalid_argument(std::string("PpoConfig JSON: member \"") + name +
-                                "\" has the wrong type: " + error.what());
-  }
+  trainer::read_member(json, name, field, "PpoConfig");
 }
-
-void require_known_members(const nlohmann::json& json, const std::vector<std::string>& known,
-                           const char* what) {
-  if (!json.is_object()) {
-    throw std::invalid_argument(std::string(what) + " JSON must be an object, got " +
-                                json.type_name());
-  }
-  for (const auto& item : json.items()) {
-    bool ok = false;
-    for (const std::string& name : known) ok = ok || item.key() == name;
-    if (!ok) {
-      std::string list;
-      for (const std::string& name : known) list += (list.empty() ? "" : ", ") + name;
-      throw std::invalid_argument(std::string(what) + " JSON: unknown member \"" + item.key() +
-                                  "\"; known: " + list);
-    }
-  }
-}
+using trainer::require_known_members;
 
 }  // namespace
 

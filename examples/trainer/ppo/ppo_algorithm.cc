@@ -134,7 +134,9 @@ json PpoAlgorithmFactory::parse_config(const std::string& text) const {
   return json::parse(config_to_json(config_from_json(text)));
 }
 
-int PpoAlgorithmFactory::set_threads(int requested) const {
+int PpoAlgorithmFactory::set_threads(int requested) const { return set_torch_threads(requested); }
+
+int set_torch_threads(int requested) {
   if (requested == 0 && std::getenv("OMP_NUM_THREADS") != nullptr) return torch::get_num_threads();
   int threads = requested;
   if (threads == 0) {

@@ -58,14 +58,17 @@ class PpoAlgorithm final : public trainer::Algorithm {
   PpoActor actor_;
 };
 
+/// Sets LibTorch's intra-op threads: `requested`, or when 0 one per core this process may run on
+/// (sched_getaffinity); OMP_NUM_THREADS, when set, wins over that default (not over
+/// `requested`). Returns the count in use.
+int set_torch_threads(int requested);
+
 /// PPO's AlgorithmFactory: name "ppo", the config a PpoConfig (to_json / from_json).
 class PpoAlgorithmFactory final : public trainer::AlgorithmFactory {
  public:
   std::string name() const override { return "ppo"; }
   nlohmann::json parse_config(const std::string& text) const override;
-  /// LibTorch's intra-op threads: `requested`, or when 0 one per core this process may run on
-  /// (sched_getaffinity); OMP_NUM_THREADS, when set, wins over that default (not over
-  /// `requested`).
+  /// set_torch_threads.
   int set_threads(int requested) const override;
   std::unique_ptr<trainer::Algorithm> make(vector::VectorEnv& env,
                                            const nlohmann::json& config) const override;

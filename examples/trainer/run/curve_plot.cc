@@ -117,7 +117,8 @@ std::vector<std::pair<std::size_t, std::size_t>> finite_runs(const Series& serie
 }
 
 // The +/- std band: a polygon per run (a bar for a lone row); a NaN std counts as 0.
-void draw_band(cv::Mat& image, const Panel& panel, const Series& series) {
+void draw_band(cv::Mat& image, const Panel& panel, const Series& series,
+               const cv::Scalar& colour = kBand) {
   const auto spread = [&](std::size_t i) { return finite(series.std[i]) ? series.std[i] : 0.0; };
   for (const auto& [begin, end] : finite_runs(series)) {
     std::vector<cv::Point> outline;
@@ -128,23 +129,25 @@ void draw_band(cv::Mat& image, const Panel& panel, const Series& series) {
       outline.push_back(panel.point(series.x[i], series.mean[i] - spread(i)));
     }
     if (end - begin >= 2) {
-      cv::fillPoly(image, std::vector<std::vector<cv::Point>>{outline}, kBand, cv::LINE_AA, kShift);
+      cv::fillPoly(image, std::vector<std::vector<cv::Point>>{outline}, colour, cv::LINE_AA,
+                   kShift);
     } else if (spread(begin) > 0.0) {
-      cv::line(image, outline[0], outline[1], kBand, 7, cv::LINE_AA, kShift);
+      cv::line(image, outline[0], outline[1], colour, 7, cv::LINE_AA, kShift);
     }
   }
 }
 
 // The mean: a line per run, a dot for a lone row.
-void draw_mean(cv::Mat& image, const Panel& panel, const Series& series) {
+void draw_mean(cv::Mat& image, const Panel& panel, const Series& series,
+               const cv::Scalar& colour = kMean) {
   for (const auto& [begin, end] : finite_runs(series)) {
     for (std::size_t i = begin + 1; i < end; ++i) {
       cv::line(image, panel.point(series.x[i - 1], series.mean[i - 1]),
-               panel.point(series.x[i], series.mean[i]), kMean, 2, cv::LINE_AA, kShift);
+               panel.point(series.x[i], series.mean[i]), colour, 2, cv::LINE_AA, kShift);
     }
     if (end - begin == 1) {
       cv::circle(image, panel.point(series.x[begin], series.mean[begin]),
-                 static_cast<int>(3 * kSubPixel), kMean, cv::FILLED, cv::LINE_AA, kShift);
+                 static_cast<int>(3 * kSubPixel), colour, cv::FILLED, cv::LINE_AA, kShift);
     }
   }
 }
@@ -323,6 +326,114 @@ render::Image draw_curve(const ProgressTable& progress, const CurvePlotOptions& 
     }
   }
 
+  cv::Mat rgb;
+  cv::cvtColor(image, rgb, cv::COLOR_BGR2RGB);
+  render::Image result;
+  result.height = rgb.rows;
+  result.width = rgb.cols;
+  result.channels = 3;
+  result.pixels.assign(rgb.data, rgb.data + rgb.total() * rgb.elemSize());
+  return result;
+}
+
+render::Image draw_comparison(const std::vector<ComparedCurve>& curves,
+                              const CurvePlotOptions& options) {
+  if (options.width < 400 || options.height < 250) {
+    throw std::invalid_argument("draw_comparison: expected a size of at least 400x250, got " +
+                                std::to_string(options.width) + "x" +
+                                std::to_string(options.height));
+  }
+  // Distinct colours (BGR), one per curve in order, repeating past the tenth.
+  const std::vector<cv::Scalar> colours = {
+      {180, 100, 25}, {14, 127, 255},  {44, 160, 44},   {40, 39, 214},  {189, 103, 148},
+      {75, 86, 140},  {194, 119, 227}, {127, 127, 127}, {34, 189, 188}, {207, 190, 23}};
+  for (const ComparedCurve& curve : curves) {
+    if (curve.x.size() != curve.wall_minutes.size() || curve.x.size() != curve.mean.size() ||
+        curve.x.size() != curve.std.size()) {
+      throw std::invalid_argument("draw_comparison: curve \"" + curve.label +
+                                  "\" has columns of different lengths");
+    }
+  }
+  cv::Mat image(options.height, options.width, CV_8UC3, kBackground);
+  int baseline = 0;
+  const int title_height = text_size("Ag", kTitleScale, 1, &baseline).height;
+  const int title_y = 10 + title_height;
+  put_text(image, options.title, options.width / 2, title_y, kTitleScale, kText, Align::kCentre);
+
+  double y_low = INFINITY;
+  double y_high = -INFINITY;
+  for (const ComparedCurve& curve : curves) {
+    for (std::size_t i = 0; i < curve.mean.size(); ++i) {
+      if (!finite(curve.mean[i])) continue;
+      const double s = finite(curve.std[i]) ? curve.std[i] : 0.0;
+      y_low = std::min(y_low, curve.mean[i] - s);
+      y_high = std::max(y_high, curve.mean[i] + s);
+    }
+  }
+  if (!finite(y_low)) {
+    y_low = 0.0;
+    y_high = 1.0;
+  }
+  const AxisTicks y_axis = nice_axis(y_low, y_high, 5);
+  const double y_magnitude = std::max(std::abs(y_axis.low), std::abs(y_axis.high));
+
+  // The legend: rows of (colour, label) under the title.
+  int legend_y = title_y + 22;
+  int legend_x = 16;
+  for (std::size_t c = 0; c < curves.size(); ++c) {
+    const int width = 30 + text_size(curves[c].label, kTickScale, 1, &baseline).width + 18;
+    if (legend_x + width > options.width - 16 && legend_x > 16) {
+      legend_x = 16;
+      legend_y += 18;
+    }
+    const cv::Scalar& colour = colours[c % colours.size()];
+    cv::line(image, {legend_x, legend_y - 4}, {legend_x + 24, legend_y - 4}, colour, 2,
+             cv::LINE_AA);
+    put_text(image, curves[c].label, legend_x + 30, legend_y, kTickScale, kText, Align::kLeft);
+    legend_x += width;
+  }
+
+  int tick_baseline = 0;
+  const int y_label_width = std::max(
+      text_size(format_tick(y_axis.low, y_axis.step, y_magnitude), kTickScale, 1, &tick_baseline)
+          .width,
+      text_size(format_tick(y_axis.high, y_axis.step, y_magnitude), kTickScale, 1, &tick_baseline)
+          .width);
+  const int left_margin = y_label_width + 16;
+  const int top = legend_y + 34;
+  const int bottom_margin = 52;
+  const int gap = 30;
+  const int right_margin = 24;
+  const int panel_width = (options.width - 2 * left_margin - gap - right_margin) / 2;
+  const int panel_height = options.height - top - bottom_margin;
+  if (panel_height < 60) {
+    throw std::invalid_argument("draw_comparison: too many curves for a height of " +
+                                std::to_string(options.height));
+  }
+  for (int p = 0; p < 2; ++p) {
+    double x_high = 0.0;
+    for (const ComparedCurve& curve : curves) {
+      for (const double value : p == 0 ? curve.x : curve.wall_minutes) {
+        if (finite(value)) x_high = std::max(x_high, value);
+      }
+    }
+    if (x_high <= 0.0) x_high = 1.0;
+    Panel panel;
+    panel.area = cv::Rect(left_margin + p * (panel_width + gap + left_margin), top, panel_width,
+                          panel_height);
+    panel.x_axis = nice_axis(0.0, x_high, 5);
+    panel.y_axis = y_axis;
+    panel.x_label = p == 0 ? options.x_label : "wall time (min)";
+    panel.x_magnitude = panel.x_axis.high;
+    panel.y_magnitude = y_magnitude;
+    draw_axes(image, panel);
+    for (std::size_t c = 0; c < curves.size(); ++c) {
+      const ComparedCurve& curve = curves[c];
+      const Series series{p == 0 ? curve.x : curve.wall_minutes, curve.mean, curve.std};
+      draw_mean(image, panel, series, colours[c % colours.size()]);
+    }
+    cv::rectangle(image, panel.area, kAxis, 1);
+  }
   cv::Mat rgb;
   cv::cvtColor(image, rgb, cv::COLOR_BGR2RGB);
   render::Image result;

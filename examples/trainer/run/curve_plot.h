@@ -15,7 +15,25 @@ struct CurvePlotOptions {
   std::string title;  // drawn centred at the top, e.g. "CartPoleBalance-v0  runs/demo"
   int width = 900;    // pixels, at least 400
   int height = 450;   // pixels, at least 250
+  /// draw_comparison: the left panel's x axis.
+  std::string x_label = "control steps";
 };
+
+/// One run's curve in a comparison: y against x (e.g. control steps) and against wall minutes.
+struct ComparedCurve {
+  std::string label;
+  std::vector<double> x;
+  std::vector<double> wall_minutes;
+  std::vector<double> mean;
+  std::vector<double> std;  // unused by the drawing (lines only), kept for the caller's tables
+};
+
+/// Curves of several runs in two panels, y against x and against wall minutes, one colour per
+/// curve with a legend of their labels. Non-finite values leave gaps. Throws
+/// std::invalid_argument for a size below 400x250, a curve whose columns differ in length, or
+/// a legend that leaves no room for the panels.
+render::Image draw_comparison(const std::vector<ComparedCurve>& curves,
+                              const CurvePlotOptions& options);
 
 /// The range and tick marks of one plot axis: ticks at multiples of `step` (1, 2 or 5 times a
 /// power of ten) from `low` to `high`, which are themselves multiples of `step`.

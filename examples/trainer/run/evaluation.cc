@@ -54,10 +54,16 @@ std::pair<LoadedCheckpoint, fs::path> find_checkpoint(const fs::path& run_or_che
 
 // The settings `checkpoint` carries (a checkpoint file copied anywhere evaluates), else its run
 // folder's config.json.
-RunSettings checkpoint_settings(const LoadedCheckpoint& checkpoint, const fs::path& folder,
-                                const AlgorithmFactory& algorithm) {
+// The run's settings and its algorithm.
+std::pair<RunSettings, const AlgorithmFactory*> checkpoint_settings(
+    const LoadedCheckpoint& checkpoint, const fs::path& folder,
+    const AlgorithmFactories& algorithms) {
+  const auto read = [&](const json& config, const fs::path& where) {
+    const AlgorithmFactory& algorithm = algorithm_of(config, where, algorithms);
+    return std::make_pair(settings_from_json(config, where, algorithm), &algorithm);
+  };
   if (const auto embedded = checkpoint.blobs.find("config"); embedded != checkpoint.blobs.end()) {
-    return settings_from_json(json::parse(embedded->second), checkpoint.path, algorithm);
+    return read(json::parse(embedded->second), checkpoint.path);
   }
   std::ifstream config_file(folder / "config.json");
   if (!config_file) {
@@ -66,7 +72,7 @@ RunSettings checkpoint_settings(const LoadedCheckpoint& checkpoint, const fs::pa
                              "in " +
                              folder.string() + " (the run folder it belongs to)");
   }
-  return settings_from_json(json::parse(config_file), folder / "config.json", algorithm);
+  return read(json::parse(config_file), folder / "config.json");
 }
 
 }  // namespace
@@ -120,13 +126,14 @@ json evaluation_json(const PolicyEvaluation& evaluation, const EvaluationRequest
   return out;
 }
 
-CheckpointEvaluation evaluate_checkpoint(const AlgorithmFactory& algorithm,
+CheckpointEvaluation evaluate_checkpoint(const AlgorithmFactories& algorithms,
                                          const EnvKwargsParser& parse_sets,
                                          const fs::path& run_or_checkpoint,
                                          const EvaluationRequest& request, std::ostream& errors) {
   const auto [checkpoint, folder] = find_checkpoint(run_or_checkpoint, errors);
-  CheckpointEvaluation result{
-      checkpoint.path, checkpoint_settings(checkpoint, folder, algorithm), {}};
+  auto [settings, found] = checkpoint_settings(checkpoint, folder, algorithms);
+  const AlgorithmFactory& algorithm = *found;
+  CheckpointEvaluation result{checkpoint.path, std::move(settings), {}};
   algorithm.set_threads(result.settings.torch_threads);
   // The spaces come from one env built as the run's.
   std::unique_ptr<Env> probe = make_run_env(result.settings, parse_sets);

@@ -46,7 +46,8 @@ nlohmann::json evaluation_json(const PolicyEvaluation& evaluation,
 /// A checkpoint's evaluation.
 struct CheckpointEvaluation {
   std::filesystem::path checkpoint;  // the file evaluated
-  RunSettings settings;              // the run's, which built the env
+  RunSettings settings;              // the run's, which built the env (settings.algorithm: its
+                                     // algorithm's name)
   PolicyEvaluation evaluation;
 };
 
@@ -56,8 +57,9 @@ struct CheckpointEvaluation {
 /// blob, else from config.json beside it; the algorithm computes with the run's thread count
 /// (a float sum over another count can round differently, and the returns would then differ from
 /// the run's summary.json). Throws std::runtime_error when there is no valid checkpoint, the
-/// file is not a valid checkpoint (read_checkpoint), or the settings are nowhere to be found.
-CheckpointEvaluation evaluate_checkpoint(const AlgorithmFactory& algorithm,
+/// file is not a valid checkpoint (read_checkpoint), or the settings are nowhere to be found or
+/// name none of `algorithms` (algorithm_of).
+CheckpointEvaluation evaluate_checkpoint(const AlgorithmFactories& algorithms,
                                          const EnvKwargsParser& parse_sets,
                                          const std::filesystem::path& run_or_checkpoint,
                                          const EvaluationRequest& request, std::ostream& errors);

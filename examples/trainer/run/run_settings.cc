@@ -31,6 +31,8 @@ json settings_to_json(const RunSettings& settings) {
   out["keep_checkpoints"] = settings.keep_checkpoints;
   out["minutes"] = settings.minutes;
   out["eval_episodes"] = settings.eval_episodes;
+  out["eval_every"] = settings.eval_every;
+  out["eval_every_episodes"] = settings.eval_every_episodes;
   out[settings.algorithm] = settings.algorithm_config;
   return out;
 }
@@ -49,12 +51,26 @@ RunSettings settings_from_json(const json& in, const std::filesystem::path& wher
         in.contains("keep_checkpoints") ? in.at("keep_checkpoints").get<std::int64_t>() : 0;
     settings.minutes = in.at("minutes").get<double>();
     settings.eval_episodes = in.at("eval_episodes").get<std::int64_t>();
+    settings.eval_every = in.value("eval_every", std::int64_t{0});
+    settings.eval_every_episodes = in.value("eval_every_episodes", std::int64_t{5});
     settings.algorithm = algorithm.name();
     settings.algorithm_config = algorithm.parse_config(in.at(settings.algorithm).dump());
     return settings;
   } catch (const json::exception& e) {
     throw std::runtime_error(where.string() + ": not a pixelgym train config: " + e.what());
   }
+}
+
+const AlgorithmFactory& algorithm_of(const json& in, const std::filesystem::path& where,
+                                     const AlgorithmFactories& algorithms) {
+  std::string names;
+  for (const AlgorithmFactory* algorithm : algorithms) {
+    if (in.is_object() && in.contains(algorithm->name())) return *algorithm;
+    names += (names.empty() ? "\"" : ", \"") + algorithm->name() + "\"";
+  }
+  throw std::runtime_error(where.string() +
+                           ": not a pixelgym train config: no member names an algorithm (" + names +
+                           ")");
 }
 
 std::unique_ptr<vector::VectorEnv> make_training_env(const RunSettings& settings,

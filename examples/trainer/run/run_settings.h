@@ -34,6 +34,10 @@ struct RunSettings {
   std::int64_t keep_checkpoints = 3;   // the newest kept, 0: all
   double minutes = 0.0;                // the run's first wall-time budget; 0: no time limit
   std::int64_t eval_episodes = 5;      // episodes of the final evaluation
+  /// Evaluations during training (eval.csv): every eval_every env steps (0: none), over
+  /// eval_every_episodes episodes each.
+  std::int64_t eval_every = 0;
+  std::int64_t eval_every_episodes = 5;
   /// The algorithm's name (AlgorithmFactory::name) and its config (AlgorithmFactory::
   /// parse_config: every member present, "seed", "num_envs" and "total_env_steps" among them).
   std::string algorithm;
@@ -50,10 +54,20 @@ nlohmann::json settings_to_json(const RunSettings& settings);
 
 /// The settings of config.json's object `in` (read from `where`) for `algorithm`: its config
 /// is the member algorithm.name(), read by algorithm.parse_config. Absent "torch_threads": 0;
-/// absent "keep_checkpoints": 0 (keep all). Throws std::runtime_error "{where}: not a pixelgym
-/// train config: ..." for a missing or ill-typed member, and what parse_config throws.
+/// absent "keep_checkpoints": 0 (keep all); absent "eval_every": 0 (none). Throws
+/// std::runtime_error "{where}: not a pixelgym train config: ..." for a missing or ill-typed
+/// member, and what parse_config throws.
 RunSettings settings_from_json(const nlohmann::json& in, const std::filesystem::path& where,
                                const AlgorithmFactory& algorithm);
+
+/// The algorithms a run may use, by AlgorithmFactory::name.
+using AlgorithmFactories = std::vector<const AlgorithmFactory*>;
+
+/// The algorithm of config.json's object `in` (read from `where`): the one of `algorithms` whose
+/// name is a member of it. Throws std::runtime_error "{where}: not a pixelgym train config: ..."
+/// naming the known algorithms when none is.
+const AlgorithmFactory& algorithm_of(const nlohmann::json& in, const std::filesystem::path& where,
+                                     const AlgorithmFactories& algorithms);
 
 /// The training env: num_envs() copies of the run's env in an AsyncVectorEnv on num_threads
 /// threads, SameStep autoreset.

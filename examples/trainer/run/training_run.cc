@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "examples/trainer/run/atomic_file.h"
 #include "examples/trainer/run/evaluation.h"
 
 namespace pixelgym::trainer {
@@ -66,6 +67,8 @@ void check_resume_settings(const ResumeChecks& given, const RunSettings& run,
   check("--checkpoint-every", given.checkpoint_every, run.checkpoint_every);
   check("--keep-checkpoints", given.keep_checkpoints, run.keep_checkpoints);
   check("--eval-episodes", given.eval_episodes, run.eval_episodes);
+  check("--eval-every", given.eval_every, run.eval_every);
+  check("--eval-every-episodes", given.eval_every_episodes, run.eval_every_episodes);
   if (!differ.empty()) {
     throw RunRequestError("train --resume continues with the settings in " + folder.string() +
                           "/config.json, and these differ from them: " + differ +
@@ -73,7 +76,48 @@ void check_resume_settings(const ResumeChecks& given, const RunSettings& run,
   }
 }
 
+const char* const kEvalHeader = "steps,wall_time_s,return_mean,return_std,episodes,eval_s";
+
 }  // namespace
+
+std::string format_eval_csv(const std::vector<EvalRow>& rows) {
+  std::ostringstream out;
+  out << kEvalHeader << "\n" << std::setprecision(17);
+  for (const EvalRow& row : rows) {
+    out << row.steps << "," << row.wall_time_s << "," << row.return_mean << "," << row.return_std
+        << "," << row.episodes << "," << row.eval_s << "\n";
+  }
+  return out.str();
+}
+
+std::vector<EvalRow> parse_eval_csv(const std::string& text, const std::string& source) {
+  std::istringstream in(text);
+  std::string line;
+  std::vector<EvalRow> rows;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    const auto fail = [&](const std::string& what) {
+      throw std::runtime_error(source + ": line " + std::to_string(number) + ": " + what);
+    };
+    if (number == 1) {
+      if (line != kEvalHeader) fail(std::string("expected the header \"") + kEvalHeader + "\"");
+      continue;
+    }
+    std::istringstream fields(line);
+    EvalRow row;
+    char c1 = 0, c2 = 0, c3 = 0, c4 = 0, c5 = 0;
+    fields >> row.steps >> c1 >> row.wall_time_s >> c2 >> row.return_mean >> c3 >> row.return_std >>
+        c4 >> row.episodes >> c5 >> row.eval_s;
+    if (!fields || c1 != ',' || c2 != ',' || c3 != ',' || c4 != ',' || c5 != ',' ||
+        !(fields >> std::ws).eof()) {
+      fail("expected six numbers separated by commas, got \"" + line + "\"");
+    }
+    rows.push_back(row);
+  }
+  if (number == 0) throw std::runtime_error(source + ": empty (no header)");
+  return rows;
+}
 
 TrainingRun::TrainingRun(const AlgorithmFactory& algorithm, EnvKwargsParser parse_sets,
                          RunSettings settings, fs::path folder, RunOutput output)
@@ -202,6 +246,13 @@ void TrainingRun::restore_from_checkpoint() {
   json budget = {{"total_env_steps", settings_.total_env_steps()}, {"minutes", budget_minutes_}};
   if (minutes_given_ > 0.0) budget["minutes_given"] = minutes_given_;
   run_.emplace(RunFolder::resume(folder_, algorithm_->env_steps(), budget));
+  if (fs::exists(folder_ / "eval.csv")) {
+    for (const EvalRow& row :
+         parse_eval_csv(read_whole_file(folder_ / "eval.csv", "train --resume"),
+                        (folder_ / "eval.csv").string())) {
+      if (row.steps <= algorithm_->env_steps()) evals_.push_back(row);
+    }
+  }
   output_.out << "resuming " << folder_.string() << " from "
               << checkpoint_->path.filename().string() << " (" << algorithm_->env_steps()
               << " env steps, " << algorithm_->updates() << " updates)\n"
@@ -222,7 +273,8 @@ void TrainingRun::replay_env_actions() {
   algorithm_->replay_env(actions->second);
   output_.out << "replayed the " << algorithm_->env_steps() << " env steps of the checkpoint in "
               << std::fixed << std::setprecision(1) << seconds_since(replay_start)
-              << std::defaultfloat << " s: the envs continue their episodes\n";
+              << std::defaultfloat << std::setprecision(6)
+              << " s: the envs continue their episodes\n";
   // Absent or 0 (a checkpoint taken before the envs were first reset): nothing to compare.
   const std::uint64_t digest = meta_.value("env_digest", std::uint64_t{0});
   if (digest != 0 && digest != algorithm_->env_digest()) {
@@ -252,8 +304,10 @@ void TrainingRun::train_until_spent() {
   while (algorithm_->env_steps() < total_steps &&
          (time_limit_s <= 0.0 || one_update_due || elapsed_s() < time_limit_s)) {
     one_update_due = false;
+    const std::int64_t steps_before = algorithm_->env_steps();
     const ProgressRow row = iterate_once();
     run_->write_curve(title);
+    evaluate_when_due(steps_before);
     if (algorithm_->updates() % settings_.checkpoint_every == 0) save_checkpoint();
     status = {algorithm_->env_steps(), total_steps, elapsed_s(), time_limit_s, row.fps,
               row.episode_return_mean};
@@ -285,6 +339,43 @@ ProgressRow TrainingRun::iterate_once() {
   row.extra = std::move(stats.extra);
   run_->append_progress(row);
   return row;
+}
+
+void TrainingRun::evaluate_when_due(std::int64_t steps_before) {
+  const std::int64_t every = settings_.eval_every;
+  const std::int64_t steps = algorithm_->env_steps();
+  if (every <= 0 || steps / every == steps_before / every) return;
+  const double this_process_s = seconds_since(start_);
+  const auto seconds = [](double s) {
+    std::ostringstream text;
+    text << std::fixed << std::setprecision(1) << s;
+    return text.str();
+  };
+  if (eval_seconds_ > 0.1 * this_process_s) {
+    output_.out << "eval at " << steps << " env steps skipped: evaluations took "
+                << seconds(eval_seconds_) << " s of " << seconds(this_process_s)
+                << " s, more than a tenth\n";
+    return;
+  }
+  const auto eval_start = std::chrono::steady_clock::now();
+  const EvaluationRequest request{settings_.eval_every_episodes,
+                                  settings_.seed() + kEvaluationSeedOffset, false, std::nullopt};
+  const PolicyEvaluation evaluation =
+      evaluate(algorithm_->actor(), settings_, parse_sets_, request);
+  EvalRow row;
+  row.steps = steps;
+  row.wall_time_s = elapsed_s();
+  row.return_mean = evaluation.mean;
+  row.return_std = evaluation.std;
+  row.episodes = settings_.eval_every_episodes;
+  row.eval_s = seconds_since(eval_start);
+  eval_seconds_ += row.eval_s;
+  evals_.push_back(row);
+  const std::string text = format_eval_csv(evals_);
+  write_file_atomically(run_->path() / "eval.csv", {text}, "train");
+  output_.out << "eval at " << steps << " env steps: return " << evaluation.mean << " +/- "
+              << evaluation.std << " over " << row.episodes << " episodes (" << seconds(row.eval_s)
+              << " s)\n";
 }
 
 void TrainingRun::save_checkpoint() {

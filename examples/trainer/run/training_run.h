@@ -11,6 +11,8 @@
 #include <optional>
 #include <ostream>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "examples/trainer/run/algorithm.h"
 #include "examples/trainer/run/checkpoint_file.h"
@@ -47,7 +49,25 @@ struct ResumeChecks {
   std::optional<std::int64_t> checkpoint_every;
   std::optional<std::int64_t> keep_checkpoints;
   std::optional<std::int64_t> eval_episodes;
+  std::optional<std::int64_t> eval_every;
+  std::optional<std::int64_t> eval_every_episodes;
 };
+
+/// One evaluation during training (a row of eval.csv).
+struct EvalRow {
+  std::int64_t steps = 0;    // env steps when it ran
+  double wall_time_s = 0.0;  // the run's wall time then (before the evaluation)
+  double return_mean = 0.0;
+  double return_std = 0.0;
+  std::int64_t episodes = 0;
+  double eval_s = 0.0;  // the evaluation's own wall time
+};
+
+/// eval.csv's text for `rows` (a header line, then one line per row).
+std::string format_eval_csv(const std::vector<EvalRow>& rows);
+/// Parses eval.csv text (from `source`). Throws std::runtime_error "{source}: line N: ..." for
+/// a line that is not a row of six numbers or a header that is not format_eval_csv's.
+std::vector<EvalRow> parse_eval_csv(const std::string& text, const std::string& source);
 
 /// Where a run reports: messages and the progress line to `out`, skipped checkpoints to `errors`.
 struct RunOutput {
@@ -66,6 +86,12 @@ struct RunOutput {
 /// keep_checkpoints. A resumed run restores the algorithm from the latest valid checkpoint and
 /// replays the checkpoint's env actions, so that the envs continue their episodes: with the
 /// same total_env_steps the result is the run that did not stop.
+///
+/// Evaluations during training: once the env steps pass each multiple of eval_every, the policy
+/// plays eval_every_episodes deterministic seeded episodes (the final evaluation's seeds) and a
+/// row goes to eval.csv (rewritten atomically; a resume drops the rows after its checkpoint).
+/// An evaluation is skipped when those of this process have taken a tenth of its wall time, so
+/// that they never take more.
 class TrainingRun {
  public:
   /// A new run of `settings` (settings.algorithm_config as algorithm.parse_config gives it) in
@@ -113,6 +139,8 @@ class TrainingRun {
   void train_until_spent();
   // One iterate() and its progress.csv row; returns the row.
   ProgressRow iterate_once();
+  // An evaluation when the steps since `steps_before` passed a multiple of eval_every.
+  void evaluate_when_due(std::int64_t steps_before);
   void save_checkpoint();
   nlohmann::json evaluate_and_summarize();
   double elapsed_s() const;
@@ -133,6 +161,8 @@ class TrainingRun {
   std::unique_ptr<Algorithm> algorithm_;
   std::optional<RunFolder> run_;
   std::deque<double> returns_;  // the latest episodes' returns (kReturnWindow at most)
+  std::vector<EvalRow> evals_;  // eval.csv's rows
+  double eval_seconds_ = 0.0;   // spent in evaluations during training by this process
   std::chrono::steady_clock::time_point start_;
 };
 

@@ -1,0 +1,671 @@
+#include "examples/trainer/drqv2/drqv2.h"
+
+#include <ATen/autocast_mode.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+#include "envs/spaces/box.h"
+#include "envs/spaces/dict.h"
+#include "examples/trainer/ppo/policy.h"
+#include "examples/trainer/run/config_members.h"
+
+namespace pixelgym::drqv2 {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+constexpr const char* kConfigName = "DrqV2Config";
+
+template <typename T>
+void read_member(const nlohmann::json& json, const char* name, T& field) {
+  trainer::read_member(json, name, field, kConfigName);
+}
+
+// Bfloat16 autocast of the CPU's convolutions for the scope of the guard (when `on`).
+class CpuAutocast {
+ public:
+  explicit CpuAutocast(bool on) : on_(on) {
+    if (!on_) return;
+    previous_ = at::autocast::is_cpu_enabled();
+    at::autocast::set_cpu_enabled(true);
+    at::autocast::set_autocast_cpu_dtype(at::kBFloat16);
+    at::autocast::increment_nesting();
+  }
+  ~CpuAutocast() {
+    if (!on_) return;
+    if (at::autocast::decrement_nesting() == 0) at::autocast::clear_cache();
+    at::autocast::set_cpu_enabled(previous_);
+  }
+  CpuAutocast(const CpuAutocast&) = delete;
+  CpuAutocast& operator=(const CpuAutocast&) = delete;
+
+ private:
+  bool on_;
+  bool previous_ = false;
+};
+
+void orthogonal_init(torch::nn::Module& module, double gain) {
+  for (auto& child : module.modules(/*include_self=*/true)) {
+    if (auto* linear = child->as<torch::nn::Linear>()) {
+      torch::nn::init::orthogonal_(linear->weight, gain);
+      torch::nn::init::zeros_(linear->bias);
+    } else if (auto* conv = child->as<torch::nn::Conv2d>()) {
+      torch::nn::init::orthogonal_(conv->weight, gain);
+      torch::nn::init::zeros_(conv->bias);
+    }
+  }
+}
+
+torch::nn::Sequential make_trunk(std::int64_t in, std::int64_t features) {
+  torch::nn::Sequential trunk(torch::nn::Linear(in, features),
+                              torch::nn::LayerNorm(torch::nn::LayerNormOptions({features})),
+                              torch::nn::Tanh());
+  orthogonal_init(*trunk, 1.0);
+  return trunk;
+}
+
+torch::nn::Sequential make_mlp(std::int64_t in, std::int64_t hidden, std::int64_t out) {
+  torch::nn::Sequential mlp(torch::nn::Linear(in, hidden), torch::nn::ReLU(),
+                            torch::nn::Linear(hidden, hidden), torch::nn::ReLU(),
+                            torch::nn::Linear(hidden, out));
+  orthogonal_init(*mlp, std::sqrt(2.0));
+  return mlp;
+}
+
+std::string shape_text(const Shape& shape) {
+  std::string text = "(";
+  for (std::size_t i = 0; i < shape.size(); ++i) {
+    text += (i ? ", " : "") + std::to_string(shape[i]);
+  }
+  return text + (shape.size() == 1 ? ",)" : ")");
+}
+
+}  // namespace
+
+const char* to_string(EncoderArchitecture architecture) {
+  switch (architecture) {
+    case EncoderArchitecture::kDrqV2:
+      return "drqv2";
+    case EncoderArchitecture::kMrq:
+      return "mrq";
+  }
+  return "?";
+}
+
+EncoderArchitecture parse_encoder_architecture(const std::string& name) {
+  if (name == "drqv2") return EncoderArchitecture::kDrqV2;
+  if (name == "mrq") return EncoderArchitecture::kMrq;
+  throw std::invalid_argument("unknown encoder \"" + name + "\"; known: drqv2, mrq");
+}
+
+void DrqV2Config::validate() const {
+  const auto fail = [](const std::string& what) {
+    throw std::invalid_argument(std::string(kConfigName) + ": " + what);
+  };
+  const auto at_least = [&](const char* name, std::int64_t value, std::int64_t minimum) {
+    if (value < minimum) {
+      fail(std::string(name) + " must be at least " + std::to_string(minimum) + ", got " +
+           std::to_string(value));
+    }
+  };
+  const auto in_range = [&](const char* name, double value, double low, double high) {
+    if (!(value >= low && value <= high)) {
+      std::ostringstream message;
+      message << name << " must be in [" << low << ", " << high << "], got " << value;
+      fail(message.str());
+    }
+  };
+  at_least("num_envs", num_envs, 1);
+  at_least("total_env_steps", total_env_steps, 1);
+  at_least("iteration_env_steps", iteration_env_steps, 1);
+  if (iteration_env_steps % num_envs != 0) {
+    fail("iteration_env_steps must be a multiple of num_envs (" + std::to_string(num_envs) +
+         "), got " + std::to_string(iteration_env_steps));
+  }
+  at_least("frame_stack", frame_stack, 1);
+  at_least("batch_size", batch_size, 1);
+  at_least("n_step", n_step, 1);
+  at_least("replay_capacity", replay_capacity, num_envs * (n_step + frame_stack + 2));
+  in_range("gamma", gamma, 0.0, 1.0);
+  if (!(learning_rate > 0.0 && std::isfinite(learning_rate))) {
+    fail("learning_rate must be positive, got " + std::to_string(learning_rate));
+  }
+  in_range("critic_tau", critic_tau, 0.0, 1.0);
+  at_least("feature_dim", feature_dim, 1);
+  at_least("hidden_dim", hidden_dim, 1);
+  at_least("seed_env_steps", seed_env_steps, 0);
+  in_range("updates_per_env_step", updates_per_env_step, 0.0, 64.0);
+  in_range("noise_start", noise_start, 0.0, 10.0);
+  in_range("noise_end", noise_end, 0.0, 10.0);
+  at_least("noise_schedule_env_steps", noise_schedule_env_steps, 0);
+  in_range("noise_clip", noise_clip, 0.0, 10.0);
+  at_least("shift_pad", shift_pad, 0);
+}
+
+double DrqV2Config::noise_std(std::int64_t env_steps) const {
+  if (noise_schedule_env_steps == 0 || env_steps >= noise_schedule_env_steps) return noise_end;
+  const double progress =
+      static_cast<double>(env_steps) / static_cast<double>(noise_schedule_env_steps);
+  return noise_start + (noise_end - noise_start) * progress;
+}
+
+void to_json(nlohmann::json& json, const DrqV2Config& config) {
+  json = {{"seed", config.seed},
+          {"num_envs", config.num_envs},
+          {"total_env_steps", config.total_env_steps},
+          {"iteration_env_steps", config.iteration_env_steps},
+          {"frame_stack", config.frame_stack},
+          {"replay_capacity", config.replay_capacity},
+          {"batch_size", config.batch_size},
+          {"n_step", config.n_step},
+          {"gamma", config.gamma},
+          {"learning_rate", config.learning_rate},
+          {"critic_tau", config.critic_tau},
+          {"encoder", to_string(config.encoder)},
+          {"feature_dim", config.feature_dim},
+          {"hidden_dim", config.hidden_dim},
+          {"seed_env_steps", config.seed_env_steps},
+          {"updates_per_env_step", config.updates_per_env_step},
+          {"noise_start", config.noise_start},
+          {"noise_end", config.noise_end},
+          {"noise_schedule_env_steps", config.noise_schedule_env_steps},
+          {"noise_clip", config.noise_clip},
+          {"shift_pad", config.shift_pad},
+          {"bfloat16", config.bfloat16},
+          {"channels_last", config.channels_last}};
+}
+
+void from_json(const nlohmann::json& json, DrqV2Config& config) {
+  nlohmann::json defaults;
+  to_json(defaults, DrqV2Config{});
+  std::vector<std::string> known;
+  for (const auto& item : defaults.items()) known.push_back(item.key());
+  trainer::require_known_members(json, known, kConfigName);
+  read_member(json, "seed", config.seed);
+  read_member(json, "num_envs", config.num_envs);
+  read_member(json, "total_env_steps", config.total_env_steps);
+  read_member(json, "iteration_env_steps", config.iteration_env_steps);
+  read_member(json, "frame_stack", config.frame_stack);
+  read_member(json, "replay_capacity", config.replay_capacity);
+  read_member(json, "batch_size", config.batch_size);
+  read_member(json, "n_step", config.n_step);
+  read_member(json, "gamma", config.gamma);
+  read_member(json, "learning_rate", config.learning_rate);
+  read_member(json, "critic_tau", config.critic_tau);
+  std::string encoder = to_string(config.encoder);
+  read_member(json, "encoder", encoder);
+  try {
+    config.encoder = parse_encoder_architecture(encoder);
+  } catch (const std::invalid_argument& error) {
+    throw std::invalid_argument(std::string(kConfigName) + ": member \"encoder\": " + error.what());
+  }
+  read_member(json, "feature_dim", config.feature_dim);
+  read_member(json, "hidden_dim", config.hidden_dim);
+  read_member(json, "seed_env_steps", config.seed_env_steps);
+  read_member(json, "updates_per_env_step", config.updates_per_env_step);
+  read_member(json, "noise_start", config.noise_start);
+  read_member(json, "noise_end", config.noise_end);
+  read_member(json, "noise_schedule_env_steps", config.noise_schedule_env_steps);
+  read_member(json, "noise_clip", config.noise_clip);
+  read_member(json, "shift_pad", config.shift_pad);
+  read_member(json, "bfloat16", config.bfloat16);
+  read_member(json, "channels_last", config.channels_last);
+  config.validate();
+}
+
+bool cpu_has_bfloat16() {
+  std::ifstream cpuinfo("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(cpuinfo, line)) {
+    if (line.rfind("flags", 0) != 0) continue;
+    std::istringstream flags(line);
+    std::string flag;
+    while (flags >> flag) {
+      if (flag == "avx512_bf16" || flag == "amx_bf16") return true;
+    }
+    return false;
+  }
+  return false;
+}
+
+ReplayLayout InputLayout::replay_layout() const {
+  ReplayLayout layout;
+  if (has_image) layout.images.push_back({image_key, stack, height * width * channels});
+  for (std::size_t v = 0; v < vector_keys.size(); ++v) {
+    layout.vectors.push_back({vector_keys[v], vector_sizes[v]});
+  }
+  layout.action_size = action_size;
+  return layout;
+}
+
+InputLayout input_layout(const Space& observation_space, const Space& action_space,
+                         std::int64_t frame_stack, const std::string& env_name) {
+  const std::string where = "drqv2 on " + env_name + ": ";
+  InputLayout input;
+  input.stack = frame_stack;
+  const auto* action_box = dynamic_cast<const spaces::Box*>(&action_space);
+  if (action_box == nullptr || !is_floating(*action_box->dtype())) {
+    throw std::invalid_argument(where +
+                                "the learner acts with continuous (float Box) actions; the "
+                                "action space is " +
+                                action_space.to_string());
+  }
+  input.action_size = static_cast<std::int64_t>(action_box->low().size());
+  for (std::size_t i = 0; i < action_box->low().size(); ++i) {
+    const double low = action_box->low()[i];
+    const double high = action_box->high()[i];
+    if (!std::isfinite(low) || !std::isfinite(high)) {
+      throw std::invalid_argument(where + "the action space must be bounded, got " +
+                                  action_space.to_string());
+    }
+    input.action_low.push_back(static_cast<float>(low));
+    input.action_high.push_back(static_cast<float>(high));
+  }
+  std::vector<std::pair<std::string, const Space*>> keys;
+  if (const auto* dict = dynamic_cast<const spaces::Dict*>(&observation_space)) {
+    for (const auto& [key, space] : dict->entries()) keys.emplace_back(key, space.get());
+  } else {
+    keys.emplace_back("", &observation_space);
+  }
+  for (const auto& [key, space] : keys) {
+    const std::string named = key.empty() ? "the observation" : "key \"" + key + "\"";
+    const auto* box = dynamic_cast<const spaces::Box*>(space);
+    if (box == nullptr) {
+      throw std::invalid_argument(where + named + " must be a Box, got " + space->to_string());
+    }
+    const Shape shape = *box->shape();
+    if (*box->dtype() == DType::kUInt8 && shape.size() >= 2) {
+      if (input.has_image) {
+        throw std::invalid_argument(where + "one image key is supported; " + named +
+                                    " is a second one");
+      }
+      // (stack, H, W[, C]) with a stack; (H, W[, C]) without.
+      const std::size_t first = frame_stack > 1 ? 1 : 0;
+      const bool fits = shape.size() == first + 2 || shape.size() == first + 3;
+      if (!fits || (frame_stack > 1 && shape[0] != frame_stack)) {
+        throw std::invalid_argument(
+            where + "image " + named + " has shape " + shape_text(shape) + "; with frame_stack " +
+            std::to_string(frame_stack) +
+            (frame_stack > 1 ? " it must be a stack of that many frames on a new leading axis, "
+                               "(stack, H, W) or (stack, H, W, C): add --wrap frame_stack=" +
+                                   std::to_string(frame_stack) + " (or set frame_stack 1)"
+                             : std::string(" it must be one frame, (H, W) or (H, W, C)")));
+      }
+      input.has_image = true;
+      input.image_key = key;
+      input.height = shape[first];
+      input.width = shape[first + 1];
+      input.channels = shape.size() == first + 3 ? shape[first + 2] : 1;
+      if (input.height < 16 || input.width < 16) {
+        throw std::invalid_argument(where + "image " + named + " of shape " + shape_text(shape) +
+                                    " is smaller than the encoder's least, 16x16");
+      }
+      continue;
+    }
+    if (*box->dtype() != DType::kFloat32) {
+      throw std::invalid_argument(
+          where + named + " must be a uint8 image or a float32 vector, got " + space->to_string());
+    }
+    std::int64_t size = 1;
+    for (const std::int64_t extent : shape) size *= extent;
+    input.vector_keys.push_back(key);
+    input.vector_sizes.push_back(size);
+  }
+  return input;
+}
+
+// ---- Agent -----------------------------------------------------------------------------------
+
+namespace {
+
+void copy_parameters(const torch::nn::Module& from, torch::nn::Module& to) {
+  torch::NoGradGuard no_grad;
+  const auto source = from.parameters();
+  auto destination = to.parameters();
+  for (std::size_t i = 0; i < source.size(); ++i) destination[i].copy_(source[i]);
+}
+
+void soft_update(const torch::nn::Module& from, torch::nn::Module& to, double tau) {
+  torch::NoGradGuard no_grad;
+  const auto source = from.parameters();
+  auto destination = to.parameters();
+  for (std::size_t i = 0; i < source.size(); ++i) destination[i].lerp_(source[i], tau);
+}
+
+}  // namespace
+
+Agent::Agent(InputLayout input, const DrqV2Config& config)
+    : input_(std::move(input)),
+      autocast_(config.bfloat16 && cpu_has_bfloat16()),
+      channels_last_(config.channels_last) {
+  std::int64_t image_features = 0;
+  if (input_.has_image) {
+    const std::vector<std::int64_t> strides = config.encoder == EncoderArchitecture::kDrqV2
+                                                  ? std::vector<std::int64_t>{2, 1, 1, 1}
+                                                  : std::vector<std::int64_t>{2, 2, 2, 1};
+    encoder = torch::nn::Sequential();
+    std::int64_t channels = input_.stack * input_.channels;
+    std::int64_t height = input_.height;
+    std::int64_t width = input_.width;
+    for (const std::int64_t stride : strides) {
+      encoder->push_back(
+          torch::nn::Conv2d(torch::nn::Conv2dOptions(channels, 32, 3).stride(stride)));
+      encoder->push_back(torch::nn::ReLU());
+      channels = 32;
+      height = (height - 3) / stride + 1;
+      width = (width - 3) / stride + 1;
+      if (height < 1 || width < 1) {
+        throw std::invalid_argument("drqv2: images of " + std::to_string(input_.height) + "x" +
+                                    std::to_string(input_.width) + " are too small for the " +
+                                    to_string(config.encoder) + " encoder");
+      }
+    }
+    encoder->push_back(torch::nn::Flatten());
+    orthogonal_init(*encoder, std::sqrt(2.0));
+    register_module("encoder", encoder);
+    image_features = channels * height * width;
+  }
+  std::int64_t vector_features = 0;
+  for (const std::int64_t size : input_.vector_sizes) vector_features += size;
+  feature_size_ = image_features + vector_features;
+  if (feature_size_ == 0) throw std::invalid_argument("drqv2: the observation has no input");
+  const std::int64_t features = config.feature_dim;
+  const std::int64_t actions = input_.action_size;
+  actor_trunk = register_module("actor_trunk", make_trunk(feature_size_, features));
+  actor_head = register_module("actor_head", make_mlp(features, config.hidden_dim, actions));
+  critic_trunk = register_module("critic_trunk", make_trunk(feature_size_, features));
+  q1 = register_module("q1", make_mlp(features + actions, config.hidden_dim, 1));
+  q2 = register_module("q2", make_mlp(features + actions, config.hidden_dim, 1));
+  target_trunk = register_module("target_trunk", make_trunk(feature_size_, features));
+  target_q1 = register_module("target_q1", make_mlp(features + actions, config.hidden_dim, 1));
+  target_q2 = register_module("target_q2", make_mlp(features + actions, config.hidden_dim, 1));
+  copy_parameters(*critic_trunk, *target_trunk);
+  copy_parameters(*q1, *target_q1);
+  copy_parameters(*q2, *target_q2);
+  for (auto* target : {&target_trunk, &target_q1, &target_q2}) {
+    for (auto& parameter : (*target)->parameters()) parameter.set_requires_grad(false);
+  }
+  low_ = register_buffer("action_low", torch::tensor(input_.action_low, torch::kFloat32));
+  high_ = register_buffer("action_high", torch::tensor(input_.action_high, torch::kFloat32));
+}
+
+torch::Tensor Agent::image_input(const torch::Tensor& images) const {
+  const std::int64_t batch = images.size(0);
+  const std::int64_t channels = input_.stack * input_.channels;
+  const torch::Tensor frames =
+      images.view({batch, input_.stack, input_.height, input_.width, input_.channels});
+  if (channels_last_) {
+    // (B, H, W, stack C) in memory: the channels-last layout of (B, stack C, H, W).
+    return frames.permute({0, 2, 3, 1, 4})
+        .reshape({batch, input_.height, input_.width, channels})
+        .to(torch::kFloat32)
+        .permute({0, 3, 1, 2});
+  }
+  return frames.permute({0, 1, 4, 2, 3})
+      .reshape({batch, channels, input_.height, input_.width})
+      .to(torch::kFloat32);
+}
+
+void shift_frames(const std::uint8_t* images, std::uint8_t* shifted, std::int64_t batch,
+                  std::int64_t frames, std::int64_t height, std::int64_t width,
+                  std::int64_t channels, std::int64_t pad, const std::int64_t* shifts) {
+  const std::int64_t row_bytes = width * channels;
+  const std::int64_t frame_bytes = height * row_bytes;
+  for (std::int64_t b = 0; b < batch; ++b) {
+    const std::int64_t dy = shifts[2 * b] - pad;
+    const std::int64_t dx = shifts[2 * b + 1] - pad;
+    // Output column x reads source column clamp(x + dx): the columns in range are one copy,
+    // the ones past an edge repeat the edge pixel.
+    const std::int64_t first = std::max<std::int64_t>(0, -dx);            // first x in range
+    const std::int64_t last = std::min<std::int64_t>(width, width - dx);  // one past the last
+    for (std::int64_t f = 0; f < frames; ++f) {
+      const std::uint8_t* source = images + (b * frames + f) * frame_bytes;
+      std::uint8_t* dest = shifted + (b * frames + f) * frame_bytes;
+      for (std::int64_t y = 0; y < height; ++y) {
+        const std::int64_t sy = std::clamp<std::int64_t>(y + dy, 0, height - 1);
+        const std::uint8_t* in = source + sy * row_bytes;
+        std::uint8_t* out = dest + y * row_bytes;
+        for (std::int64_t x = 0; x < first; ++x) {
+          std::memcpy(out + x * channels, in, static_cast<std::size_t>(channels));
+        }
+        std::memcpy(out + first * channels, in + (first + dx) * channels,
+                    static_cast<std::size_t>((last - first) * channels));
+        for (std::int64_t x = last; x < width; ++x) {
+          std::memcpy(out + x * channels, in + (width - 1) * channels,
+                      static_cast<std::size_t>(channels));
+        }
+      }
+    }
+  }
+}
+
+torch::Tensor Agent::encode(const torch::Tensor& images, const torch::Tensor& vectors) {
+  std::vector<torch::Tensor> parts;
+  if (input_.has_image) {
+    torch::Tensor x = images / 255.0 - 0.5;
+    if (channels_last_) x = x.contiguous(at::MemoryFormat::ChannelsLast);
+    torch::Tensor h;
+    {
+      const CpuAutocast autocast(autocast_);
+      h = encoder->forward(x);
+    }
+    parts.push_back(h.to(torch::kFloat32));
+  }
+  if (vectors.defined()) parts.push_back(vectors);
+  return parts.size() == 1 ? parts[0] : torch::cat(parts, 1);
+}
+
+torch::Tensor Agent::actor_mean(const torch::Tensor& features) {
+  return torch::tanh(actor_head->forward(actor_trunk->forward(features)));
+}
+
+std::pair<torch::Tensor, torch::Tensor> Agent::q_values(const torch::Tensor& features,
+                                                        const torch::Tensor& actions, bool target) {
+  const torch::Tensor h = (target ? target_trunk : critic_trunk)->forward(features);
+  const torch::Tensor input = torch::cat({h, actions}, 1);
+  return {(target ? target_q1 : q1)->forward(input).squeeze(1),
+          (target ? target_q2 : q2)->forward(input).squeeze(1)};
+}
+
+torch::Tensor Agent::env_action(const torch::Tensor& actions) const {
+  return low_ + (actions + 1.0) * 0.5 * (high_ - low_);
+}
+
+torch::Tensor Agent::unit_action(const torch::Tensor& env_actions) const {
+  return ((env_actions.to(torch::kFloat32) - low_) / (high_ - low_) * 2.0 - 1.0).clamp(-1.0, 1.0);
+}
+
+// ---- Learner ---------------------------------------------------------------------------------
+
+namespace {
+
+std::shared_ptr<Agent> make_agent(InputLayout input, const DrqV2Config& config) {
+  config.validate();
+  torch::manual_seed(config.seed);
+  return std::make_shared<Agent>(std::move(input), config);
+}
+
+std::vector<torch::Tensor> parameters_of(std::initializer_list<torch::nn::Module*> modules) {
+  std::vector<torch::Tensor> parameters;
+  for (torch::nn::Module* module : modules) {
+    for (auto& parameter : module->parameters()) parameters.push_back(parameter);
+  }
+  return parameters;
+}
+
+// A Tensor over a vector's memory (no copy): valid while the vector is not resized.
+template <typename T>
+torch::Tensor view_of(const std::vector<T>& values, std::vector<std::int64_t> shape,
+                      torch::ScalarType type) {
+  return torch::from_blob(const_cast<T*>(values.data()), shape, torch::TensorOptions(type));
+}
+
+torch::Tensor vectors_of(const std::vector<std::vector<float>>& vectors, const InputLayout& input,
+                         std::int64_t batch) {
+  if (vectors.empty()) return {};
+  std::vector<torch::Tensor> parts;
+  for (std::size_t v = 0; v < vectors.size(); ++v) {
+    parts.push_back(view_of(vectors[v], {batch, input.vector_sizes[v]}, torch::kFloat32));
+  }
+  return parts.size() == 1 ? parts[0] : torch::cat(parts, 1);
+}
+
+torch::Tensor clipped_noise(const torch::Tensor& like, double std, double clip,
+                            at::Generator& generator) {
+  return (torch::randn(like.sizes(), generator, like.options()) * std).clamp(-clip, clip);
+}
+
+}  // namespace
+
+Learner::Learner(InputLayout input, DrqV2Config config)
+    : config_(std::move(config)), agent_(make_agent(std::move(input), config_)) {
+  const auto adam = [&](std::vector<torch::Tensor> parameters) {
+    return std::make_unique<torch::optim::Adam>(std::move(parameters),
+                                                torch::optim::AdamOptions(config_.learning_rate));
+  };
+  if (agent_->input().has_image) encoder_optimizer_ = adam(agent_->encoder->parameters());
+  actor_optimizer_ =
+      adam(parameters_of({agent_->actor_trunk.ptr().get(), agent_->actor_head.ptr().get()}));
+  critic_optimizer_ = adam(parameters_of(
+      {agent_->critic_trunk.ptr().get(), agent_->q1.ptr().get(), agent_->q2.ptr().get()}));
+}
+
+UpdateStats Learner::update(const ReplayBatch& batch, std::int64_t env_steps,
+                            at::Generator& augmentation, at::Generator& noise, UpdateTimes* times) {
+  Agent& agent = *agent_;
+  const InputLayout& input = agent.input();
+  const std::int64_t size = batch.size;
+  auto clock = Clock::now();
+  const auto lap = [&](double UpdateTimes::*phase) {
+    if (times == nullptr) return;
+    times->*phase += seconds_since(clock);
+    clock = Clock::now();
+  };
+  // Inputs, augmented.
+  torch::Tensor images, next_images;
+  if (input.has_image) {
+    const std::int64_t bytes = input.stack * input.height * input.width * input.channels;
+    const auto shifted = [&](const std::vector<std::uint8_t>& stacks,
+                             std::vector<std::uint8_t>& into) {
+      if (config_.shift_pad == 0)
+        return agent.image_input(view_of(stacks, {size, bytes}, torch::kUInt8));
+      const std::int64_t pad = config_.shift_pad;
+      const torch::Tensor shifts =
+          torch::randint(0, 2 * pad + 1, {size, 2}, augmentation, torch::kInt64);
+      into.resize(stacks.size());
+      shift_frames(stacks.data(), into.data(), size, input.stack, input.height, input.width,
+                   input.channels, pad, shifts.data_ptr<std::int64_t>());
+      return agent.image_input(view_of(into, {size, bytes}, torch::kUInt8));
+    };
+    images = shifted(batch.images[0], shifted_);
+    next_images = shifted(batch.next_images[0], next_shifted_);
+  }
+  const torch::Tensor vectors = vectors_of(batch.vectors, input, size);
+  const torch::Tensor next_vectors = vectors_of(batch.next_vectors, input, size);
+  const torch::Tensor actions = view_of(batch.actions, {size, input.action_size}, torch::kFloat32);
+  const torch::Tensor rewards = view_of(batch.rewards, {size}, torch::kFloat32);
+  const torch::Tensor discounts = view_of(batch.discounts, {size}, torch::kFloat32);
+  lap(&UpdateTimes::augment);
+
+  const torch::Tensor features = agent.encode(images, vectors);
+  torch::Tensor next_features;
+  {
+    torch::NoGradGuard no_grad;
+    next_features = agent.encode(next_images, next_vectors);
+  }
+  lap(&UpdateTimes::encode);
+
+  // Critic: the n-step target from the target critic at the target policy's noisy action.
+  const double std = config_.noise_std(env_steps);
+  torch::Tensor target;
+  {
+    torch::NoGradGuard no_grad;
+    const torch::Tensor mean = agent.actor_mean(next_features);
+    const torch::Tensor next_action =
+        (mean + clipped_noise(mean, std, config_.noise_clip, noise)).clamp(-1.0, 1.0);
+    const auto [target_q1, target_q2] = agent.q_values(next_features, next_action, true);
+    target = rewards + discounts * torch::min(target_q1, target_q2);
+  }
+  const auto [q1, q2] = agent.q_values(features, actions, false);
+  const torch::Tensor critic_loss = torch::mse_loss(q1, target) + torch::mse_loss(q2, target);
+  UpdateStats stats;
+  stats.critic_loss = critic_loss.item<double>();
+  stats.q_mean = q1.mean().item<double>();
+  stats.target_mean = target.mean().item<double>();
+  lap(&UpdateTimes::critic);
+  if (!std::isfinite(stats.critic_loss)) {
+    throw std::runtime_error("drqv2: the critic loss is not finite (" +
+                             std::to_string(stats.critic_loss) + ", Q mean " +
+                             std::to_string(stats.q_mean) + "): no step taken");
+  }
+  if (encoder_optimizer_) encoder_optimizer_->zero_grad();
+  critic_optimizer_->zero_grad();
+  critic_loss.backward();
+  critic_optimizer_->step();
+  if (encoder_optimizer_) encoder_optimizer_->step();
+  lap(&UpdateTimes::backward);
+
+  // Actor: the critic's value of the policy's noisy action, on features the actor cannot move.
+  const torch::Tensor detached = features.detach();
+  const torch::Tensor mean = agent.actor_mean(detached);
+  const torch::Tensor action =
+      (mean + clipped_noise(mean, std, config_.noise_clip, noise)).clamp(-1.0, 1.0);
+  const auto [actor_q1, actor_q2] = agent.q_values(detached, action, false);
+  const torch::Tensor actor_loss = -torch::min(actor_q1, actor_q2).mean();
+  stats.actor_loss = actor_loss.item<double>();
+  if (!std::isfinite(stats.actor_loss)) {
+    throw std::runtime_error("drqv2: the actor loss is not finite (" +
+                             std::to_string(stats.actor_loss) + "): no step taken");
+  }
+  actor_optimizer_->zero_grad();
+  actor_loss.backward();
+  actor_optimizer_->step();
+  lap(&UpdateTimes::actor);
+
+  soft_update(*agent.critic_trunk, *agent.target_trunk, config_.critic_tau);
+  soft_update(*agent.q1, *agent.target_q1, config_.critic_tau);
+  soft_update(*agent.q2, *agent.target_q2, config_.critic_tau);
+  lap(&UpdateTimes::target);
+  return stats;
+}
+
+torch::Tensor Agent::act(const std::map<std::string, torch::Tensor>& obs, bool deterministic,
+                         double noise_std, at::Generator* noise) {
+  torch::NoGradGuard no_grad;
+  Agent& agent = *this;
+  const InputLayout& input = input_;
+  torch::Tensor images;
+  std::int64_t batch = 0;
+  if (input.has_image) {
+    const torch::Tensor& stacked = obs.at(input.image_key);
+    batch = stacked.size(0);
+    images = agent.image_input(stacked.reshape({batch, -1}).contiguous());
+  }
+  torch::Tensor vectors;
+  if (!input.vector_keys.empty()) {
+    std::vector<torch::Tensor> parts;
+    for (const std::string& key : input.vector_keys) {
+      const torch::Tensor& value = obs.at(key);
+      batch = value.size(0);
+      parts.push_back(value.reshape({batch, -1}).to(torch::kFloat32));
+    }
+    vectors = parts.size() == 1 ? parts[0] : torch::cat(parts, 1);
+  }
+  const torch::Tensor mean = agent.actor_mean(agent.encode(images, vectors));
+  if (deterministic || noise == nullptr) return mean;
+  return (mean + torch::randn(mean.sizes(), *noise, mean.options()) * noise_std).clamp(-1.0, 1.0);
+}
+
+}  // namespace pixelgym::drqv2

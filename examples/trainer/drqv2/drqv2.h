@@ -1,0 +1,231 @@
+// DrQ-v2 (Yarats et al. 2021): DDPG from pixels with a twin critic and its target, n-step
+// returns from a replay buffer, random-shift augmentation and a scheduled exploration noise.
+// The config, the networks and one update.
+#pragma once
+
+#include <torch/torch.h>
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <nlohmann/json_fwd.hpp>
+#include <string>
+#include <vector>
+
+#include "envs/space.h"
+#include "examples/trainer/drqv2/replay_buffer.h"
+
+namespace pixelgym::drqv2 {
+
+/// The convolutional encoder of the image key (32 channels of 3x3 kernels in each layer).
+enum class EncoderArchitecture : std::uint8_t {
+  /// DrQ-v2's: four convolutions of strides 2, 1, 1, 1 (at 64x64: 25x25 cells, 20000 features;
+  /// about 23M multiply-adds per 9-channel sample).
+  kDrqV2,
+  /// MR.Q's (Fujimoto et al. 2025): strides 2, 2, 2, 1 (at 64x64: 5x5 cells, 800 features;
+  /// about 5M multiply-adds per sample).
+  kMrq,
+};
+/// "drqv2", "mrq".
+const char* to_string(EncoderArchitecture architecture);
+/// The inverse of to_string. Throws std::invalid_argument listing the names.
+EncoderArchitecture parse_encoder_architecture(const std::string& name);
+
+/// Every setting of the learner; validate() checks each. Counts of steps are env steps (all
+/// envs together): with action_repeat K each is K control steps. The defaults are DrQ-v2's
+/// (lr 1e-4, batch 256, 3-step returns, tau 0.01, features 50, hidden 1024, noise clip 0.3),
+/// with one update per env step as DrQ and its seed steps and noise schedule counted in env
+/// steps for action_repeat 4 to 8.
+struct DrqV2Config {
+  /// Seeds torch (weights), the replay sampling, the exploration noise, the augmentation and the
+  /// envs (env i resets with seed + i).
+  std::uint64_t seed = 0;
+  /// Envs stepped together, and the run's length.
+  std::int64_t num_envs = 1;
+  std::int64_t total_env_steps = 100'000;
+  /// Env steps per iteration (a progress.csv row; checkpoints come every checkpoint_every
+  /// iterations). A multiple of num_envs.
+  std::int64_t iteration_env_steps = 500;
+  /// Frames in each observation's stack (the env must give them: --wrap frame_stack=K, the
+  /// new_axis layout; 1: single frames).
+  std::int64_t frame_stack = 3;
+  /// Replay buffer slots (one per env step, plus one per episode for its last observation).
+  std::int64_t replay_capacity = 100'000;
+  std::int64_t batch_size = 128;
+  std::int64_t n_step = 3;
+  double gamma = 0.99;
+  /// Adam's learning rate of the encoder, the actor and the critic.
+  double learning_rate = 1e-4;
+  /// The target critic moves this fraction towards the critic after each update.
+  double critic_tau = 0.01;
+  /// The encoder, and the width of the actor's and the critic's own trunk (Linear, LayerNorm,
+  /// tanh) and of their hidden layers.
+  EncoderArchitecture encoder = EncoderArchitecture::kMrq;
+  std::int64_t feature_dim = 50;
+  std::int64_t hidden_dim = 256;
+  /// Env steps of uniformly random actions before the policy acts (and learning starts).
+  std::int64_t seed_env_steps = 1000;
+  /// Updates per env step (all envs together): 1 updates after every step of one env, 0.5
+  /// after every second.
+  double updates_per_env_step = 1.0;
+  /// The exploration noise's standard deviation: noise_start, linearly to noise_end over
+  /// noise_schedule_env_steps env steps, then noise_end. The target policy's and the actor
+  /// loss's noise is clipped to +-noise_clip.
+  double noise_start = 1.0;
+  double noise_end = 0.1;
+  std::int64_t noise_schedule_env_steps = 25'000;
+  double noise_clip = 0.3;
+  /// Random shifts of the images during updates, by up to shift_pad pixels (0: none).
+  std::int64_t shift_pad = 4;
+  /// Run the encoder's convolutions under bfloat16 autocast where the CPU has AVX512-BF16 (or
+  /// AMX); elsewhere it stays float32.
+  bool bfloat16 = true;
+  /// Lay the encoder's images out channels-last (oneDNN's preferred layout: its first
+  /// convolution ran 8x faster so on this project's 2-core AVX2 machine).
+  bool channels_last = true;
+
+  /// Throws std::invalid_argument naming the first member out of range and its value.
+  void validate() const;
+  /// The noise's standard deviation after `env_steps`.
+  double noise_std(std::int64_t env_steps) const;
+};
+
+/// JSON form: one member per field, named as the fields, the encoder by its name. from_json
+/// takes any subset (the rest keep their defaults) and throws std::invalid_argument for an
+/// unknown member (listing the known ones), a member of the wrong type, or a config that fails
+/// validate().
+void to_json(nlohmann::json& json, const DrqV2Config& config);
+void from_json(const nlohmann::json& json, DrqV2Config& config);
+
+/// Whether this CPU computes bfloat16 natively (AVX512-BF16 or AMX-BF16).
+bool cpu_has_bfloat16();
+
+/// The observation as the learner reads it: one image key (or none) and vector keys.
+struct InputLayout {
+  /// The image key ("" for a bare Box observation): frames of (H, W, C) (or (H, W): C = 1) in
+  /// stacks of `stack`.
+  bool has_image = false;
+  std::string image_key;
+  std::int64_t stack = 1;
+  std::int64_t height = 0;
+  std::int64_t width = 0;
+  std::int64_t channels = 0;
+  /// Float vector keys and their sizes, in key order.
+  std::vector<std::string> vector_keys;
+  std::vector<std::int64_t> vector_sizes;
+  std::int64_t action_size = 0;
+  /// The Box action's bounds (float32, finite).
+  std::vector<float> action_low;
+  std::vector<float> action_high;
+
+  /// The buffer's layout of this input.
+  ReplayLayout replay_layout() const;
+};
+
+/// The input layout of one env's spaces (`env_name` for the errors). The observation is a Box or
+/// a Dict of Boxes with at most one uint8 image key of shape (frame_stack, H, W[, C]) (or, for
+/// frame_stack 1, (H, W[, C])) and any float32 keys; the action space a bounded float Box.
+/// Throws std::invalid_argument naming the env, the key and the space otherwise (a Discrete
+/// action space among them).
+InputLayout input_layout(const Space& observation_space, const Space& action_space,
+                         std::int64_t frame_stack, const std::string& env_name);
+
+/// The encoder, actor, critic and target critic. Built from torch's default generator (call
+/// torch::manual_seed first). Orthogonal weights (gain sqrt(2) before ReLU, else 1), zero
+/// biases, as DrQ-v2.
+class Agent : public torch::nn::Module {
+ public:
+  Agent(InputLayout input, const DrqV2Config& config);
+
+  /// Images uint8 (B, stack * H * W * C) as the buffer stores them, to float (B, stack C, H, W).
+  torch::Tensor image_input(const torch::Tensor& images) const;
+  /// Features of a batch: the encoder over float images (B, stack C, H, W) in [0, 255]
+  /// (undefined: no image) beside the vector keys (B, sum of sizes; undefined: none).
+  torch::Tensor encode(const torch::Tensor& images, const torch::Tensor& vectors);
+  /// The policy's action in [-1, 1] (tanh) for features.
+  torch::Tensor actor_mean(const torch::Tensor& features);
+  /// Q1 and Q2 of the critic (or of the target critic) for features and actions in [-1, 1].
+  std::pair<torch::Tensor, torch::Tensor> q_values(const torch::Tensor& features,
+                                                   const torch::Tensor& actions, bool target);
+  /// Actions in [-1, 1] for a batch of observations (a vector env's, as ppo::observation_tensors
+  /// gives them): the policy's mean when `deterministic` or `noise` is null, else the mean plus
+  /// Gaussian noise of std `noise_std` drawn from `noise`, clamped. Computes no gradients.
+  torch::Tensor act(const std::map<std::string, torch::Tensor>& obs, bool deterministic,
+                    double noise_std, at::Generator* noise);
+  /// Actions in [-1, 1] to the env's bounds (float32), and back.
+  torch::Tensor env_action(const torch::Tensor& actions) const;
+  torch::Tensor unit_action(const torch::Tensor& env_actions) const;
+
+  const InputLayout& input() const { return input_; }
+  std::int64_t feature_size() const { return feature_size_; }
+  bool autocast() const { return autocast_; }
+
+  torch::nn::Sequential encoder{nullptr};
+  torch::nn::Sequential actor_trunk{nullptr}, actor_head{nullptr};
+  torch::nn::Sequential critic_trunk{nullptr}, q1{nullptr}, q2{nullptr};
+  torch::nn::Sequential target_trunk{nullptr}, target_q1{nullptr}, target_q2{nullptr};
+
+ private:
+  InputLayout input_;
+  std::int64_t feature_size_ = 0;
+  bool autocast_ = false;
+  bool channels_last_ = false;
+  torch::Tensor low_, high_;
+};
+
+/// DrQ's random shift on uint8 stacks, as ppo::random_shift does it on float images: `batch`
+/// stacks of `frames` frames of (height, width, channels) bytes; frame f of stack b is padded by
+/// `pad` pixels on each side, repeating its edge pixels, and the window at offset (shifts[2b],
+/// shifts[2b + 1]) (rows, columns; each in [0, 2 pad]) is kept: the same offset for every frame
+/// of a stack. Offset (pad, pad) copies the stack unchanged.
+void shift_frames(const std::uint8_t* images, std::uint8_t* shifted, std::int64_t batch,
+                  std::int64_t frames, std::int64_t height, std::int64_t width,
+                  std::int64_t channels, std::int64_t pad, const std::int64_t* shifts);
+
+/// What one update did.
+struct UpdateStats {
+  double critic_loss = 0.0;
+  double actor_loss = 0.0;
+  double q_mean = 0.0;       // mean of Q1 over the batch
+  double target_mean = 0.0;  // mean of the n-step target
+};
+
+/// Where an update's time went (seconds), filled when profiling.
+struct UpdateTimes {
+  double sample = 0.0;    // ReplayBuffer::sample and the copy to tensors
+  double augment = 0.0;   // random shifts of obs and next obs
+  double encode = 0.0;    // the encoder forward on obs and next obs
+  double critic = 0.0;    // target, critic forward and loss
+  double backward = 0.0;  // critic and encoder backward and their Adam steps
+  double actor = 0.0;     // actor forward, loss, backward, step
+  double target = 0.0;    // the target critic's soft update
+};
+
+/// The learner: an Agent, its three Adams (encoder, actor, critic) and the update.
+class Learner {
+ public:
+  /// Seeds torch with config.seed before building the agent. Throws as input_layout's checks.
+  Learner(InputLayout input, DrqV2Config config);
+
+  /// One update from `batch` at `env_steps` (the noise's schedule); generators for the
+  /// augmentation and the noise. When `times` is given, synchronous timings of its phases are
+  /// added to it. Throws std::runtime_error (naming the losses) when a loss is not finite; no
+  /// step is taken then.
+  UpdateStats update(const ReplayBatch& batch, std::int64_t env_steps, at::Generator& augmentation,
+                     at::Generator& noise, UpdateTimes* times = nullptr);
+  Agent& agent() { return *agent_; }
+  const std::shared_ptr<Agent>& agent_ptr() const { return agent_; }
+  /// Null when the observation has no image (no encoder).
+  torch::optim::Adam* encoder_optimizer() { return encoder_optimizer_.get(); }
+  torch::optim::Adam& actor_optimizer() { return *actor_optimizer_; }
+  torch::optim::Adam& critic_optimizer() { return *critic_optimizer_; }
+  const DrqV2Config& config() const { return config_; }
+
+ private:
+  DrqV2Config config_;
+  std::shared_ptr<Agent> agent_;
+  std::unique_ptr<torch::optim::Adam> encoder_optimizer_, actor_optimizer_, critic_optimizer_;
+  std::vector<std::uint8_t> shifted_, next_shifted_;  // the batch's images, shifted
+};
+
+}  // namespace pixelgym::drqv2

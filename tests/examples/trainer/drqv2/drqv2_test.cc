@@ -1,0 +1,246 @@
+// DrQ-v2's pieces: its config's JSON form and the errors naming each bad member, the spaces it
+// refuses (a Discrete action space, an image without its frame stack), the random shift on
+// uint8 stacks (the same images as ppo::random_shift, never a pixel from outside the padded
+// window), the target critic's soft update, and an update that learns a fixed batch.
+#include "examples/trainer/drqv2/drqv2.h"
+
+#include <ATen/CPUGeneratorImpl.h>
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "envs/spaces/box.h"
+#include "envs/spaces/dict.h"
+#include "envs/spaces/discrete.h"
+#include "examples/trainer/ppo/policy.h"
+
+namespace pixelgym::drqv2 {
+namespace {
+
+using nlohmann::json;
+
+DrqV2Config parse(const json& in) {
+  DrqV2Config config;
+  from_json(in, config);
+  return config;
+}
+
+void expect_refused(const json& in, const std::string& word) {
+  try {
+    parse(in);
+    ADD_FAILURE() << in.dump() << " was accepted; expected an error naming " << word;
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find(word), std::string::npos) << error.what();
+  }
+}
+
+TEST(DrqV2ConfigTest, JsonRoundTripsAndBadMembersAreNamed) {
+  DrqV2Config config;
+  config.encoder = EncoderArchitecture::kDrqV2;
+  config.batch_size = 64;
+  config.noise_end = 0.2;
+  json out;
+  to_json(out, config);
+  EXPECT_EQ(out.at("encoder"), "drqv2");
+  const DrqV2Config back = parse(out);
+  EXPECT_EQ(back.encoder, EncoderArchitecture::kDrqV2);
+  EXPECT_EQ(back.batch_size, 64);
+  EXPECT_EQ(back.noise_end, 0.2);
+  EXPECT_EQ(parse(json::object()).hidden_dim, DrqV2Config{}.hidden_dim);
+
+  expect_refused({{"batch_sise", 4}}, "batch_sise");
+  expect_refused({{"batch_size", 0}}, "batch_size");
+  expect_refused({{"batch_size", "big"}}, "batch_size");
+  expect_refused({{"gamma", 1.5}}, "gamma");
+  expect_refused({{"encoder", "resnet"}}, "encoder");
+  expect_refused({{"n_step", 0}}, "n_step");
+  expect_refused({{"num_envs", 2}, {"iteration_env_steps", 3}}, "iteration_env_steps");
+  expect_refused({{"replay_capacity", 5}}, "replay_capacity");
+  expect_refused({{"updates_per_env_step", -1}}, "updates_per_env_step");
+}
+
+TEST(DrqV2ConfigTest, NoiseFollowsItsSchedule) {
+  DrqV2Config config;
+  config.noise_start = 1.0;
+  config.noise_end = 0.2;
+  config.noise_schedule_env_steps = 100;
+  EXPECT_DOUBLE_EQ(config.noise_std(0), 1.0);
+  EXPECT_DOUBLE_EQ(config.noise_std(50), 0.6);
+  EXPECT_DOUBLE_EQ(config.noise_std(100), 0.2);
+  EXPECT_DOUBLE_EQ(config.noise_std(1000), 0.2);
+}
+
+spaces::Dict pixel_space(Shape pixels) {
+  return spaces::Dict({{"pixels", std::make_shared<spaces::Box>(0.0, 255.0, pixels, DType::kUInt8)},
+                       {"joint_pos", std::make_shared<spaces::Box>(-1.0, 1.0, Shape{2})}});
+}
+
+TEST(DrqV2InputTest, ReadsStacksAndRefusesWhatItCannotLearnFrom) {
+  const spaces::Box action(-2.0, 2.0, Shape{2});
+  const InputLayout input = input_layout(pixel_space({3, 32, 32}), action, 3, "Env-v0");
+  EXPECT_TRUE(input.has_image);
+  EXPECT_EQ(input.image_key, "pixels");
+  EXPECT_EQ(input.channels, 1);
+  EXPECT_EQ(input.height, 32);
+  EXPECT_EQ(input.vector_keys, (std::vector<std::string>{"joint_pos"}));
+  EXPECT_EQ(input.action_size, 2);
+  EXPECT_EQ(input_layout(pixel_space({3, 32, 32, 3}), action, 3, "Env-v0").channels, 3);
+
+  const auto refused = [](auto call, std::vector<std::string> words) {
+    try {
+      call();
+      ADD_FAILURE() << "accepted";
+    } catch (const std::invalid_argument& error) {
+      for (const std::string& word : words) {
+        EXPECT_NE(std::string(error.what()).find(word), std::string::npos) << error.what();
+      }
+    }
+  };
+  refused(
+      [&] {
+        input_layout(pixel_space({3, 32, 32}), spaces::Discrete(3), 3, "Pole-v0");
+      },
+      {"Pole-v0", "Discrete(3)"});
+  refused(
+      [&] {
+        input_layout(pixel_space({32, 32, 3}), action, 3, "Pole-v0");
+      },
+      {"Pole-v0", "\"pixels\"", "frame_stack=3"});
+  refused(
+      [&] {
+        input_layout(pixel_space({3, 32, 32}), spaces::Box(-INFINITY, INFINITY, Shape{1}), 3,
+                     "P-v0");
+      },
+      {"bounded"});
+}
+
+TEST(DrqV2AugmentationTest, ShiftsMatchPpoRandomShiftAndStayInsideThePaddedWindow) {
+  const std::int64_t batch = 6, frames = 2, h = 12, w = 10, c = 3, pad = 4;
+  std::mt19937 rng(7);
+  std::vector<std::uint8_t> images(static_cast<std::size_t>(batch * frames * h * w * c));
+  for (auto& v : images) v = static_cast<std::uint8_t>(rng());
+  std::vector<std::int64_t> shifts = {0, 0, 8, 8, 4, 4, 0, 8, 8, 0, 3, 5};
+  std::vector<std::uint8_t> shifted(images.size());
+  shift_frames(images.data(), shifted.data(), batch, frames, h, w, c, pad, shifts.data());
+
+  // (B, frames, H, W, C) as float (B, frames C, H, W), shifted by ppo's float version.
+  const auto as_chw = [&](std::vector<std::uint8_t>& bytes) {
+    return torch::from_blob(bytes.data(), {batch, frames, h, w, c}, torch::kUInt8)
+        .permute({0, 1, 4, 2, 3})
+        .reshape({batch, frames * c, h, w})
+        .to(torch::kFloat32);
+  };
+  const torch::Tensor expected =
+      ppo::random_shift(as_chw(images), torch::tensor(shifts, torch::kInt64).view({batch, 2}), pad);
+  EXPECT_TRUE(torch::equal(as_chw(shifted), expected));
+  // Offset (pad, pad) is the identity.
+  const std::size_t stack_bytes = static_cast<std::size_t>(frames * h * w * c);
+  EXPECT_TRUE(std::equal(images.begin() + 2 * stack_bytes, images.begin() + 3 * stack_bytes,
+                         shifted.begin() + 2 * stack_bytes));
+  // Every output pixel of a stack comes from within `pad` rows and columns of its own place.
+  for (std::int64_t b = 0; b < batch; ++b) {
+    for (std::int64_t y = 0; y < h; ++y) {
+      for (std::int64_t x = 0; x < w; ++x) {
+        const std::int64_t sy = std::clamp<std::int64_t>(y + shifts[2 * b] - pad, 0, h - 1);
+        const std::int64_t sx = std::clamp<std::int64_t>(x + shifts[2 * b + 1] - pad, 0, w - 1);
+        EXPECT_LE(std::abs(sy - y), pad);
+        EXPECT_LE(std::abs(sx - x), pad);
+        const std::size_t at = static_cast<std::size_t>((((b * frames) * h + y) * w + x) * c);
+        const std::size_t from = static_cast<std::size_t>((((b * frames) * h + sy) * w + sx) * c);
+        EXPECT_EQ(shifted[at], images[from]);
+      }
+    }
+  }
+}
+
+// A learner on 32x32 gray stacks of 3 with one state key, and a batch of random transitions.
+struct Fixture {
+  InputLayout input;
+  DrqV2Config config;
+  ReplayBatch batch;
+
+  Fixture() {
+    input = input_layout(pixel_space({3, 32, 32}), spaces::Box(-1.0, 1.0, Shape{1}), 3, "T-v0");
+    config.batch_size = 16;
+    config.hidden_dim = 32;
+    config.feature_dim = 16;
+    config.learning_rate = 1e-3;
+    std::mt19937 rng(3);
+    const std::size_t b = 16;
+    batch.size = static_cast<std::int64_t>(b);
+    for (auto* images : {&batch.images, &batch.next_images}) {
+      images->assign(1, std::vector<std::uint8_t>(b * 3 * 32 * 32));
+      for (auto& v : (*images)[0]) v = static_cast<std::uint8_t>(rng() % 256);
+    }
+    for (auto* vectors : {&batch.vectors, &batch.next_vectors}) {
+      vectors->assign(1, std::vector<float>(b * 2));
+      for (auto& v : (*vectors)[0]) v = static_cast<float>(rng() % 100) / 100.0f;
+    }
+    batch.actions.resize(b);
+    batch.rewards.resize(b);
+    batch.discounts.assign(b, 0.0f);  // terminal: the target is the reward
+    for (std::size_t i = 0; i < b; ++i) {
+      batch.actions[i] = static_cast<float>(rng() % 200) / 100.0f - 1.0f;
+      batch.rewards[i] = batch.actions[i] > 0.0f ? 1.0f : -1.0f;
+    }
+  }
+};
+
+std::vector<torch::Tensor> copies(const torch::nn::Module& module) {
+  std::vector<torch::Tensor> out;
+  for (const auto& p : module.parameters()) out.push_back(p.detach().clone());
+  return out;
+}
+
+TEST(DrqV2LearnerTest, TheTargetCriticStartsEqualAndMovesByTau) {
+  Fixture f;
+  f.config.critic_tau = 0.25;
+  Learner learner(f.input, f.config);
+  Agent& agent = learner.agent();
+  const auto critic_before = copies(*agent.q1);
+  const auto target_before = copies(*agent.target_q1);
+  ASSERT_EQ(critic_before.size(), target_before.size());
+  for (std::size_t i = 0; i < critic_before.size(); ++i) {
+    EXPECT_TRUE(torch::equal(critic_before[i], target_before[i]));
+  }
+  at::Generator augmentation = at::detail::createCPUGenerator(1);
+  at::Generator noise = at::detail::createCPUGenerator(2);
+  learner.update(f.batch, 0, augmentation, noise);
+  const auto critic_after = copies(*agent.q1);
+  const auto target_after = copies(*agent.target_q1);
+  bool moved = false;
+  for (std::size_t i = 0; i < critic_after.size(); ++i) {
+    // target' = target + tau (critic' - target): the critic after its step.
+    const torch::Tensor expected = target_before[i] + 0.25 * (critic_after[i] - target_before[i]);
+    EXPECT_TRUE(torch::allclose(target_after[i], expected, 1e-5, 1e-6)) << "parameter " << i;
+    moved = moved || !torch::equal(target_after[i], target_before[i]);
+  }
+  EXPECT_TRUE(moved);
+  for (const auto& p : agent.target_trunk->parameters()) EXPECT_FALSE(p.requires_grad());
+}
+
+TEST(DrqV2LearnerTest, UpdatesFitAFixedBatchAndAreDeterministic) {
+  Fixture f;
+  const auto run = [&](int updates, std::vector<double>* losses) {
+    Learner learner(f.input, f.config);
+    at::Generator augmentation = at::detail::createCPUGenerator(1);
+    at::Generator noise = at::detail::createCPUGenerator(2);
+    for (int u = 0; u < updates; ++u) {
+      losses->push_back(learner.update(f.batch, 0, augmentation, noise).critic_loss);
+    }
+    return copies(learner.agent());
+  };
+  std::vector<double> losses, again;
+  const auto a = run(60, &losses);
+  const auto b = run(60, &again);
+  EXPECT_LT(losses.back(), 0.2 * losses.front()) << losses.front() << " -> " << losses.back();
+  EXPECT_EQ(losses, again);
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(torch::equal(a[i], b[i]));
+}
+
+}  // namespace
+}  // namespace pixelgym::drqv2
