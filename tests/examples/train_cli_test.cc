@@ -486,8 +486,10 @@ TEST(TrainCliTest, DrqV2WritesARunThatEvalReadsAndResumesAsIfItHadNotStopped) {
           "feature_dim": 8, "replay_capacity": 400, "n_step": 2})";
   std::ofstream(folder / "drqv2.json") << config;
   const auto arguments = [&](const fs::path& run, std::int64_t steps) {
+    // 96 env steps of 4 control steps each: 384 control steps.
     return "train CartPoleBalance-v1 --algo drqv2 --set obs_mode=pixels+state --set width=32 "
-           "--set height=32 --set max_episode_steps=24 --wrap grayscale --wrap frame_stack=3 "
+           "--set height=32 --set action_repeat=4 --set max_episode_steps=24 --wrap grayscale "
+           "--wrap frame_stack=3 "
            "--threads 1 --config " +
            (folder / "drqv2.json").string() + " --steps " + std::to_string(steps) +
            " --checkpoint-every 2 --keep-checkpoints 0 --eval-every 32 --eval-every-episodes 1 "
@@ -537,15 +539,15 @@ TEST(TrainCliTest, DrqV2WritesARunThatEvalReadsAndResumesAsIfItHadNotStopped) {
     EXPECT_EQ(json::parse(a.at("meta")).at("drqv2"), json::parse(b.at("meta")).at("drqv2"));
   }
 
-  // compare draws both runs' evaluations (control steps: env steps x no action_repeat).
+  // compare draws both runs' evaluations (control steps: env steps x action_repeat 4).
   const CliRun compared = run_cli("compare " + straight.string() + "=straight " + split.string() +
                                   " --out " + (folder / "compare.png").string());
   ASSERT_EQ(compared.exit_code, 0) << compared.output;
   EXPECT_TRUE(fs::exists(folder / "compare.png"));
-  EXPECT_NE(compared.output.find("\nstraight,96,"), std::string::npos) << compared.output;
-  EXPECT_NE(compared.output.find("\nsplit,96,"), std::string::npos) << compared.output;
-  const CliRun no_evals = run_cli("compare " + folder.string() + " --out " +
-                                  (folder / "none.png").string());
+  EXPECT_NE(compared.output.find("\nstraight,384,"), std::string::npos) << compared.output;
+  EXPECT_NE(compared.output.find("\nsplit,384,"), std::string::npos) << compared.output;
+  const CliRun no_evals =
+      run_cli("compare " + folder.string() + " --out " + (folder / "none.png").string());
   EXPECT_NE(no_evals.exit_code, 0);
   EXPECT_FALSE(fs::exists(folder / "none.png"));
 

@@ -152,6 +152,45 @@ void draw_mean(cv::Mat& image, const Panel& panel, const Series& series,
   }
 }
 
+// Where the two panels go: room on the left of each for the y tick labels, `top` under the
+// legend, room on the right for half the last x tick label.
+struct PanelLayout {
+  int left_margin = 0;
+  int top = 0;
+  int gap = 30;
+  int panel_width = 0;
+  int panel_height = 0;
+};
+
+PanelLayout panel_layout(const AxisTicks& y_axis, double y_magnitude, int legend_y,
+                         const CurvePlotOptions& options) {
+  int baseline = 0;
+  const int y_label_width = std::max(
+      text_size(format_tick(y_axis.low, y_axis.step, y_magnitude), kTickScale, 1, &baseline).width,
+      text_size(format_tick(y_axis.high, y_axis.step, y_magnitude), kTickScale, 1, &baseline)
+          .width);
+  PanelLayout layout;
+  layout.left_margin = y_label_width + 16;
+  layout.top = legend_y + 34;
+  const int bottom_margin = 52;
+  const int right_margin = 24;
+  layout.panel_width = (options.width - 2 * layout.left_margin - layout.gap - right_margin) / 2;
+  layout.panel_height = options.height - layout.top - bottom_margin;
+  return layout;
+}
+
+// A BGR drawing as an RGB image.
+render::Image rgb_image(const cv::Mat& image) {
+  cv::Mat rgb;
+  cv::cvtColor(image, rgb, cv::COLOR_BGR2RGB);
+  render::Image result;
+  result.height = rgb.rows;
+  result.width = rgb.cols;
+  result.channels = 3;
+  result.pixels.assign(rgb.data, rgb.data + rgb.total() * rgb.elemSize());
+  return result;
+}
+
 // Wall time in the unit that suits the run's length: its values, its axis label.
 std::pair<std::vector<double>, std::string> wall_time_axis(const std::vector<double>& seconds) {
   double longest = 0.0;
@@ -283,19 +322,12 @@ render::Image draw_curve(const ProgressTable& progress, const CurvePlotOptions& 
   put_text(image, "+/- std", band_x + 30, legend_y, kTickScale, kText, Align::kLeft);
 
   // Two panels side by side; room on the left of each for the y tick labels.
-  int tick_baseline = 0;
-  const int y_label_width = std::max(
-      text_size(format_tick(y_axis.low, y_axis.step, y_magnitude), kTickScale, 1, &tick_baseline)
-          .width,
-      text_size(format_tick(y_axis.high, y_axis.step, y_magnitude), kTickScale, 1, &tick_baseline)
-          .width);
-  const int left_margin = y_label_width + 16;
-  const int top = legend_y + 34;
-  const int bottom_margin = 52;
-  const int gap = 30;
-  const int right_margin = 24;  // room for half the last x tick label
-  const int panel_width = (options.width - 2 * left_margin - gap - right_margin) / 2;
-  const int panel_height = options.height - top - bottom_margin;
+  const PanelLayout layout = panel_layout(y_axis, y_magnitude, legend_y, options);
+  const int left_margin = layout.left_margin;
+  const int top = layout.top;
+  const int gap = layout.gap;
+  const int panel_width = layout.panel_width;
+  const int panel_height = layout.panel_height;
 
   const auto [wall_time, wall_label] = wall_time_axis(wall_time_s);
   const std::vector<std::pair<std::vector<double>, std::string>> xs = {{steps, "env steps"},
@@ -326,14 +358,7 @@ render::Image draw_curve(const ProgressTable& progress, const CurvePlotOptions& 
     }
   }
 
-  cv::Mat rgb;
-  cv::cvtColor(image, rgb, cv::COLOR_BGR2RGB);
-  render::Image result;
-  result.height = rgb.rows;
-  result.width = rgb.cols;
-  result.channels = 3;
-  result.pixels.assign(rgb.data, rgb.data + rgb.total() * rgb.elemSize());
-  return result;
+  return rgb_image(image);
 }
 
 render::Image draw_comparison(const std::vector<ComparedCurve>& curves,
@@ -393,19 +418,12 @@ render::Image draw_comparison(const std::vector<ComparedCurve>& curves,
     legend_x += width;
   }
 
-  int tick_baseline = 0;
-  const int y_label_width = std::max(
-      text_size(format_tick(y_axis.low, y_axis.step, y_magnitude), kTickScale, 1, &tick_baseline)
-          .width,
-      text_size(format_tick(y_axis.high, y_axis.step, y_magnitude), kTickScale, 1, &tick_baseline)
-          .width);
-  const int left_margin = y_label_width + 16;
-  const int top = legend_y + 34;
-  const int bottom_margin = 52;
-  const int gap = 30;
-  const int right_margin = 24;
-  const int panel_width = (options.width - 2 * left_margin - gap - right_margin) / 2;
-  const int panel_height = options.height - top - bottom_margin;
+  const PanelLayout layout = panel_layout(y_axis, y_magnitude, legend_y, options);
+  const int left_margin = layout.left_margin;
+  const int top = layout.top;
+  const int gap = layout.gap;
+  const int panel_width = layout.panel_width;
+  const int panel_height = layout.panel_height;
   if (panel_height < 60) {
     throw std::invalid_argument("draw_comparison: too many curves for a height of " +
                                 std::to_string(options.height));
@@ -434,14 +452,7 @@ render::Image draw_comparison(const std::vector<ComparedCurve>& curves,
     }
     cv::rectangle(image, panel.area, kAxis, 1);
   }
-  cv::Mat rgb;
-  cv::cvtColor(image, rgb, cv::COLOR_BGR2RGB);
-  render::Image result;
-  result.height = rgb.rows;
-  result.width = rgb.cols;
-  result.channels = 3;
-  result.pixels.assign(rgb.data, rgb.data + rgb.total() * rgb.elemSize());
-  return result;
+  return rgb_image(image);
 }
 
 void write_curve_png(const std::filesystem::path& path, const ProgressTable& progress,
