@@ -68,6 +68,7 @@ struct TrainArguments : EnvArguments {
   std::int64_t eval_episodes = 5;
   std::int64_t eval_every = 0;
   std::int64_t eval_every_episodes = 5;
+  double eval_max_share = 0.1;
   const CLI::App* command = nullptr;  // the parsed subcommand: which flags were given
 };
 
@@ -100,6 +101,7 @@ trainer::RunSettings new_run_settings(const TrainArguments& args,
                             ? args.eval_every
                             : std::max<std::int64_t>(total / 10, 1);
   settings.eval_every_episodes = args.eval_every_episodes;
+  settings.eval_max_share = args.eval_max_share;
   return settings;
 }
 
@@ -235,12 +237,17 @@ void add_run_setting_options(CLI::App& train, TrainArguments& args) {
                      "multiple of this (0: never; default: a tenth of --steps, ten evaluations), "
                      "over --eval-every-episodes deterministic episodes with the final "
                      "evaluation's seeds; each adds a row to eval.csv (steps, wall_time_s, "
-                     "return_mean, return_std, episodes, eval_s). An evaluation is skipped when "
-                     "this process's evaluations have taken a tenth of its wall time",
+                     "return_mean, return_std, episodes, eval_s). An evaluation is skipped while "
+                     "this process's evaluations have taken more than --eval-max-share of its "
+                     "wall time",
                      CLI::Range(std::int64_t{0}, std::int64_t{1} << 50));
   add_checked_option(train, "--eval-every-episodes", args.eval_every_episodes,
                      "Episodes of each evaluation during training",
                      CLI::Range(std::int64_t{1}, std::int64_t{1} << 20));
+  add_checked_option(train, "--eval-max-share", args.eval_max_share,
+                     "The share of this process's wall time that evaluations during training may "
+                     "take before the next is skipped (1: never skipped); config.json keeps it",
+                     CLI::Range(0.001, 1.0));
 }
 
 void declare_train(CLI::App& train, TrainArguments& args) {

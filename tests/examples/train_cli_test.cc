@@ -18,6 +18,7 @@
 
 #include "examples/trainer/run/checkpoint_file.h"
 #include "examples/trainer/run/progress_csv.h"
+#include "examples/trainer/run/training_run.h"
 #include "tests/examples/cli_run.h"
 
 namespace pixelgym::testing {
@@ -493,6 +494,7 @@ TEST(TrainCliTest, DrqV2WritesARunThatEvalReadsAndResumesAsIfItHadNotStopped) {
            "--threads 1 --config " +
            (folder / "drqv2.json").string() + " --steps " + std::to_string(steps) +
            " --checkpoint-every 2 --keep-checkpoints 0 --eval-every 32 --eval-every-episodes 1 "
+           "--eval-max-share 1 "
            "--eval-episodes 1 --quiet --out " +
            run.string();
   };
@@ -538,6 +540,17 @@ TEST(TrainCliTest, DrqV2WritesARunThatEvalReadsAndResumesAsIfItHadNotStopped) {
     }
     EXPECT_EQ(json::parse(a.at("meta")).at("drqv2"), json::parse(b.at("meta")).at("drqv2"));
   }
+  // The evaluations during training: at the same steps, with the same returns.
+  const auto evaluations = [](const fs::path& run) {
+    std::vector<std::pair<std::int64_t, double>> rows;
+    for (const trainer::EvalRow& row :
+         trainer::parse_eval_csv(read_text(run / "eval.csv"), (run / "eval.csv").string())) {
+      rows.emplace_back(row.steps, row.return_mean);
+    }
+    return rows;
+  };
+  EXPECT_EQ(evaluations(straight), evaluations(split));
+  EXPECT_EQ(evaluations(split).size(), 3U);
 
   // compare draws both runs' evaluations (control steps: env steps x action_repeat 4).
   const CliRun compared = run_cli("compare " + straight.string() + "=straight " + split.string() +

@@ -38,6 +38,9 @@ struct RunSettings {
   /// eval_every_episodes episodes each.
   std::int64_t eval_every = 0;
   std::int64_t eval_every_episodes = 5;
+  /// An evaluation during training is skipped while those of this process have taken more than
+  /// this share of its wall time (in (0, 1]; 1: never skipped).
+  double eval_max_share = 0.1;
   /// The algorithm's name (AlgorithmFactory::name) and its config (AlgorithmFactory::
   /// parse_config: every member present, "seed", "num_envs" and "total_env_steps" among them).
   std::string algorithm;
@@ -54,7 +57,8 @@ nlohmann::json settings_to_json(const RunSettings& settings);
 
 /// The settings of config.json's object `in` (read from `where`) for `algorithm`: its config
 /// is the member algorithm.name(), read by algorithm.parse_config. Absent "torch_threads": 0;
-/// absent "keep_checkpoints": 0 (keep all); absent "eval_every": 0 (none). Throws
+/// absent "keep_checkpoints": 0 (keep all); absent "eval_every": 0 (none), "eval_max_share":
+/// 0.1. Throws
 /// std::runtime_error "{where}: not a pixelgym train config: ..." for a missing or ill-typed
 /// member, and what parse_config throws.
 RunSettings settings_from_json(const nlohmann::json& in, const std::filesystem::path& where,

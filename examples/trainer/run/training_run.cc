@@ -351,10 +351,10 @@ void TrainingRun::evaluate_when_due(std::int64_t steps_before) {
     text << std::fixed << std::setprecision(1) << s;
     return text.str();
   };
-  if (eval_seconds_ > 0.1 * this_process_s) {
+  if (eval_seconds_ > settings_.eval_max_share * this_process_s) {
     output_.out << "eval at " << steps << " env steps skipped: evaluations took "
                 << seconds(eval_seconds_) << " s of " << seconds(this_process_s)
-                << " s, more than a tenth\n";
+                << " s, more than --eval-max-share " << settings_.eval_max_share << "\n";
     return;
   }
   const auto eval_start = std::chrono::steady_clock::now();

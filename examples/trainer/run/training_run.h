@@ -90,8 +90,8 @@ struct RunOutput {
 /// Evaluations during training: once the env steps pass each multiple of eval_every, the policy
 /// plays eval_every_episodes deterministic seeded episodes (the final evaluation's seeds) and a
 /// row goes to eval.csv (rewritten atomically; a resume drops the rows after its checkpoint).
-/// An evaluation is skipped when those of this process have taken a tenth of its wall time, so
-/// that they never take more.
+/// An evaluation is skipped when those of this process have taken more than eval_max_share (a
+/// tenth by default) of its wall time, so that they never take much more.
 class TrainingRun {
  public:
   /// A new run of `settings` (settings.algorithm_config as algorithm.parse_config gives it) in

@@ -7,6 +7,8 @@
 #include <ATen/CPUGeneratorImpl.h>
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <stdexcept>
@@ -61,6 +63,21 @@ TEST(DrqV2ConfigTest, JsonRoundTripsAndBadMembersAreNamed) {
   expect_refused({{"num_envs", 2}, {"iteration_env_steps", 3}}, "iteration_env_steps");
   expect_refused({{"replay_capacity", 5}}, "replay_capacity");
   expect_refused({{"updates_per_env_step", -1}}, "updates_per_env_step");
+}
+
+// The configs shipped in examples/trainer/drqv2/configs (docs/drqv2.md's commands name them)
+// parse and validate.
+TEST(DrqV2ConfigTest, EveryShippedConfigParses) {
+  const std::filesystem::path folder =
+      std::filesystem::path(PIXELGYM_SOURCE_DIR) / "examples" / "trainer" / "drqv2" / "configs";
+  int parsed = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+    if (entry.path().extension() != ".json") continue;
+    std::ifstream file(entry.path());
+    EXPECT_NO_THROW(parse(json::parse(file))) << entry.path();
+    ++parsed;
+  }
+  EXPECT_GE(parsed, 2);
 }
 
 TEST(DrqV2ConfigTest, NoiseFollowsItsSchedule) {
