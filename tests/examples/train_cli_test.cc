@@ -16,6 +16,7 @@
 #include <string>
 #include <thread>
 
+#include "examples/trainer/drqv2/drqv2.h"
 #include "examples/trainer/run/checkpoint_file.h"
 #include "examples/trainer/run/progress_csv.h"
 #include "examples/trainer/run/training_run.h"
@@ -475,6 +476,37 @@ TEST(TrainCliTest, TruncatedAndCorruptCheckpointsAreRefused) {
       << resumed.output;
   EXPECT_NE(resumed.output.find("from ckpt-000001.pgck"), std::string::npos) << resumed.output;
   fs::remove_all(folder);
+}
+
+// `train --help` names every DrqV2Config member with its default (the JSON --config reads).
+TEST(TrainCliTest, TrainHelpListsEveryDrqV2Setting) {
+  const CliRun help = run_cli("train --help");
+  ASSERT_EQ(help.exit_code, 0) << help.output;
+  // CLI11 wraps long descriptions: compare with the whitespace folded and the thousands'
+  // commas dropped.
+  std::string text;
+  for (const char c : help.output) {
+    if (c == ',') continue;
+    if (c == ' ' || c == '\n') {
+      if (!text.empty() && text.back() != ' ') text += ' ';
+    } else {
+      text += c;
+    }
+  }
+  nlohmann::json defaults;
+  drqv2::to_json(defaults, drqv2::DrqV2Config{});
+  for (const auto& item : defaults.items()) {
+    if (item.key() == "seed") continue;  // listed bare: --seed sets it
+    std::string shown = item.value().dump();
+    if (item.value().is_number_float()) {
+      std::ostringstream number;
+      number << item.value().get<double>();
+      shown = number.str();
+    }
+    if (item.value().is_string()) shown = item.value().get<std::string>();
+    EXPECT_NE(text.find(item.key() + " (" + shown), std::string::npos)
+        << item.key() << " (" << shown << ") is not in train --help";
+  }
 }
 
 // The off-policy learner through the same run machinery: a run folder with its own columns and

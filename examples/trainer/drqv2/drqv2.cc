@@ -100,14 +100,29 @@ const char* to_string(EncoderArchitecture architecture) {
       return "drqv2";
     case EncoderArchitecture::kMrq:
       return "mrq";
+    case EncoderArchitecture::kFine:
+      return "fine";
   }
   return "?";
+}
+
+std::vector<std::int64_t> encoder_strides(EncoderArchitecture architecture) {
+  switch (architecture) {
+    case EncoderArchitecture::kDrqV2:
+      return {2, 1, 1, 1};
+    case EncoderArchitecture::kMrq:
+      return {2, 2, 2, 1};
+    case EncoderArchitecture::kFine:
+      return {2, 2, 1, 1};
+  }
+  return {};
 }
 
 EncoderArchitecture parse_encoder_architecture(const std::string& name) {
   if (name == "drqv2") return EncoderArchitecture::kDrqV2;
   if (name == "mrq") return EncoderArchitecture::kMrq;
-  throw std::invalid_argument("unknown encoder \"" + name + "\"; known: drqv2, mrq");
+  if (name == "fine") return EncoderArchitecture::kFine;
+  throw std::invalid_argument("unknown encoder \"" + name + "\"; known: drqv2, mrq, fine");
 }
 
 void DrqV2Config::validate() const {
@@ -151,6 +166,7 @@ void DrqV2Config::validate() const {
   in_range("noise_end", noise_end, 0.0, 10.0);
   at_least("noise_schedule_env_steps", noise_schedule_env_steps, 0);
   in_range("noise_clip", noise_clip, 0.0, 10.0);
+  in_range("actor_preactivation_penalty", actor_preactivation_penalty, 0.0, 1e3);
   at_least("shift_pad", shift_pad, 0);
 }
 
@@ -182,6 +198,7 @@ void to_json(nlohmann::json& json, const DrqV2Config& config) {
           {"noise_end", config.noise_end},
           {"noise_schedule_env_steps", config.noise_schedule_env_steps},
           {"noise_clip", config.noise_clip},
+          {"actor_preactivation_penalty", config.actor_preactivation_penalty},
           {"shift_pad", config.shift_pad},
           {"bfloat16", config.bfloat16},
           {"channels_last", config.channels_last}};
@@ -219,6 +236,7 @@ void from_json(const nlohmann::json& json, DrqV2Config& config) {
   read_member(json, "noise_end", config.noise_end);
   read_member(json, "noise_schedule_env_steps", config.noise_schedule_env_steps);
   read_member(json, "noise_clip", config.noise_clip);
+  read_member(json, "actor_preactivation_penalty", config.actor_preactivation_penalty);
   read_member(json, "shift_pad", config.shift_pad);
   read_member(json, "bfloat16", config.bfloat16);
   read_member(json, "channels_last", config.channels_last);
@@ -352,9 +370,7 @@ Agent::Agent(InputLayout input, const DrqV2Config& config)
       channels_last_(config.channels_last) {
   std::int64_t image_features = 0;
   if (input_.has_image) {
-    const std::vector<std::int64_t> strides = config.encoder == EncoderArchitecture::kDrqV2
-                                                  ? std::vector<std::int64_t>{2, 1, 1, 1}
-                                                  : std::vector<std::int64_t>{2, 2, 2, 1};
+    const std::vector<std::int64_t> strides = encoder_strides(config.encoder);
     encoder = torch::nn::Sequential();
     std::int64_t channels = input_.stack * input_.channels;
     std::int64_t height = input_.height;
@@ -467,8 +483,12 @@ torch::Tensor Agent::encode(const torch::Tensor& images, const torch::Tensor& ve
   return parts.size() == 1 ? parts[0] : torch::cat(parts, 1);
 }
 
+torch::Tensor Agent::actor_preactivation(const torch::Tensor& features) {
+  return actor_head->forward(actor_trunk->forward(features));
+}
+
 torch::Tensor Agent::actor_mean(const torch::Tensor& features) {
-  return torch::tanh(actor_head->forward(actor_trunk->forward(features)));
+  return torch::tanh(actor_preactivation(features));
 }
 
 std::pair<torch::Tensor, torch::Tensor> Agent::q_values(const torch::Tensor& features,
@@ -619,11 +639,15 @@ UpdateStats Learner::update(const ReplayBatch& batch, std::int64_t env_steps,
 
   // Actor: the critic's value of the policy's noisy action, on features the actor cannot move.
   const torch::Tensor detached = features.detach();
-  const torch::Tensor mean = agent.actor_mean(detached);
+  const torch::Tensor preactivation = agent.actor_preactivation(detached);
+  const torch::Tensor mean = torch::tanh(preactivation);
   const torch::Tensor action =
       (mean + clipped_noise(mean, std, config_.noise_clip, noise)).clamp(-1.0, 1.0);
   const auto [actor_q1, actor_q2] = agent.q_values(detached, action, false);
-  const torch::Tensor actor_loss = -torch::min(actor_q1, actor_q2).mean();
+  torch::Tensor actor_loss = -torch::min(actor_q1, actor_q2).mean();
+  if (config_.actor_preactivation_penalty > 0.0) {
+    actor_loss = actor_loss + config_.actor_preactivation_penalty * preactivation.square().mean();
+  }
   stats.actor_loss = actor_loss.item<double>();
   if (!std::isfinite(stats.actor_loss)) {
     throw std::runtime_error("drqv2: the actor loss is not finite (" +

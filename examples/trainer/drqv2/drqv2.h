@@ -25,17 +25,24 @@ enum class EncoderArchitecture : std::uint8_t {
   /// MR.Q's (Fujimoto et al. 2025): strides 2, 2, 2, 1 (at 64x64: 5x5 cells, 800 features;
   /// about 5M multiply-adds per sample).
   kMrq,
+  /// Between the two: strides 2, 2, 1, 1 (at 64x64: 11x11 cells, 3872 features; about 7M
+  /// multiply-adds per sample), for thin things such as a pole a pixel or two wide.
+  kFine,
 };
-/// "drqv2", "mrq".
+/// "drqv2", "mrq", "fine".
 const char* to_string(EncoderArchitecture architecture);
+/// The strides of the architecture's four 3x3 convolutions.
+std::vector<std::int64_t> encoder_strides(EncoderArchitecture architecture);
 /// The inverse of to_string. Throws std::invalid_argument listing the names.
 EncoderArchitecture parse_encoder_architecture(const std::string& name);
 
 /// Every setting of the learner; validate() checks each. Counts of steps are env steps (all
-/// envs together): with action_repeat K each is K control steps. The defaults are DrQ-v2's
-/// (lr 1e-4, batch 256, 3-step returns, tau 0.01, features 50, hidden 1024, noise clip 0.3),
-/// with one update per env step as DrQ and its seed steps and noise schedule counted in env
-/// steps for action_repeat 4 to 8.
+/// envs together): with action_repeat K each is K control steps. The defaults follow DrQ-v2
+/// (3-step returns, tau 0.01, features 50, noise clip 0.3) with DrQ's learning rate 1e-3 and
+/// one update per env step (DrQ's at action repeat 4 to 8), a smaller batch (128, not 256) and
+/// MLPs (256, not 1024) for a CPU, and TD7's penalty on the actor's pre-tanh values: at DrQ-v2's
+/// learning rate 1e-4 a 100k-control-step run makes too few updates, and at 1e-3 without the
+/// penalty the policy saturated from pixels (docs/drqv2.md, Results).
 struct DrqV2Config {
   /// Seeds torch (weights), the replay sampling, the exploration noise, the augmentation and the
   /// envs (env i resets with seed + i).
@@ -55,7 +62,7 @@ struct DrqV2Config {
   std::int64_t n_step = 3;
   double gamma = 0.99;
   /// Adam's learning rate of the encoder, the actor and the critic.
-  double learning_rate = 1e-4;
+  double learning_rate = 1e-3;
   /// The target critic moves this fraction towards the critic after each update.
   double critic_tau = 0.01;
   /// The encoder, and the width of the actor's and the critic's own trunk (Linear, LayerNorm,
@@ -75,6 +82,10 @@ struct DrqV2Config {
   double noise_end = 0.1;
   std::int64_t noise_schedule_env_steps = 25'000;
   double noise_clip = 0.3;
+  /// The actor's loss adds this times the mean square of the values its tanh is taken of (as
+  /// TD7 and MR.Q do): a policy pushed into tanh's flat tails, where the critic's gradient
+  /// vanishes, is pulled back. 0: none.
+  double actor_preactivation_penalty = 1e-3;
   /// Random shifts of the images during updates, by up to shift_pad pixels (0: none).
   std::int64_t shift_pad = 4;
   /// Run the encoder's convolutions under bfloat16 autocast where the CPU has AVX512-BF16 (or
@@ -142,8 +153,9 @@ class Agent : public torch::nn::Module {
   /// Features of a batch: the encoder over float images (B, stack C, H, W) in [0, 255]
   /// (undefined: no image) beside the vector keys (B, sum of sizes; undefined: none).
   torch::Tensor encode(const torch::Tensor& images, const torch::Tensor& vectors);
-  /// The policy's action in [-1, 1] (tanh) for features.
+  /// The policy's action in [-1, 1] (tanh) for features, and what the tanh is taken of.
   torch::Tensor actor_mean(const torch::Tensor& features);
+  torch::Tensor actor_preactivation(const torch::Tensor& features);
   /// Q1 and Q2 of the critic (or of the target critic) for features and actions in [-1, 1].
   std::pair<torch::Tensor, torch::Tensor> q_values(const torch::Tensor& features,
                                                    const torch::Tensor& actions, bool target);

@@ -2,7 +2,7 @@
 // critic, backward, actor, target update), its medians over many updates, and its FLOP rate
 // against this CPU's FP32 peak. A replay buffer of random frames stands in for an env's.
 //
-//   drqv2_bench [--size 64] [--encoder drqv2|mrq] [--batch 256] [--stack 3] [--channels 3]
+//   drqv2_bench [--size 64] [--encoder drqv2|mrq|fine] [--batch 256] [--stack 3] [--channels 3]
 //               [--updates 30] [--hidden 1024] [--threads 0] [--bfloat16] [--channels-last]
 #include <ATen/CPUGeneratorImpl.h>
 
@@ -40,9 +40,7 @@ double median(std::vector<double> values) {
 // Multiply-adds of the encoder's convolutions for one sample, and of its first layer.
 std::pair<double, double> conv_macs(const InputLayout& input, EncoderArchitecture encoder,
                                     std::int64_t* features) {
-  const std::vector<std::int64_t> strides = encoder == EncoderArchitecture::kDrqV2
-                                                ? std::vector<std::int64_t>{2, 1, 1, 1}
-                                                : std::vector<std::int64_t>{2, 2, 2, 1};
+  const std::vector<std::int64_t> strides = pixelgym::drqv2::encoder_strides(encoder);
   std::int64_t channels = input.stack * input.channels, h = input.height, w = input.width;
   double total = 0.0, first = 0.0;
   for (const std::int64_t stride : strides) {

@@ -45,6 +45,7 @@ TEST(DrqV2ConfigTest, JsonRoundTripsAndBadMembersAreNamed) {
   config.encoder = EncoderArchitecture::kDrqV2;
   config.batch_size = 64;
   config.noise_end = 0.2;
+  config.actor_preactivation_penalty = 0.01;
   json out;
   to_json(out, config);
   EXPECT_EQ(out.at("encoder"), "drqv2");
@@ -52,6 +53,8 @@ TEST(DrqV2ConfigTest, JsonRoundTripsAndBadMembersAreNamed) {
   EXPECT_EQ(back.encoder, EncoderArchitecture::kDrqV2);
   EXPECT_EQ(back.batch_size, 64);
   EXPECT_EQ(back.noise_end, 0.2);
+  EXPECT_EQ(back.actor_preactivation_penalty, 0.01);
+  EXPECT_EQ(parse({{"encoder", "fine"}}).encoder, EncoderArchitecture::kFine);
   EXPECT_EQ(parse(json::object()).hidden_dim, DrqV2Config{}.hidden_dim);
 
   expect_refused({{"batch_sise", 4}}, "batch_sise");
@@ -63,6 +66,7 @@ TEST(DrqV2ConfigTest, JsonRoundTripsAndBadMembersAreNamed) {
   expect_refused({{"num_envs", 2}, {"iteration_env_steps", 3}}, "iteration_env_steps");
   expect_refused({{"replay_capacity", 5}}, "replay_capacity");
   expect_refused({{"updates_per_env_step", -1}}, "updates_per_env_step");
+  expect_refused({{"actor_preactivation_penalty", -0.1}}, "actor_preactivation_penalty");
 }
 
 // The configs shipped in examples/trainer/drqv2/configs (docs/drqv2.md's commands name them)
@@ -257,6 +261,46 @@ TEST(DrqV2LearnerTest, UpdatesFitAFixedBatchAndAreDeterministic) {
   EXPECT_LT(losses.back(), 0.2 * losses.front()) << losses.front() << " -> " << losses.back();
   EXPECT_EQ(losses, again);
   for (std::size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(torch::equal(a[i], b[i]));
+}
+
+// Each architecture's four convolutions leave the documented grid: at 64x64, 25x25 cells
+// (drqv2), 5x5 (mrq), 11x11 (fine), 32 channels each, beside the state key's 2 values.
+TEST(DrqV2LearnerTest, EncodersLeaveTheirDocumentedGrid) {
+  const InputLayout input =
+      input_layout(pixel_space({3, 64, 64}), spaces::Box(-1.0, 1.0, Shape{1}), 3, "T-v0");
+  for (const auto& [architecture, cells] :
+       std::vector<std::pair<EncoderArchitecture, std::int64_t>>{
+           {EncoderArchitecture::kDrqV2, 25}, {EncoderArchitecture::kMrq, 5},
+           {EncoderArchitecture::kFine, 11}}) {
+    DrqV2Config config;
+    config.encoder = architecture;
+    const Agent agent(input, config);
+    EXPECT_EQ(agent.feature_size(), 32 * cells * cells + 2) << to_string(architecture);
+  }
+}
+
+// A policy pushed deep into tanh's tail gets no gradient from the critic: without the penalty
+// its output layer stays where it is; with it, Adam pulls the layer back.
+TEST(DrqV2LearnerTest, ThePreactivationPenaltyPullsASaturatedActorBack) {
+  const auto bias_after = [](double penalty) {
+    Fixture f;
+    f.config.actor_preactivation_penalty = penalty;
+    Learner learner(f.input, f.config);
+    torch::Tensor bias;
+    for (const auto& item : learner.agent().actor_head->named_parameters()) {
+      if (item.key().find("bias") != std::string::npos) bias = item.value();  // the last layer's
+    }
+    {
+      torch::NoGradGuard no_grad;
+      bias.fill_(30.0);
+    }
+    at::Generator augmentation = at::detail::createCPUGenerator(1);
+    at::Generator noise = at::detail::createCPUGenerator(2);
+    for (int u = 0; u < 20; ++u) learner.update(f.batch, 0, augmentation, noise);
+    return bias.item<double>();
+  };
+  EXPECT_NEAR(bias_after(0.0), 30.0, 1e-6);
+  EXPECT_LT(bias_after(0.01), 30.0 - 0.01);
 }
 
 }  // namespace

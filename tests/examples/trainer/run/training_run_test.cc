@@ -5,10 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstring>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "envs/tasks/grid_world.h"
@@ -30,10 +32,12 @@ class DownActor final : public Actor {
     EXPECT_TRUE(deterministic);
     EXPECT_EQ(observations.array().shape()[0], 1);
     ++calls;
+    if (sleep_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(sleep_ms));
     actions.array().data<std::int64_t>()[0] = 1;
     return {};
   }
   std::int64_t calls = 0;
+  int sleep_ms = 0;  // a slow policy: evaluations take 50 x this per episode
 };
 
 // A pseudo-random action for env i at step t (SplitMix64 of t * 2 + i), down or right two times
@@ -173,6 +177,7 @@ class CountingFactory final : public AlgorithmFactory {
   int set_threads(int requested) const override { return requested == 0 ? 3 : requested; }
   std::unique_ptr<Algorithm> make(vector::VectorEnv& env, const json& config) const override {
     auto algorithm = std::make_unique<CountingAlgorithm>(env, config);
+    algorithm->actor_.sleep_ms = actor_sleep_ms;
     last = algorithm.get();
     return algorithm;
   }
@@ -181,6 +186,7 @@ class CountingFactory final : public AlgorithmFactory {
     return std::make_unique<DownActor>();
   }
   mutable CountingAlgorithm* last = nullptr;  // the latest made (valid while its run lives)
+  int actor_sleep_ms = 0;                      // its actor's (DownActor::sleep_ms)
 };
 
 Params integer_kwargs(const std::string&, const std::vector<std::string>& sets) {
@@ -257,6 +263,40 @@ TEST(TrainingRunTest, ANewRunTrainsToItsStepBudgetAndWritesTheRunFolder) {
   EXPECT_GT(fs::file_size(folder / "final.mp4"), 0U);
   EXPECT_NE(out.str().find("evaluation: return -2 +/- 0 over 2 episodes"), std::string::npos)
       << out.str();
+}
+
+// Evaluations during training go to eval.csv, one row each; while they have taken more than
+// eval_max_share of the process's time, the next is skipped and the output says so. Here
+// training is instant and an evaluation takes 100 ms: with share 1 every evaluation runs, with
+// share 0.1 only the first does.
+TEST(TrainingRunTest, EvaluationsDuringTrainingKeepToTheirShareOfTheTime) {
+  const auto evaluations = [](double share, std::string* output) {
+    const fs::path folder = test_folders::fresh_folder("training_run_eval_share") / "run";
+    CountingFactory factory;
+    factory.actor_sleep_ms = 2;
+    RunSettings settings = grid_settings(100);
+    settings.eval_every = 8;  // every iteration
+    settings.eval_every_episodes = 1;
+    settings.eval_max_share = share;
+    std::ostringstream out;
+    std::ostringstream errors;
+    TrainingRun run = TrainingRun::create(factory, integer_kwargs, settings, folder, TrainBudget{},
+                                          RunOutput{out, errors});
+    EXPECT_TRUE(run.train().has_value()) << out.str();
+    *output = out.str();
+    std::ifstream csv(folder / "eval.csv");
+    std::string line;
+    std::vector<std::string> steps;
+    std::getline(csv, line);  // the header
+    while (std::getline(csv, line)) steps.push_back(line.substr(0, line.find(',')));
+    return steps;
+  };
+  std::string output;
+  EXPECT_EQ(evaluations(1.0, &output), (std::vector<std::string>{"8", "16", "24", "32", "40"}));
+  EXPECT_EQ(output.find("skipped"), std::string::npos) << output;
+  EXPECT_EQ(evaluations(0.1, &output), (std::vector<std::string>{"8"}));
+  EXPECT_NE(output.find("eval at 16 env steps skipped: evaluations took "), std::string::npos)
+      << output;
 }
 
 // Stopped by its budget at 96 env steps and resumed to 192, a run is the run that trained to 192
