@@ -165,21 +165,22 @@ void add_run_options(CLI::App& train, TrainArguments& args) {
                   "--resume and eval read it from there")
       ->check(CLI::IsMember({"ppo", "drqv2"}))
       ->each([&args](const std::string&) { args.algo_given = true; });
-  train.add_option("--config", args.config_file,
-                   "The algorithm's settings as JSON (any subset of the fields; the rest keep "
-                   "their defaults). ppo: examples/trainer/ppo/ppo.h, PpoConfig. drqv2: "
-                   "examples/trainer/drqv2/drqv2.h, DrqV2Config: seed, num_envs (1), "
-                   "total_env_steps (100,000), iteration_env_steps (500, one progress.csv row), "
-                   "frame_stack (3), replay_capacity (100,000 steps), batch_size (128), n_step "
-                   "(3), gamma (0.99), learning_rate (0.001), critic_tau (0.01), encoder (mrq, "
-                   "fine or drqv2), feature_dim (50), hidden_dim (256), seed_env_steps (1000 steps of "
-                   "random actions), updates_per_env_step (1), noise_start (1), noise_end (0.1), "
-                   "noise_schedule_env_steps (25,000), noise_clip (0.3), "
-                   "actor_preactivation_penalty (0.001), shift_pad (4), "
-                   "bfloat16 (true: autocast the encoder where the CPU has AVX512-BF16 or AMX), "
-                   "channels_last (true). drqv2's replay buffer is not in its checkpoints: "
-                   "--resume refills it by replaying the run's env actions, which puts the "
-                   "same transitions back");
+  train.add_option(
+      "--config", args.config_file,
+      "The algorithm's settings as JSON (any subset of the fields; the rest keep "
+      "their defaults). ppo: examples/trainer/ppo/ppo.h, PpoConfig. drqv2: "
+      "examples/trainer/drqv2/drqv2.h, DrqV2Config: seed, num_envs (1), "
+      "total_env_steps (100,000), iteration_env_steps (500, one progress.csv row), "
+      "frame_stack (3), replay_capacity (100,000 steps), batch_size (128), n_step "
+      "(3), gamma (0.99), learning_rate (0.001), critic_tau (0.01), encoder (mrq, "
+      "fine or drqv2), feature_dim (50), hidden_dim (256), seed_env_steps (1000 steps of "
+      "random actions), updates_per_env_step (1), noise_start (1), noise_end (0.1), "
+      "noise_schedule_env_steps (25,000), noise_clip (0.3), "
+      "actor_preactivation_penalty (0.001), shift_pad (4), "
+      "bfloat16 (true: autocast the encoder where the CPU has AVX512-BF16 or AMX), "
+      "channels_last (true). drqv2's replay buffer is not in its checkpoints: "
+      "--resume refills it by replaying the run's env actions, which puts the "
+      "same transitions back");
   train.add_option("--steps", args.steps,
                    "Env steps to train for, all envs together; with --set action_repeat=K "
                    "each is K control steps (default: the config's total_env_steps: ppo "

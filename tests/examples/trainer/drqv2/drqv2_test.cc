@@ -270,7 +270,8 @@ TEST(DrqV2LearnerTest, EncodersLeaveTheirDocumentedGrid) {
       input_layout(pixel_space({3, 64, 64}), spaces::Box(-1.0, 1.0, Shape{1}), 3, "T-v0");
   for (const auto& [architecture, cells] :
        std::vector<std::pair<EncoderArchitecture, std::int64_t>>{
-           {EncoderArchitecture::kDrqV2, 25}, {EncoderArchitecture::kMrq, 5},
+           {EncoderArchitecture::kDrqV2, 25},
+           {EncoderArchitecture::kMrq, 5},
            {EncoderArchitecture::kFine, 11}}) {
     DrqV2Config config;
     config.encoder = architecture;

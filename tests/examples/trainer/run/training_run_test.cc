@@ -186,7 +186,7 @@ class CountingFactory final : public AlgorithmFactory {
     return std::make_unique<DownActor>();
   }
   mutable CountingAlgorithm* last = nullptr;  // the latest made (valid while its run lives)
-  int actor_sleep_ms = 0;                      // its actor's (DownActor::sleep_ms)
+  int actor_sleep_ms = 0;                     // its actor's (DownActor::sleep_ms)
 };
 
 Params integer_kwargs(const std::string&, const std::vector<std::string>& sets) {
