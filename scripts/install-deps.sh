@@ -20,6 +20,8 @@ PACKAGES=(
   # BLAS Debian's LibTorch links by default: several times faster convolutions and linear layers
   # on a CPU (see the README, Training)
   libtorch-dev libopenblas0-pthread
+  # the distributed trainer: Gloo's headers for c10d's ProcessGroupGloo (in libtorch_cpu)
+  libgloo-dev
   # command line, JSON
   libcli11-dev nlohmann-json3-dev
   # the Python binding (python/) and its pytest suite (tests/python/), for Debian's python3

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "examples/pixelgym/cli.h"
+#include "examples/trainer/distributed/gloo_communicator.h"
 #include "examples/trainer/drqv2/drqv2_algorithm.h"
 #include "examples/trainer/ppo/ppo_algorithm.h"
 #include "examples/trainer/run/atomic_file.h"
@@ -69,8 +70,28 @@ struct TrainArguments : EnvArguments {
   std::int64_t eval_every = 0;
   std::int64_t eval_every_episodes = 5;
   double eval_max_share = 0.1;
+  int nproc = 1;
+  double dist_timeout = 60.0;
   const CLI::App* command = nullptr;  // the parsed subcommand: which flags were given
 };
+
+// This process's command line without --nproc N (or --nproc=N): what each local rank runs.
+std::vector<std::string> command_line_without_nproc() {
+  std::ifstream file("/proc/self/cmdline", std::ios::binary);
+  std::vector<std::string> arguments;
+  std::string argument;
+  while (std::getline(file, argument, '\0')) arguments.push_back(argument);
+  std::vector<std::string> kept;
+  for (std::size_t i = 0; i < arguments.size(); ++i) {
+    if (arguments[i] == "--nproc") {
+      ++i;  // and its value
+      continue;
+    }
+    if (arguments[i].rfind("--nproc=", 0) == 0) continue;
+    kept.push_back(arguments[i]);
+  }
+  return kept;
+}
 
 // The settings of a new run: the flags, over the --config file's settings of the algorithm.
 trainer::RunSettings new_run_settings(const TrainArguments& args,
@@ -131,13 +152,45 @@ int run_train(const TrainArguments& args) {
         "train --resume takes the env and settings from the run's config.json: give no id, "
         "--set, --wrap, --algo, --config or --out with it");
   }
-  trainer::tune_process_for_training();
+  const bool launcher = args.nproc > 1;
+  if (launcher && std::getenv("WORLD_SIZE") != nullptr) {
+    throw UsageError(
+        "train --nproc starts its own local ranks, but WORLD_SIZE is set (a launcher such as "
+        "torchrun or srun started this process as a rank already): give one or the other");
+  }
+  // A rank of a data-parallel run started by a launcher (torchrun, srun, train --nproc).
+  std::optional<distributed::DistributedSettings> ranks =
+      launcher ? std::nullopt
+               : distributed::DistributedSettings::from_environment(args.dist_timeout);
+  const bool joins = ranks && ranks->rank > 0;
+  // Rank 0 takes the algorithm from the command line or the run folder; the others from it.
   const trainer::AlgorithmFactory& algorithm =
-      args.resume.empty() ? algorithm_named(args.algo) : algorithm_of_run(args.resume);
+      joins ? kPpo
+            : (args.resume.empty() ? algorithm_named(args.algo) : algorithm_of_run(args.resume));
+  if ((launcher || (ranks && ranks->world_size > 1)) && algorithm.name() != "ppo") {
+    throw UsageError("train --algo " + algorithm.name() +
+                     " runs in one process; data-parallel training (--nproc, WORLD_SIZE) is "
+                     "PPO's (--algo ppo)");
+  }
+  if (launcher) {
+    return distributed::run_local_ranks(args.nproc, command_line_without_nproc(), args.dist_timeout,
+                                        std::cerr);
+  }
+  trainer::tune_process_for_training();
+  std::unique_ptr<distributed::GlooCommunicator> communicator;
+  if (ranks && ranks->world_size > 1) {
+    communicator = std::make_unique<distributed::GlooCommunicator>(*ranks);
+  }
   const trainer::TrainBudget budget{args.steps, args.minutes};
-  const trainer::RunOutput output{std::cout, std::cerr,
-                                  trainer::ProgressLine::mode_for_stdout(args.quiet),
+  // Ranks other than 0 print errors only.
+  std::ostream discard(nullptr);
+  const trainer::RunOutput output{joins ? discard : std::cout, std::cerr,
+                                  trainer::ProgressLine::mode_for_stdout(args.quiet || joins),
                                   trainer::ProgressLine::stdout_columns()};
+  if (joins) {
+    trainer::TrainingRun::join(kAlgorithms, parse_sets, *communicator, output).train();
+    return 0;
+  }
   try {
     trainer::TrainingRun run =
         args.resume.empty()
@@ -147,6 +200,7 @@ int run_train(const TrainArguments& args) {
                   output)
             : trainer::TrainingRun::resume(algorithm, parse_sets, args.resume, budget,
                                            resume_checks(args), output);
+    if (communicator) run.distribute(*communicator);
     run.train();
   } catch (const trainer::RunRequestError& error) {
     throw UsageError(error.what());
@@ -199,6 +253,22 @@ void add_run_options(CLI::App& train, TrainArguments& args) {
                    "equal the run's). The envs replay the checkpoint's actions and go on "
                    "with their episodes, so with the run's --steps (the learning rate anneals "
                    "over it) the result is the run that did not stop");
+  add_checked_option(
+      train, "--nproc", args.nproc,
+      "Train data-parallel (DD-PPO) with this many local processes (ranks), as torchrun "
+      "--standalone would start them: each steps its own --num-envs envs (rank r's env i is "
+      "seeded seed + r * num_envs + i) and gradients are averaged across ranks after every "
+      "minibatch, so all hold the same parameters; rank 0 writes the run folder and "
+      "progress.csv counts every rank's env steps. Each rank gets OMP_NUM_THREADS = cores / N "
+      "unless it is set. Across machines, start `pixelgym train` (no --nproc) once per rank "
+      "with MASTER_ADDR, MASTER_PORT, WORLD_SIZE and RANK set (torchrun and srun set them). "
+      "ppo only; --resume needs the run's own count",
+      CLI::Range(1, 1024));
+  add_checked_option(train, "--dist-timeout", args.dist_timeout,
+                     "Seconds a rank of a data-parallel run may stop answering (its heartbeat "
+                     "stands still: it died, was stopped or hangs) before the others stop with "
+                     "an error naming it",
+                     CLI::Range(1.0, 86400.0));
   train.add_flag("--quiet", args.quiet,
                  "No progress bar: a plain line every 10 updates (also when stdout is not a "
                  "terminal)");

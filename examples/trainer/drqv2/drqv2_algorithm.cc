@@ -381,8 +381,14 @@ int DrqV2AlgorithmFactory::set_threads(int requested) const {
   return ppo::set_torch_threads(requested);
 }
 
-std::unique_ptr<trainer::Algorithm> DrqV2AlgorithmFactory::make(vector::VectorEnv& env,
-                                                                const json& config) const {
+std::unique_ptr<trainer::Algorithm> DrqV2AlgorithmFactory::make(
+    vector::VectorEnv& env, const json& config, trainer::Communicator* communicator) const {
+  if (communicator != nullptr && communicator->world_size() > 1) {
+    throw std::invalid_argument(
+        "train --algo drqv2 runs in one process; it was started as " +
+        std::to_string(communicator->world_size()) +
+        " ranks (--nproc or WORLD_SIZE). Data-parallel training is PPO's (--algo ppo)");
+  }
   DrqV2Config parsed;
   from_json(config, parsed);
   return std::make_unique<DrqV2Algorithm>(env, parsed);

@@ -122,8 +122,11 @@ class DrqV2AlgorithmFactory final : public trainer::AlgorithmFactory {
   nlohmann::json parse_config(const std::string& text) const override;
   /// As ppo::set_torch_threads.
   int set_threads(int requested) const override;
-  std::unique_ptr<trainer::Algorithm> make(vector::VectorEnv& env,
-                                           const nlohmann::json& config) const override;
+  /// Throws std::invalid_argument for a communicator of several ranks: DrQ-v2 trains in one
+  /// process (its replay buffer and updates are not shared across ranks).
+  std::unique_ptr<trainer::Algorithm> make(
+      vector::VectorEnv& env, const nlohmann::json& config,
+      trainer::Communicator* communicator = nullptr) const override;
   /// An Agent of the config for these spaces with the checkpoint's "agent".
   std::unique_ptr<trainer::Actor> load_actor(
       const Space& observation_space, const Space& action_space, const nlohmann::json& config,

@@ -38,6 +38,12 @@ void read_member(const nlohmann::json& json, const char* name, T& field) {
 }
 using trainer::require_known_members;
 
+// The steps after which a rollout may be preempted: ceil(fraction * num_steps), at least 1.
+std::int64_t preempt_min_steps(std::int64_t num_steps, double fraction) {
+  return std::max<std::int64_t>(
+      1, static_cast<std::int64_t>(std::ceil(fraction * static_cast<double>(num_steps) - 1e-9)));
+}
+
 }  // namespace
 
 // ---- PpoConfig -------------------------------------------------------------------------------
@@ -78,6 +84,15 @@ void PpoConfig::validate() const {
   positive("max_grad_norm", max_grad_norm);
   non_negative("target_kl", target_kl);
   if (shift_pad < 0) fail("shift_pad must be >= 0, got " + std::to_string(shift_pad));
+  unit("preempt_done_fraction", preempt_done_fraction);
+  unit("preempt_min_steps_fraction", preempt_min_steps_fraction);
+  if (preempt_stragglers && num_minibatches > 0 &&
+      preempt_min_steps(num_steps, preempt_min_steps_fraction) * num_envs < num_minibatches) {
+    fail("a rollout preempted after preempt_min_steps_fraction (" +
+         std::to_string(preempt_min_steps_fraction) + ") of num_steps has " +
+         std::to_string(preempt_min_steps(num_steps, preempt_min_steps_fraction) * num_envs) +
+         " transitions, fewer than num_minibatches (" + std::to_string(num_minibatches) + ")");
+  }
   policy.validate();
 }
 
@@ -132,6 +147,9 @@ void to_json(nlohmann::json& json, const PpoConfig& config) {
                         {"target_kl", config.target_kl},
                         {"augment", config.augment},
                         {"shift_pad", config.shift_pad},
+                        {"preempt_stragglers", config.preempt_stragglers},
+                        {"preempt_done_fraction", config.preempt_done_fraction},
+                        {"preempt_min_steps_fraction", config.preempt_min_steps_fraction},
                         {"policy", config.policy}};
 }
 
@@ -158,6 +176,9 @@ void from_json(const nlohmann::json& json, PpoConfig& config) {
                          "target_kl",
                          "augment",
                          "shift_pad",
+                         "preempt_stragglers",
+                         "preempt_done_fraction",
+                         "preempt_min_steps_fraction",
                          "policy"},
                         "PpoConfig");
   read_member(json, "seed", config.seed);
@@ -181,6 +202,9 @@ void from_json(const nlohmann::json& json, PpoConfig& config) {
   read_member(json, "target_kl", config.target_kl);
   read_member(json, "augment", config.augment);
   read_member(json, "shift_pad", config.shift_pad);
+  read_member(json, "preempt_stragglers", config.preempt_stragglers);
+  read_member(json, "preempt_done_fraction", config.preempt_done_fraction);
+  read_member(json, "preempt_min_steps_fraction", config.preempt_min_steps_fraction);
   if (auto found = json.find("policy"); found != json.end()) {
     PolicyConfig policy = config.policy;
     from_json(*found, policy);
@@ -241,7 +265,8 @@ void RolloutStorage::insert_observations(std::int64_t t, const ObservationTensor
   }
 }
 
-void RolloutStorage::compute_advantages(double gamma, double lambda) {
+void RolloutStorage::compute_advantages(double gamma, double lambda, std::int64_t steps) {
+  if (steps < 0) steps = num_steps;
   const torch::Tensor r = rewards.contiguous();
   const torch::Tensor v = values.contiguous();
   const torch::Tensor term = terminated.contiguous();
@@ -249,7 +274,7 @@ void RolloutStorage::compute_advantages(double gamma, double lambda) {
   const torch::Tensor fv = final_values.contiguous();
   const torch::Tensor lv = last_values.contiguous();
   GaeInputs in;
-  in.num_steps = num_steps;
+  in.num_steps = steps;
   in.num_envs = num_envs;
   in.rewards = r.data_ptr<float>();
   in.values = v.data_ptr<float>();
@@ -263,9 +288,12 @@ void RolloutStorage::compute_advantages(double gamma, double lambda) {
   std::memcpy(returns.data_ptr<float>(), out.returns.data(), out.returns.size() * sizeof(float));
 }
 
-ObservationTensors RolloutStorage::flat_observations() const {
+ObservationTensors RolloutStorage::flat_observations(std::int64_t steps) const {
+  if (steps < 0) steps = num_steps;
   ObservationTensors flat;
-  for (const auto& [key, stored] : observations) flat.emplace(key, stored.flatten(0, 1));
+  for (const auto& [key, stored] : observations) {
+    flat.emplace(key, stored.slice(0, 0, steps).flatten(0, 1));
+  }
   return flat;
 }
 
@@ -276,6 +304,9 @@ namespace {
 // The stats key of the trainer's own RecordEpisodeStatistics (not "episode": the env given may
 // record its own).
 const char* const kEpisodeKey = "ppo_episode";
+
+// Rank r's generators are seeded seed + r * this (and + 1): far from the seeds of other ranks.
+constexpr std::uint64_t kRankSeedStride = 1'000'003;
 
 std::shared_ptr<Policy> make_policy(const vector::VectorEnv& env, const PpoConfig& config) {
   config.validate();
@@ -296,7 +327,7 @@ std::shared_ptr<Policy> make_policy(const vector::VectorEnv& env, const PpoConfi
 
 }  // namespace
 
-Trainer::Trainer(vector::VectorEnv& env, PpoConfig config)
+Trainer::Trainer(vector::VectorEnv& env, PpoConfig config, trainer::Communicator* communicator)
     : config_(std::move(config)),
       policy_(make_policy(env, config_)),
       optimizer_(std::make_unique<torch::optim::Adam>(
@@ -315,6 +346,101 @@ Trainer::Trainer(vector::VectorEnv& env, PpoConfig config)
   episodes_ = episodes.get();
   normalizer_ =
       std::make_unique<vector::NormalizeReward>(std::move(episodes), config_.gamma, kRewardEpsilon);
+  reward_statistics_before_ = normalizer_->statistics();
+  communicator_ = communicator;
+  if (communicator_ == nullptr || communicator_->world_size() == 1) return;
+  const auto rank = static_cast<std::uint64_t>(communicator_->rank());
+  sampling_ = at::detail::createCPUGenerator(config_.seed + rank * kRankSeedStride);
+  augmentation_ = at::detail::createCPUGenerator(config_.seed + 1 + rank * kRankSeedStride);
+  // Every rank built the same weights from the same seed, but a library on another machine may
+  // round differently: rank 0's are everyone's, and the digests must then agree.
+  torch::NoGradGuard no_grad;
+  for (torch::Tensor& parameter : policy_->parameters()) {
+    torch::Tensor flat = parameter.detach().contiguous();
+    communicator_->broadcast(flat.data_ptr<float>(), static_cast<std::size_t>(flat.numel()),
+                             "the initial parameters' broadcast");
+    parameter.copy_(flat);
+  }
+  trainer::check_same_on_every_rank(*communicator_, parameter_digest(), 0);
+}
+
+std::uint64_t Trainer::env_seed() const {
+  const std::uint64_t rank =
+      communicator_ == nullptr ? 0 : static_cast<std::uint64_t>(communicator_->rank());
+  return config_.seed + rank * static_cast<std::uint64_t>(config_.num_envs);
+}
+
+std::uint64_t Trainer::parameter_digest() const {
+  std::uint64_t digest = trainer::fnv1a(nullptr, 0);
+  const auto add = [&digest](const torch::Tensor& tensor) {
+    const torch::Tensor contiguous = tensor.detach().contiguous();
+    digest = trainer::fnv1a(contiguous.data_ptr(), contiguous.nbytes(), digest);
+  };
+  for (const torch::Tensor& parameter : policy_->parameters()) add(parameter);
+  for (const torch::Tensor& buffer : policy_->buffers()) add(buffer);
+  return digest;
+}
+
+void Trainer::all_reduce(std::vector<double>& values, const std::string& what) {
+  if (communicator_ == nullptr || communicator_->world_size() == 1) return;
+  const auto start = Clock::now();
+  communicator_->all_reduce_sum(values.data(), values.size(), what);
+  collective_seconds_ += seconds_since(start);
+}
+
+void Trainer::average_gradients(const MinibatchPosition& at) {
+  if (communicator_ == nullptr || communicator_->world_size() == 1) return;
+  std::vector<torch::Tensor> gradients;
+  for (const torch::Tensor& parameter : policy_->parameters()) {
+    if (parameter.grad().defined()) gradients.push_back(parameter.grad());
+  }
+  if (gradients.empty()) return;
+  std::vector<torch::Tensor> flat;
+  flat.reserve(gradients.size());
+  for (const torch::Tensor& gradient : gradients) flat.push_back(gradient.reshape({-1}));
+  torch::Tensor buffer = torch::cat(flat).contiguous();
+  const auto start = Clock::now();
+  communicator_->all_reduce_sum(
+      buffer.data_ptr<float>(), static_cast<std::size_t>(buffer.numel()),
+      "the gradient all-reduce of update " + std::to_string(updates_ + 1) + ", epoch " +
+          std::to_string(at.epoch + 1) + ", minibatch " + std::to_string(at.minibatch + 1));
+  collective_seconds_ += seconds_since(start);
+  buffer.div_(static_cast<double>(communicator_->world_size()));
+  std::int64_t offset = 0;
+  for (torch::Tensor& gradient : gradients) {
+    const std::int64_t size = gradient.numel();
+    gradient.copy_(buffer.slice(0, offset, offset + size).view_as(gradient));
+    offset += size;
+  }
+}
+
+void Trainer::merge_statistics(
+    const std::map<std::string, wrappers::RunningStatistics>& observations,
+    const wrappers::RunningStatistics& rewards) {
+  if (communicator_ == nullptr || communicator_->world_size() == 1) return;
+  for (const auto& [key, before] : observations) {
+    wrappers::RunningStatistics merged = policy_->observation_statistics(key);
+    trainer::merge_statistics_across_ranks(*communicator_, before, merged,
+                                           "the observation statistics of \"" + key + "\"");
+    policy_->set_observation_statistics(key, merged);
+  }
+  if (!config_.normalize_rewards) return;
+  wrappers::RunningStatistics merged = normalizer_->statistics();
+  trainer::merge_statistics_across_ranks(*communicator_, rewards, merged,
+                                         "the reward scaling's statistics");
+  normalizer_->set_statistics(merged);
+  reward_statistics_before_ = std::move(merged);
+}
+
+bool Trainer::preempted(std::int64_t steps_done) {
+  if (!config_.preempt_stragglers || communicator_ == nullptr || communicator_->world_size() == 1 ||
+      steps_done >= config_.num_steps ||
+      steps_done < preempt_min_steps(config_.num_steps, config_.preempt_min_steps_fraction)) {
+    return false;
+  }
+  const auto needed = static_cast<int>(
+      std::ceil(config_.preempt_done_fraction * communicator_->world_size() - 1e-9));
+  return communicator_->rollouts_done(updates_) >= std::max(needed, 1);
 }
 
 vector::VectorEnv& Trainer::stepped() {
@@ -341,7 +467,11 @@ void Trainer::replay_env(const std::string& env_action_log) {
   }
   Array& env_actions = actions_.array();
   const std::size_t batch_bytes = env_actions.nbytes();
-  const auto batches = static_cast<std::size_t>(env_steps_ / config_.num_envs);
+  // Distributed, a rank's own steps are not env_steps_ (every rank's), nor its share when
+  // stragglers were preempted: its log holds whole batches.
+  const bool distributed = communicator_ != nullptr && communicator_->world_size() > 1;
+  const auto batches = distributed ? env_action_log.size() / batch_bytes
+                                   : static_cast<std::size_t>(env_steps_ / config_.num_envs);
   if (env_action_log.size() != batches * batch_bytes) {
     throw std::invalid_argument("Trainer::replay_env: an action log of " + std::to_string(batches) +
                                 " batches of " + std::to_string(batch_bytes) + " bytes (" +
@@ -351,28 +481,27 @@ void Trainer::replay_env(const std::string& env_action_log) {
   }
   torch::NoGradGuard no_grad;
   // Below the reward normalization, whose state comes from the checkpoint.
-  current_obs_ = observation_tensors(episodes_->reset(config_.seed).obs);
+  current_obs_ = observation_tensors(episodes_->reset(env_seed()).obs);
   started_ = true;
   for (std::size_t b = 0; b < batches; ++b) {
     std::memcpy(env_actions.raw_data(), env_action_log.data() + b * batch_bytes, batch_bytes);
     current_obs_ = observation_tensors(episodes_->step(actions_).obs);
   }
   env_action_log_ = env_action_log;
+  log_from_start_ = true;
 }
 
 bool Trainer::env_action_log_complete() const {
+  if (communicator_ != nullptr && communicator_->world_size() > 1) return log_from_start_;
   const auto batches = static_cast<std::size_t>(env_steps_ / config_.num_envs);
   return env_action_log_.size() == batches * actions_.array().nbytes();
 }
 
 std::uint64_t Trainer::env_digest() const {
   if (!started_) return 0;
-  std::uint64_t digest = 14695981039346656037ULL;  // FNV-1a, 64-bit
+  std::uint64_t digest = trainer::fnv1a(nullptr, 0);
   const auto add = [&digest](const void* data, std::size_t size) {
-    const auto* bytes = static_cast<const unsigned char*>(data);
-    for (std::size_t k = 0; k < size; ++k) {
-      digest = (digest ^ bytes[k]) * 1099511628211ULL;
-    }
+    digest = trainer::fnv1a(data, size, digest);
   };
   for (const auto& [key, tensor] : current_obs_) {  // std::map: in key order
     add(key.data(), key.size());
@@ -391,13 +520,15 @@ RolloutStats Trainer::collect() {
   RolloutStats stats;
   if (!started_) {
     const auto start = Clock::now();
-    current_obs_ = observation_tensors(stepped().reset(config_.seed).obs);
+    current_obs_ = observation_tensors(stepped().reset(env_seed()).obs);
     stats.env_seconds += seconds_since(start);
     started_ = true;
   }
   Array& env_actions = actions_.array();
   const std::int64_t envs = config_.num_envs;
-  for (std::int64_t t = 0; t < config_.num_steps; ++t) {
+  std::int64_t steps = 0;
+  for (std::int64_t t = 0; t < config_.num_steps && !preempted(t); ++t) {
+    steps = t + 1;
     auto start = Clock::now();
     const ActResult act = policy_->act(current_obs_, /*deterministic=*/false, sampling_);
     stats.policy_seconds += seconds_since(start);
@@ -450,8 +581,15 @@ RolloutStats Trainer::collect() {
   const auto start = Clock::now();
   storage_.last_values.copy_(policy_->value(current_obs_));
   stats.policy_seconds += seconds_since(start);
-  storage_.compute_advantages(config_.gamma, config_.gae_lambda);
-  env_steps_ += config_.num_steps * envs;
+  storage_.compute_advantages(config_.gamma, config_.gae_lambda, steps);
+  collected_steps_ = steps;
+  std::vector<double> rollout_steps{static_cast<double>(steps * envs)};
+  if (config_.preempt_stragglers && communicator_ != nullptr) {
+    communicator_->mark_rollout_done(updates_);
+  }
+  all_reduce(rollout_steps, "the rollout's step count");
+  last_rollout_steps_ = static_cast<std::int64_t>(std::llround(rollout_steps[0]));
+  env_steps_ += last_rollout_steps_;
   collected_ = true;
   return stats;
 }
@@ -459,8 +597,7 @@ RolloutStats Trainer::collect() {
 double Trainer::learning_rate() const {
   if (!config_.anneal_learning_rate) return config_.learning_rate;
   // The steps done before the rollout being learned from: the first update uses the full rate.
-  const std::int64_t before =
-      collected_ ? env_steps_ - config_.num_steps * config_.num_envs : env_steps_;
+  const std::int64_t before = collected_ ? env_steps_ - last_rollout_steps_ : env_steps_;
   const double remaining =
       1.0 - static_cast<double>(before) / static_cast<double>(config_.total_env_steps);
   return config_.learning_rate * std::max(remaining, 0.0);
@@ -468,14 +605,15 @@ double Trainer::learning_rate() const {
 
 Trainer::UpdateBatch Trainer::update_batch() {
   UpdateBatch batch;
-  batch.size = config_.num_steps * config_.num_envs;
+  const std::int64_t steps = collected_steps_;
+  batch.size = steps * config_.num_envs;
   batch.minibatch = batch.size / config_.num_minibatches;
-  batch.obs = storage_.flat_observations();
-  batch.actions = storage_.actions.flatten(0, 1);
-  batch.old_log_probs = storage_.log_probs.flatten(0, 1);
-  batch.old_values = storage_.values.flatten(0, 1);
-  batch.advantages = storage_.advantages.flatten(0, 1);
-  batch.returns = storage_.returns.flatten(0, 1);
+  batch.obs = storage_.flat_observations(steps);
+  batch.actions = storage_.actions.slice(0, 0, steps).flatten(0, 1);
+  batch.old_log_probs = storage_.log_probs.slice(0, 0, steps).flatten(0, 1);
+  batch.old_values = storage_.values.slice(0, 0, steps).flatten(0, 1);
+  batch.advantages = storage_.advantages.slice(0, 0, steps).flatten(0, 1);
+  batch.returns = storage_.returns.slice(0, 0, steps).flatten(0, 1);
   if (!config_.augment) return batch;
   batch.shifts =
       torch::randint(0, 2 * config_.shift_pad + 1, {batch.size, 2}, augmentation_, torch::kInt64);
@@ -484,7 +622,8 @@ Trainer::UpdateBatch Trainer::update_batch() {
   batch.old_log_probs = torch::empty_like(batch.old_log_probs);
   batch.old_values = torch::empty_like(batch.old_values);
   for (std::int64_t begin = 0; begin < batch.size; begin += batch.minibatch) {
-    const torch::Tensor index = torch::arange(begin, begin + batch.minibatch, torch::kInt64);
+    const torch::Tensor index =
+        torch::arange(begin, std::min(begin + batch.minibatch, batch.size), torch::kInt64);
     const Evaluation old =
         policy_->evaluate(select_rows(batch.obs, index), batch.actions.index_select(0, index),
                           batch.shifts.index_select(0, index), config_.shift_pad);
@@ -506,6 +645,7 @@ torch::Tensor Trainer::value_loss(const UpdateBatch& batch, const torch::Tensor&
 double Trainer::step_optimizer(const torch::Tensor& loss, double checked_loss,
                                const std::string& losses, const MinibatchPosition& at) {
   loss.backward();
+  average_gradients(at);
   const double grad_norm =
       torch::nn::utils::clip_grad_norm_(policy_->parameters(), config_.max_grad_norm);
   if (!std::isfinite(checked_loss) || !std::isfinite(grad_norm)) {
@@ -545,8 +685,24 @@ double Trainer::step_minibatch(const UpdateBatch& batch, const torch::Tensor& in
   const torch::Tensor log_ratio = now.log_prob - batch.old_log_probs.index_select(0, index);
   const torch::Tensor ratio = log_ratio.exp();
   torch::Tensor advantage = batch.advantages.index_select(0, index);
-  if (config_.normalize_advantages && batch.minibatch > 1) {
-    advantage = (advantage - advantage.mean()) / (advantage.std() + 1e-8);
+  if (config_.normalize_advantages) {
+    if (communicator_ == nullptr || communicator_->world_size() == 1) {
+      if (advantage.size(0) > 1) {
+        advantage = (advantage - advantage.mean()) / (advantage.std() + 1e-8);
+      }
+    } else {
+      // The mean and (unbiased) standard deviation of every rank's minibatch together.
+      const torch::Tensor wide = advantage.to(torch::kFloat64);
+      std::vector<double> moments{static_cast<double>(advantage.size(0)), wide.sum().item<double>(),
+                                  wide.pow(2).sum().item<double>()};
+      all_reduce(moments, "the advantages' moments");
+      if (moments[0] > 1.0) {
+        const double mean = moments[1] / moments[0];
+        const double var =
+            std::max(moments[2] - moments[0] * mean * mean, 0.0) / (moments[0] - 1.0);
+        advantage = (advantage - mean) / (std::sqrt(var) + 1e-8);
+      }
+    }
   }
   const torch::Tensor policy_loss =
       torch::max(-advantage * ratio,
@@ -582,6 +738,7 @@ double Trainer::step_minibatch(const UpdateBatch& batch, const torch::Tensor& in
 UpdateStats Trainer::update() {
   if (!collected_) throw std::logic_error("Trainer::update: no rollout collected since the last");
   UpdateStats stats;
+  collective_seconds_ = 0.0;
   stats.learning_rate = learning_rate();
   for (auto& group : optimizer_->param_groups()) {
     static_cast<torch::optim::AdamOptions&>(group.options()).lr(stats.learning_rate);
@@ -594,18 +751,33 @@ UpdateStats Trainer::update() {
   bool stop = false;
   for (std::int64_t epoch = 0; epoch < config_.update_epochs && !(stop && !value_after_stop);
        ++epoch) {
-    const torch::Tensor order = torch::randperm(batch.size, sampling_, torch::kInt64);
+    const torch::Tensor order = minibatch_order_
+                                    ? minibatch_order_(epoch, batch.size)
+                                    : torch::randperm(batch.size, sampling_, torch::kInt64);
+    if (order.dim() != 1 || order.size(0) != batch.size) {
+      throw std::invalid_argument("Trainer::update: the minibatch order of epoch " +
+                                  std::to_string(epoch) + " must be a permutation of " +
+                                  std::to_string(batch.size) + " indices");
+    }
     std::int64_t policy_steps_in_epoch = 0;
     for (std::int64_t m = 0; m < config_.num_minibatches; ++m) {
-      const torch::Tensor index = order.slice(0, m * batch.minibatch, (m + 1) * batch.minibatch);
+      // Near-equal slices when a preempted rollout is not a multiple of num_minibatches.
+      const torch::Tensor index = order.slice(0, m * batch.size / config_.num_minibatches,
+                                              (m + 1) * batch.size / config_.num_minibatches);
       const MinibatchPosition at{epoch, m};
       if (stop) {
         step_value_only(batch, index, at);
         stats.value_minibatches += 1;
         continue;
       }
-      const double approx_kl = step_minibatch(batch, index, at, stats);
+      double approx_kl = step_minibatch(batch, index, at, stats);
       policy_steps_in_epoch += 1;
+      if (config_.target_kl > 0.0 && communicator_ != nullptr) {
+        // Every rank must stop at the same minibatch: the mean KL over the ranks decides.
+        std::vector<double> kl{approx_kl};
+        all_reduce(kl, "the approximate KL");
+        approx_kl = kl[0] / communicator_->world_size();
+      }
       if (config_.target_kl > 0.0 && approx_kl > config_.target_kl) {
         stop = true;
         if (!value_after_stop) break;
@@ -614,13 +786,25 @@ UpdateStats Trainer::update() {
     if (policy_steps_in_epoch > 0) stats.epochs += 1;
   }
   finish_update_stats(stats);
+  std::map<std::string, wrappers::RunningStatistics> observations_before;
+  if (communicator_ != nullptr && policy_->config().normalize_observations) {
+    for (const PolicyInput& input : policy_->inputs()) {
+      try {
+        observations_before.emplace(input.key, policy_->observation_statistics(input.key));
+      } catch (const std::out_of_range&) {
+        // An image key: not normalized.
+      }
+    }
+  }
   policy_->update_observation_statistics(batch.obs);
+  merge_statistics(observations_before, reward_statistics_before_);
+  stats.allreduce_seconds = collective_seconds_;
   updates_ += 1;
   collected_ = false;
   return stats;
 }
 
-void Trainer::finish_update_stats(UpdateStats& stats) const {
+void Trainer::finish_update_stats(UpdateStats& stats) {
   const auto count = static_cast<double>(stats.minibatches);
   stats.policy_loss /= count;
   stats.value_loss /= count;
@@ -628,12 +812,32 @@ void Trainer::finish_update_stats(UpdateStats& stats) const {
   stats.approx_kl /= count;
   stats.clip_fraction /= count;
   stats.grad_norm /= count;
-  const torch::Tensor values = storage_.values.flatten();
-  const torch::Tensor targets = storage_.returns.flatten();
-  const double variance = targets.var(/*unbiased=*/false).item<double>();
-  stats.explained_variance =
-      variance == 0.0 ? 0.0
-                      : 1.0 - (targets - values).var(/*unbiased=*/false).item<double>() / variance;
+  const torch::Tensor values = storage_.values.slice(0, 0, collected_steps_).flatten();
+  const torch::Tensor targets =
+      storage_.returns.slice(0, 0, collected_steps_).flatten().to(torch::kFloat64);
+  const torch::Tensor errors = targets - values.to(torch::kFloat64);
+  // Sums, so that a distributed update reports the figures of every rank's transitions.
+  std::vector<double> sums{stats.policy_loss,
+                           stats.value_loss,
+                           stats.entropy,
+                           stats.approx_kl,
+                           stats.clip_fraction,
+                           static_cast<double>(targets.numel()),
+                           targets.sum().item<double>(),
+                           targets.pow(2).sum().item<double>(),
+                           errors.sum().item<double>(),
+                           errors.pow(2).sum().item<double>()};
+  all_reduce(sums, "the update's statistics");
+  const double ranks = communicator_ == nullptr ? 1.0 : communicator_->world_size();
+  stats.policy_loss = sums[0] / ranks;
+  stats.value_loss = sums[1] / ranks;
+  stats.entropy = sums[2] / ranks;
+  stats.approx_kl = sums[3] / ranks;
+  stats.clip_fraction = sums[4] / ranks;
+  const double n = sums[5];
+  const double variance = sums[7] / n - (sums[6] / n) * (sums[6] / n);
+  const double error_variance = sums[9] / n - (sums[8] / n) * (sums[8] / n);
+  stats.explained_variance = variance <= 0.0 ? 0.0 : 1.0 - error_variance / variance;
 }
 
 void Trainer::set_progress(std::int64_t env_steps, std::int64_t updates) {
@@ -642,6 +846,32 @@ void Trainer::set_progress(std::int64_t env_steps, std::int64_t updates) {
   }
   env_steps_ = env_steps;
   updates_ = updates;
+  log_from_start_ = env_steps == 0 && env_action_log_.empty();
+}
+
+void Trainer::load_rollout(const RolloutStorage& rollout) {
+  if (rollout.num_steps != config_.num_steps || rollout.num_envs != config_.num_envs) {
+    throw std::invalid_argument(
+        "Trainer::load_rollout: a rollout of " + std::to_string(config_.num_steps) + " x " +
+        std::to_string(config_.num_envs) + " expected, got " + std::to_string(rollout.num_steps) +
+        " x " + std::to_string(rollout.num_envs));
+  }
+  for (auto& [key, stored] : storage_.observations) stored.copy_(rollout.observations.at(key));
+  storage_.actions.copy_(rollout.actions);
+  storage_.log_probs.copy_(rollout.log_probs);
+  storage_.values.copy_(rollout.values);
+  storage_.rewards.copy_(rollout.rewards);
+  storage_.terminated.copy_(rollout.terminated);
+  storage_.truncated.copy_(rollout.truncated);
+  storage_.final_values.copy_(rollout.final_values);
+  storage_.last_values.copy_(rollout.last_values);
+  storage_.advantages.copy_(rollout.advantages);
+  storage_.returns.copy_(rollout.returns);
+  collected_steps_ = config_.num_steps;
+  const std::int64_t ranks = communicator_ == nullptr ? 1 : communicator_->world_size();
+  last_rollout_steps_ = config_.num_steps * config_.num_envs * ranks;
+  env_steps_ += last_rollout_steps_;
+  collected_ = true;
 }
 
 RewardScaling Trainer::reward_scaling() const {
@@ -664,6 +894,7 @@ void Trainer::set_reward_scaling(RewardScaling scaling) {
                                   std::to_string(r));
     }
   }
+  reward_statistics_before_ = scaling.statistics;
   normalizer_->set_statistics(std::move(scaling.statistics));
   normalizer_->set_discounted_returns(std::move(scaling.returns));
 }

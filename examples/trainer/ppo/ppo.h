@@ -5,6 +5,8 @@
 #include <torch/torch.h>
 
 #include <cstdint>
+#include <functional>
+#include <map>
 #include <memory>
 #include <nlohmann/json_fwd.hpp>
 #include <string>
@@ -12,6 +14,7 @@
 
 #include "envs/vector/vector_env.h"
 #include "examples/trainer/ppo/policy.h"
+#include "examples/trainer/run/communicator.h"
 #include "wrappers/running_statistics.h"
 #include "wrappers/vector/normalize_reward.h"
 #include "wrappers/vector/record_episode_statistics.h"
@@ -72,6 +75,13 @@ struct PpoConfig {
   /// shift_pad pixels each way.
   bool augment = false;
   std::int64_t shift_pad = 4;
+  /// Straggler preemption in a distributed run, as DD-PPO (Wijmans et al. 2020) does it: once
+  /// preempt_done_fraction of the ranks have finished their rollout, a rank that has collected
+  /// at least preempt_min_steps_fraction of its num_steps stops its rollout there and learns
+  /// from the shorter one (DD-PPO's 0.6 and 0.25). Off by default; does nothing in one process.
+  bool preempt_stragglers = false;
+  double preempt_done_fraction = 0.6;
+  double preempt_min_steps_fraction = 0.25;
   /// The network, and the observation normalization of the vector keys
   /// (policy.normalize_observations, policy.observation_clip).
   PolicyConfig policy;
@@ -124,10 +134,12 @@ struct RolloutStorage {
 
   /// Copies a batch of N observations (as observation_tensors gives) into step t.
   void insert_observations(std::int64_t t, const ObservationTensors& obs);
-  /// compute_gae over the stored rollout into advantages and returns.
-  void compute_advantages(double gamma, double lambda);
-  /// Every stored observation flattened to (T N, *shape), sharing memory.
-  ObservationTensors flat_observations() const;
+  /// compute_gae over the first `steps` stored steps (all num_steps when < 0) into advantages
+  /// and returns; last_values must then be V(s_steps).
+  void compute_advantages(double gamma, double lambda, std::int64_t steps = -1);
+  /// The stored observations of the first `steps` steps (all num_steps when < 0) flattened to
+  /// (steps N, *shape), sharing memory.
+  ObservationTensors flat_observations(std::int64_t steps = -1) const;
 };
 
 /// What an update did, averaged over the minibatches it ran (CleanRL's logged quantities).
@@ -144,6 +156,9 @@ struct UpdateStats {
   std::int64_t minibatches = 0;     // minibatches run (the losses above are their means)
   /// Minibatches of the value network alone after a target_kl stop (separate_value_network).
   std::int64_t value_minibatches = 0;
+  /// Distributed: seconds of the update spent in collective operations (the gradients'
+  /// all-reduces and the few small ones), waiting for the other ranks included; 0 alone.
+  double allreduce_seconds = 0.0;
 };
 
 /// An episode that ended during a rollout: the sum of the rewards the trainer was given (after
@@ -202,11 +217,27 @@ struct RewardScaling {
 /// Observation normalization: after each update the rollout's observations are merged into
 /// the policy's statistics (Policy::update_observation_statistics), so the next rollout acts
 /// and learns with the same statistics.
+///
+/// Data-parallel training (DD-PPO, Wijmans et al. 2020), with a `communicator` of world size W:
+/// each rank steps its own envs (rank r's env i resets with seed + r num_envs + i, so no two
+/// ranks share an env seed; its sampling and augmentation generators are seeded with
+/// seed + r 1,000,003 and seed + 1 + r 1,000,003) and learns from its own rollout, and the ranks
+/// stay identical: rank 0's parameters and buffers are broadcast at construction; every
+/// minibatch's gradients are averaged across ranks (one all-reduce of all of them, before
+/// clipping), its advantages standardized with the mean and standard deviation of every rank's
+/// minibatch together, and the KL stop decided on the ranks' mean KL; after each update the
+/// observation statistics and the reward scaling's statistics take in every rank's samples
+/// (merge_statistics_across_ranks). A minibatch is num_steps num_envs / num_minibatches
+/// transitions of each rank, so an update of W ranks of N envs is the update of one process of
+/// W N envs over the same transitions, up to rounding. env_steps() counts every rank's steps;
+/// the learning rate anneals over them. Each rank's episode records are its own.
 class Trainer {
  public:
   /// Throws std::invalid_argument when config.validate() fails, when the env's autoreset mode
   /// is not SameStep or its num_envs differs from config.num_envs, and as Policy's constructor.
-  Trainer(vector::VectorEnv& env, PpoConfig config);
+  /// `communicator` (null: one process) must outlive the trainer; every rank must construct its
+  /// trainer with the same config.
+  Trainer(vector::VectorEnv& env, PpoConfig config, trainer::Communicator* communicator = nullptr);
 
   /// Steps every env num_steps times with actions sampled from the policy (no gradients),
   /// storing the transitions and the values GAE needs, then computes advantages and returns.
@@ -221,6 +252,22 @@ class Trainer {
   /// epoch and minibatch, the losses and the gradient norm) when a minibatch's loss or gradient
   /// norm is not finite; that minibatch's step is not taken.
   UpdateStats update();
+
+  /// The order in which an update visits the rollout's transitions in `epoch` (a permutation of
+  /// 0 .. size - 1, int64, over this rank's flattened rollout, step-major: index t N + n); absent:
+  /// torch::randperm from the sampling generator.
+  using MinibatchOrder = std::function<torch::Tensor(std::int64_t epoch, std::int64_t size)>;
+  /// Replaces the minibatch order (tests and comparisons of runs: see Trainer's data-parallel
+  /// note); an empty function restores the default.
+  void set_minibatch_order(MinibatchOrder order) { minibatch_order_ = std::move(order); }
+  /// Learns from `rollout` (as collect() leaves the storage: advantages and returns computed,
+  /// num_steps x num_envs) at the next update() instead of a collected one; counts its steps
+  /// (of every rank) as collected. For comparisons of updates on one rollout.
+  void load_rollout(const RolloutStorage& rollout);
+
+  /// A 64-bit digest (FNV-1a) of the policy's parameters and buffers, in their order: equal on
+  /// every rank of a distributed run.
+  std::uint64_t parameter_digest() const;
 
   Policy& policy() { return *policy_; }
   const std::shared_ptr<Policy>& policy_ptr() const { return policy_; }
@@ -297,9 +344,20 @@ class Trainer {
   double step_minibatch(const UpdateBatch& batch, const torch::Tensor& index,
                         const MinibatchPosition& at, UpdateStats& stats);
   // Averages the sums over the minibatches; the explained variance of the rollout.
-  void finish_update_stats(UpdateStats& stats) const;
+  void finish_update_stats(UpdateStats& stats);
   // The env the trainer steps: normalizer_ when it normalizes rewards, else episodes_.
   vector::VectorEnv& stepped();
+  // This rank's env seed (config seed + rank num_envs).
+  std::uint64_t env_seed() const;
+  // Distributed: sums `value` over the ranks (one all-reduce); alone: `value`.
+  void all_reduce(std::vector<double>& values, const std::string& what);
+  // Distributed: averages every defined gradient over the ranks.
+  void average_gradients(const MinibatchPosition& at);
+  // Distributed: the observation and reward statistics take in every rank's samples.
+  void merge_statistics(const std::map<std::string, wrappers::RunningStatistics>& observations,
+                        const wrappers::RunningStatistics& rewards);
+  // Whether a rollout at step `t` (steps done t + 1) should stop as a straggler.
+  bool preempted(std::int64_t steps_done);
   // Appends the episodes that `step` ended (episodes_'s infos) to `ended`.
   void add_ended_episodes(const vector::VectorStepResult& step, std::vector<Episode>& ended) const;
 
@@ -315,6 +373,13 @@ class Trainer {
   Value actions_;                   // laid out as env_.action_space()
   ObservationTensors current_obs_;  // views of the env's observation batch
   std::string env_action_log_;
+  trainer::Communicator* communicator_ = nullptr;
+  MinibatchOrder minibatch_order_;
+  std::int64_t collected_steps_ = 0;     // steps per env of the last rollout (<= num_steps)
+  std::int64_t last_rollout_steps_ = 0;  // env steps of every rank in the last rollout
+  bool log_from_start_ = true;           // env_action_log_ goes back to the first reset
+  double collective_seconds_ = 0.0;      // in collectives during the current update
+  wrappers::RunningStatistics reward_statistics_before_;  // as of the last update (distributed)
   bool started_ = false;
   bool collected_ = false;
   std::int64_t env_steps_ = 0;

@@ -61,8 +61,13 @@ ActCounts PpoActor::act(const Value& observations, bool deterministic, Value& ac
   return counts;
 }
 
-PpoAlgorithm::PpoAlgorithm(vector::VectorEnv& env, PpoConfig config)
-    : trainer_(env, std::move(config)), actor_(trainer_.policy_ptr()) {}
+PpoAlgorithm::PpoAlgorithm(vector::VectorEnv& env, PpoConfig config,
+                           trainer::Communicator* communicator)
+    : trainer_(env, std::move(config), communicator), actor_(trainer_.policy_ptr()) {}
+
+std::vector<std::string> PpoAlgorithm::rank_blobs() const {
+  return {"rng_sampling", "rng_augmentation"};
+}
 
 IterationStats PpoAlgorithm::iterate() {
   const RolloutStats rollout = trainer_.collect();
@@ -84,7 +89,8 @@ IterationStats PpoAlgorithm::iterate() {
                  {"learning_rate", update.learning_rate},
                  {"env_s", rollout.env_seconds},
                  {"act_s", rollout.policy_seconds},
-                 {"update_s", update_s}};
+                 {"update_s", update_s},
+                 {"allreduce_s", update.allreduce_seconds}};
   return stats;
 }
 
@@ -93,7 +99,8 @@ void PpoAlgorithm::set_progress(std::int64_t env_steps, std::int64_t updates) {
 }
 
 std::vector<std::string> PpoAlgorithm::progress_columns() const {
-  return {"explained_variance", "grad_norm", "learning_rate", "env_s", "act_s", "update_s"};
+  return {"explained_variance", "grad_norm",  "learning_rate", "env_s", "act_s",
+          "update_s",           "allreduce_s"};
 }
 
 void PpoAlgorithm::save(CheckpointBlobs& blobs, json& meta) {
@@ -148,9 +155,9 @@ int set_torch_threads(int requested) {
   return torch::get_num_threads();
 }
 
-std::unique_ptr<Algorithm> PpoAlgorithmFactory::make(vector::VectorEnv& env,
-                                                     const json& config) const {
-  return std::make_unique<PpoAlgorithm>(env, config_from_json(config.dump()));
+std::unique_ptr<Algorithm> PpoAlgorithmFactory::make(vector::VectorEnv& env, const json& config,
+                                                     trainer::Communicator* communicator) const {
+  return std::make_unique<PpoAlgorithm>(env, config_from_json(config.dump()), communicator);
 }
 
 std::unique_ptr<Actor> PpoAlgorithmFactory::load_actor(const Space& observation_space,

@@ -32,11 +32,14 @@ class PpoActor final : public trainer::Actor {
 /// "reward_scaling" {"mean", "var", "count", "returns"} (RewardScaling; JSON numbers keep a
 /// double exactly). progress.csv's extra columns: explained_variance, grad_norm, learning_rate,
 /// and where the iteration's time went: env_s in the vector env's step/reset, act_s in the
-/// policy's forward passes while collecting, update_s in the PPO epochs.
+/// policy's forward passes while collecting, update_s in the PPO epochs, and allreduce_s the part
+/// of update_s spent in the collectives of a distributed run (UpdateStats::allreduce_seconds; 0
+/// in one process).
 class PpoAlgorithm final : public trainer::Algorithm {
  public:
   /// Throws as Trainer's constructor.
-  PpoAlgorithm(vector::VectorEnv& env, PpoConfig config);
+  PpoAlgorithm(vector::VectorEnv& env, PpoConfig config,
+               trainer::Communicator* communicator = nullptr);
 
   trainer::IterationStats iterate() override;
   std::int64_t env_steps() const override { return trainer_.env_steps(); }
@@ -50,6 +53,10 @@ class PpoAlgorithm final : public trainer::Algorithm {
   void replay_env(const std::string& env_action_log) override;
   std::uint64_t env_digest() const override { return trainer_.env_digest(); }
   trainer::Actor& actor() override { return actor_; }
+  std::uint64_t parameter_digest() const override { return trainer_.parameter_digest(); }
+  /// The generators' states: "rng_sampling", "rng_augmentation" (the reward scaling's
+  /// discounted returns, per env, are in each rank's meta).
+  std::vector<std::string> rank_blobs() const override;
 
   Trainer& trainer() { return trainer_; }
 
@@ -70,8 +77,10 @@ class PpoAlgorithmFactory final : public trainer::AlgorithmFactory {
   nlohmann::json parse_config(const std::string& text) const override;
   /// set_torch_threads.
   int set_threads(int requested) const override;
-  std::unique_ptr<trainer::Algorithm> make(vector::VectorEnv& env,
-                                           const nlohmann::json& config) const override;
+  /// Trains distributed (see Trainer) with a communicator of several ranks.
+  std::unique_ptr<trainer::Algorithm> make(
+      vector::VectorEnv& env, const nlohmann::json& config,
+      trainer::Communicator* communicator = nullptr) const override;
   /// A Policy of config["policy"] with the checkpoint's "model", in eval mode.
   std::unique_ptr<trainer::Actor> load_actor(
       const Space& observation_space, const Space& action_space, const nlohmann::json& config,

@@ -14,6 +14,7 @@
 #include "envs/value.h"
 #include "envs/vector/vector_env.h"
 #include "examples/trainer/run/checkpoint_file.h"
+#include "examples/trainer/run/communicator.h"
 #include "examples/trainer/run/progress_csv.h"
 
 namespace pixelgym::trainer {
@@ -96,6 +97,15 @@ class Algorithm {
 
   /// The policy as trained so far, for evaluation.
   virtual Actor& actor() = 0;
+
+  /// A digest of the parameters (and buffers) learned, equal on every rank of a distributed run
+  /// after every update; 0 when the algorithm has none to give.
+  virtual std::uint64_t parameter_digest() const { return 0; }
+  /// The blobs of save() that belong to one rank of a distributed run (its generators, ...);
+  /// the others (parameters, optimizer state) are the same on every rank. A distributed
+  /// checkpoint keeps rank 0's blobs and, for every other rank r, these blobs and its meta as
+  /// "rank{r}.{name}" and "rank{r}.meta".
+  virtual std::vector<std::string> rank_blobs() const { return {}; }
 };
 
 /// An algorithm's kind: its config, and how to build it to train or to act. Implemented once per
@@ -116,10 +126,11 @@ class AlgorithmFactory {
   /// default; returns the count in use.
   virtual int set_threads(int requested) const = 0;
   /// The algorithm, to train on `env` (SameStep autoreset, config["num_envs"] envs) with
-  /// `config` (as parse_config gives it). Throws std::invalid_argument for an env it cannot
-  /// train on.
-  virtual std::unique_ptr<Algorithm> make(vector::VectorEnv& env,
-                                          const nlohmann::json& config) const = 0;
+  /// `config` (as parse_config gives it), as one rank of `communicator`'s run (null: a single
+  /// process; it must outlive the algorithm). Throws std::invalid_argument for an env it cannot
+  /// train on, or a communicator of several ranks when it does not train distributed.
+  virtual std::unique_ptr<Algorithm> make(vector::VectorEnv& env, const nlohmann::json& config,
+                                          Communicator* communicator = nullptr) const = 0;
   /// The policy saved in `checkpoint`, for an env of these spaces, to act only. Throws
   /// std::runtime_error naming checkpoint.path when a blob it needs is not there.
   virtual std::unique_ptr<Actor> load_actor(const Space& observation_space,

@@ -117,6 +117,53 @@ class Reader {
 
 }  // namespace
 
+std::string pack_blobs(const CheckpointBlobs& blobs) {
+  std::string out;
+  const auto put = [&out](std::uint64_t value) {
+    for (int b = 0; b < 8; ++b) out.push_back(static_cast<char>((value >> (8 * b)) & 0xFF));
+  };
+  put(blobs.size());
+  for (const auto& [name, bytes] : blobs) {
+    put(name.size());
+    out += name;
+    put(bytes.size());
+    out += bytes;
+  }
+  return out;
+}
+
+CheckpointBlobs unpack_blobs(const std::string& bytes, const std::string& source) {
+  std::size_t at = 0;
+  const auto fail = [&]() -> std::runtime_error {
+    return std::runtime_error(source + ": not a packed set of blobs (" +
+                              std::to_string(bytes.size()) + " bytes, malformed at byte " +
+                              std::to_string(at) + ")");
+  };
+  const auto get = [&]() {
+    if (bytes.size() - at < 8) throw fail();
+    std::uint64_t value = 0;
+    for (int b = 0; b < 8; ++b) {
+      value |= static_cast<std::uint64_t>(static_cast<unsigned char>(bytes[at + b])) << (8 * b);
+    }
+    at += 8;
+    return value;
+  };
+  const auto take = [&](std::uint64_t size) {
+    if (bytes.size() - at < size) throw fail();
+    std::string part = bytes.substr(at, size);
+    at += size;
+    return part;
+  };
+  CheckpointBlobs blobs;
+  const std::uint64_t count = get();
+  for (std::uint64_t i = 0; i < count; ++i) {
+    std::string name = take(get());
+    blobs[std::move(name)] = take(get());
+  }
+  if (at != bytes.size()) throw fail();
+  return blobs;
+}
+
 void write_checkpoint(const fs::path& path, const CheckpointBlobs& blobs) {
   if (blobs.empty()) {
     throw std::invalid_argument("write_checkpoint: " + path.string() +

@@ -30,6 +30,11 @@ inline constexpr std::uint32_t kCheckpointFormatVersion = 1;
 /// "write_checkpoint: cannot write {path}: {reason}" when the file cannot be written.
 void write_checkpoint(const std::filesystem::path& path, const CheckpointBlobs& blobs);
 
+/// `blobs` as one string (u64 count, then per blob u64 name length, name, u64 size, bytes;
+/// little-endian), to send between processes, and back. unpack_blobs throws std::runtime_error
+/// naming `source` for bytes that are not such a string.
+std::string pack_blobs(const CheckpointBlobs& blobs);
+CheckpointBlobs unpack_blobs(const std::string& bytes, const std::string& source);
 /// Reads a checkpoint written by write_checkpoint, all or nothing. Throws std::runtime_error
 /// "read_checkpoint: {path}: ..." naming what was expected and what was found when the file
 /// cannot be read, is shorter than its table says (truncated), longer (trailing bytes), has a

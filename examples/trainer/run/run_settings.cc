@@ -34,6 +34,7 @@ json settings_to_json(const RunSettings& settings) {
   out["eval_every"] = settings.eval_every;
   out["eval_every_episodes"] = settings.eval_every_episodes;
   out["eval_max_share"] = settings.eval_max_share;
+  if (settings.world_size > 1) out["world_size"] = settings.world_size;
   out[settings.algorithm] = settings.algorithm_config;
   return out;
 }
@@ -55,6 +56,7 @@ RunSettings settings_from_json(const json& in, const std::filesystem::path& wher
     settings.eval_every = in.value("eval_every", std::int64_t{0});
     settings.eval_every_episodes = in.value("eval_every_episodes", std::int64_t{5});
     settings.eval_max_share = in.value("eval_max_share", 0.1);
+    settings.world_size = in.value("world_size", 1);
     settings.algorithm = algorithm.name();
     settings.algorithm_config = algorithm.parse_config(in.at(settings.algorithm).dump());
     return settings;

@@ -41,6 +41,9 @@ struct RunSettings {
   /// An evaluation during training is skipped while those of this process have taken more than
   /// this share of its wall time (in (0, 1]; 1: never skipped).
   double eval_max_share = 0.1;
+  /// The ranks of a data-parallel run (train --nproc, or WORLD_SIZE), each stepping num_envs()
+  /// envs; 1: one process. config.json has "world_size" only when it is above 1.
+  int world_size = 1;
   /// The algorithm's name (AlgorithmFactory::name) and its config (AlgorithmFactory::
   /// parse_config: every member present, "seed", "num_envs" and "total_env_steps" among them).
   std::string algorithm;

@@ -1,6 +1,7 @@
 #include "examples/trainer/run/training_run.h"
 
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
@@ -74,6 +75,49 @@ void check_resume_settings(const ResumeChecks& given, const RunSettings& run,
                           "/config.json, and these differ from them: " + differ +
                           " (only --steps and --minutes may change)");
   }
+}
+
+// "rank{r}." : the prefix of rank r's blobs in a distributed checkpoint.
+std::string rank_prefix(int rank) { return "rank" + std::to_string(rank) + "."; }
+
+std::string hex_digest(std::uint64_t digest) {
+  std::ostringstream text;
+  text << std::hex << std::setw(16) << std::setfill('0') << digest;
+  return text.str();
+}
+
+// Rank r's view of a distributed checkpoint: rank 0's blobs with rank r's "rank{r}.*" in place
+// of theirs, no other rank's, and rank r's meta members over rank 0's.
+CheckpointBlobs rank_checkpoint(const CheckpointBlobs& all, int rank, int world,
+                                const fs::path& path) {
+  CheckpointBlobs mine;
+  for (const auto& [name, bytes] : all) {
+    if (name.rfind("rank", 0) == 0 && name.find('.') != std::string::npos &&
+        name.find_first_not_of("0123456789", 4) == name.find('.')) {
+      continue;  // some rank's own
+    }
+    mine[name] = bytes;
+  }
+  if (rank == 0) return mine;
+  const std::string prefix = rank_prefix(rank);
+  const auto meta = all.find(prefix + "meta");
+  if (meta == all.end()) {
+    throw std::runtime_error(path.string() + ": the checkpoint has no \"" + prefix +
+                             "meta\" entry: it is not of a run of " + std::to_string(world) +
+                             " ranks");
+  }
+  for (const auto& [name, bytes] : all) {
+    if (name.rfind(prefix, 0) == 0 && name != prefix + "meta") {
+      mine[name.substr(prefix.size())] = bytes;
+    }
+  }
+  // Rank 0's env actions are not rank r's: without its own there are none.
+  if (all.count(prefix + "env_actions") == 0) mine.erase("env_actions");
+  json merged = json::parse(mine.at("meta"));
+  const json own = json::parse(meta->second);
+  for (auto member = own.begin(); member != own.end(); ++member) merged[member.key()] = *member;
+  mine["meta"] = merged.dump();
+  return mine;
 }
 
 const char* const kEvalHeader = "steps,wall_time_s,return_mean,return_std,episodes,eval_s";
@@ -216,22 +260,147 @@ bool TrainingRun::nothing_to_do() const {
   return true;
 }
 
+TrainingRun TrainingRun::join(const AlgorithmFactories& algorithms, EnvKwargsParser parse_sets,
+                              Communicator& communicator, RunOutput output) {
+  if (communicator.rank() == 0 || algorithms.empty()) {
+    throw std::invalid_argument("TrainingRun::join: rank 0 creates or resumes the run");
+  }
+  TrainingRun run(*algorithms.front(), std::move(parse_sets), RunSettings{}, fs::path(), output);
+  run.communicator_ = &communicator;
+  run.join_algorithms_ = algorithms;
+  return run;
+}
+
+void TrainingRun::distribute(Communicator& communicator) {
+  if (communicator.rank() != 0) {
+    throw std::invalid_argument("TrainingRun::distribute: rank " +
+                                std::to_string(communicator.rank()) + " joins the run (join)");
+  }
+  communicator_ = &communicator;
+}
+
+bool TrainingRun::lead() const { return communicator_ == nullptr || communicator_->rank() == 0; }
+
+bool TrainingRun::distributed() const {
+  return communicator_ != nullptr && communicator_->world_size() > 1;
+}
+
+void TrainingRun::send_start(bool nothing) {
+  const int world = communicator_->world_size();
+  std::vector<std::string> starts(static_cast<std::size_t>(world));
+  for (int r = 1; r < world; ++r) {
+    CheckpointBlobs start;
+    start["settings"] = settings_to_json(settings_).dump();
+    start["nothing_to_do"] = nothing ? "1" : "0";
+    if (checkpoint_ && !nothing) {
+      start["checkpoint_path"] = checkpoint_->path.string();
+      start["checkpoint_update"] = std::to_string(checkpoint_->update);
+      for (auto& [name, bytes] : rank_checkpoint(checkpoint_->blobs, r, world, checkpoint_->path)) {
+        start["checkpoint." + name] = std::move(bytes);
+      }
+    }
+    starts[static_cast<std::size_t>(r)] = pack_blobs(start);
+  }
+  communicator_->scatter_bytes(starts, "the run's start");
+  if (checkpoint_ && !nothing) {
+    checkpoint_->blobs = rank_checkpoint(checkpoint_->blobs, 0, world, checkpoint_->path);
+  }
+}
+
+bool TrainingRun::receive_start() {
+  const CheckpointBlobs start =
+      unpack_blobs(communicator_->scatter_bytes({}, "the run's start"), "rank 0's start");
+  if (start.at("nothing_to_do") == "1") return false;
+  const json settings = json::parse(start.at("settings"));
+  factory_ = &algorithm_of(settings, "rank 0's config", join_algorithms_);
+  settings_ = settings_from_json(settings, "rank 0's config", *factory_);
+  if (start.count("checkpoint_path") != 0) {
+    LoadedCheckpoint checkpoint;
+    checkpoint.path = start.at("checkpoint_path");
+    checkpoint.update = std::stoll(start.at("checkpoint_update"));
+    const std::string prefix = "checkpoint.";
+    for (const auto& [name, bytes] : start) {
+      if (name.rfind(prefix, 0) == 0) checkpoint.blobs[name.substr(prefix.size())] = bytes;
+    }
+    checkpoint_ = std::move(checkpoint);
+    meta_ = read_meta(*checkpoint_);
+    wall_before_s_ = meta_.at("wall_time_s").get<double>();
+  }
+  return true;
+}
+
+bool TrainingRun::keep_training(bool lead_says) {
+  if (!distributed()) return lead_says;
+  double go = lead() && lead_says ? 1.0 : 0.0;
+  communicator_->all_reduce_sum(&go, 1, "rank 0's go-on");
+  return go > 0.5;
+}
+
+std::vector<double> TrainingRun::gather_returns(const std::vector<double>& mine) {
+  if (!distributed()) return mine;
+  std::string bytes(mine.size() * sizeof(double), '\0');
+  if (!mine.empty()) std::memcpy(bytes.data(), mine.data(), bytes.size());
+  std::vector<double> all;
+  for (const std::string& part : communicator_->gather_bytes(bytes, "episode returns")) {
+    const std::size_t count = part.size() / sizeof(double);
+    const std::size_t at = all.size();
+    all.resize(at + count);
+    if (count > 0) std::memcpy(all.data() + at, part.data(), count * sizeof(double));
+  }
+  return all;
+}
+
 std::optional<json> TrainingRun::train() {
-  if (checkpoint_ && nothing_to_do()) return std::nullopt;
-  // The count in use goes into config.json, so that a resume runs with it (results depend on it).
-  settings_.torch_threads = factory_->set_threads(settings_.torch_threads);
+  const int world = communicator_ == nullptr ? 1 : communicator_->world_size();
+  if (lead()) {
+    if (checkpoint_ && settings_.world_size != world) {
+      throw RunRequestError(
+          "train --resume " + folder_.string() + ": the run was trained by " +
+          std::to_string(settings_.world_size) +
+          (settings_.world_size == 1 ? " process" : " ranks") + " and this is " +
+          (world == 1 ? "one process" : "a run of " + std::to_string(world) + " ranks") +
+          "; resume it with " +
+          (settings_.world_size == 1
+               ? std::string("no --nproc (and no WORLD_SIZE)")
+               : "--nproc " + std::to_string(settings_.world_size) +
+                     " (or WORLD_SIZE=" + std::to_string(settings_.world_size) + ")") +
+          ": each rank continues its own envs, so the world size cannot change");
+    }
+    settings_.world_size = world;
+    const bool nothing = checkpoint_ && nothing_to_do();
+    // The count in use goes into config.json, so that a resume runs with it (results depend on
+    // it).
+    settings_.torch_threads = factory_->set_threads(settings_.torch_threads);
+    if (distributed()) send_start(nothing);
+    if (nothing) {
+      if (communicator_ != nullptr) communicator_->finish();
+      return std::nullopt;
+    }
+  } else {
+    if (!receive_start()) {
+      communicator_->finish();
+      return std::nullopt;
+    }
+    settings_.torch_threads = factory_->set_threads(settings_.torch_threads);
+  }
   env_ = make_training_env(settings_, parse_sets_);
-  algorithm_ = factory_->make(*env_, settings_.algorithm_config);
+  algorithm_ = factory_->make(*env_, settings_.algorithm_config, communicator_);
   if (checkpoint_) {
     restore_from_checkpoint();
-  } else {
+  } else if (lead()) {
     run_.emplace(
         RunFolder::create(folder_, settings_to_json(settings_), algorithm_->progress_columns()));
   }
   train_until_spent();
   save_checkpoint();
   env_->close();
-  return evaluate_and_summarize();
+  if (!lead()) {
+    communicator_->finish();
+    return std::nullopt;
+  }
+  json summary = evaluate_and_summarize();
+  if (communicator_ != nullptr) communicator_->finish();
+  return summary;
 }
 
 void TrainingRun::restore_from_checkpoint() {
@@ -245,8 +414,8 @@ void TrainingRun::restore_from_checkpoint() {
   // (0: none), with the minutes this resume was given, when it was.
   json budget = {{"total_env_steps", settings_.total_env_steps()}, {"minutes", budget_minutes_}};
   if (minutes_given_ > 0.0) budget["minutes_given"] = minutes_given_;
-  run_.emplace(RunFolder::resume(folder_, algorithm_->env_steps(), budget));
-  if (fs::exists(folder_ / "eval.csv")) {
+  if (lead()) run_.emplace(RunFolder::resume(folder_, algorithm_->env_steps(), budget));
+  if (lead() && fs::exists(folder_ / "eval.csv")) {
     for (const EvalRow& row :
          parse_eval_csv(read_whole_file(folder_ / "eval.csv", "train --resume"),
                         (folder_ / "eval.csv").string())) {
@@ -301,13 +470,19 @@ void TrainingRun::train_until_spent() {
   // left to do).
   ProgressStatus status{algorithm_->env_steps(), total_steps,      elapsed_s(), time_limit_s,
                         ProgressStatus::kNone,   mean_of(returns_)};
-  while (algorithm_->env_steps() < total_steps &&
-         (time_limit_s <= 0.0 || one_update_due || elapsed_s() < time_limit_s)) {
+  while (keep_training(algorithm_->env_steps() < total_steps &&
+                       (time_limit_s <= 0.0 || one_update_due || elapsed_s() < time_limit_s))) {
     one_update_due = false;
     const std::int64_t steps_before = algorithm_->env_steps();
     const ProgressRow row = iterate_once();
-    run_->write_curve(title);
-    evaluate_when_due(steps_before);
+    if (distributed() && algorithm_->updates() % kDigestEvery == 0) {
+      parameter_digests_ = check_same_on_every_rank(*communicator_, algorithm_->parameter_digest(),
+                                                    algorithm_->updates());
+    }
+    if (lead()) {
+      run_->write_curve(title);
+      evaluate_when_due(steps_before);
+    }
     if (algorithm_->updates() % settings_.checkpoint_every == 0) save_checkpoint();
     status = {algorithm_->env_steps(), total_steps, elapsed_s(), time_limit_s, row.fps,
               row.episode_return_mean};
@@ -320,6 +495,7 @@ ProgressRow TrainingRun::iterate_once() {
   const auto iteration_start = std::chrono::steady_clock::now();
   const std::int64_t steps_before = algorithm_->env_steps();
   IterationStats stats = algorithm_->iterate();
+  stats.episode_returns = gather_returns(stats.episode_returns);
   for (const double episode_return : stats.episode_returns) {
     returns_.push_back(episode_return);
     if (returns_.size() > kReturnWindow) returns_.pop_front();
@@ -337,7 +513,7 @@ ProgressRow TrainingRun::iterate_once() {
   row.approx_kl = stats.approx_kl;
   row.clip_fraction = stats.clip_fraction;
   row.extra = std::move(stats.extra);
-  run_->append_progress(row);
+  if (lead()) run_->append_progress(row);
   return row;
 }
 
@@ -380,10 +556,29 @@ void TrainingRun::evaluate_when_due(std::int64_t steps_before) {
 
 void TrainingRun::save_checkpoint() {
   CheckpointBlobs blobs;
-  // The run's settings, so that a checkpoint file evaluates on its own (away from its folder).
-  blobs["config"] = settings_to_json(settings_).dump();
   json meta;
   algorithm_->save(blobs, meta);
+  if (distributed()) {
+    parameter_digests_ = check_same_on_every_rank(*communicator_, algorithm_->parameter_digest(),
+                                                  algorithm_->updates());
+    // Each rank's own part (generators, env actions, meta with its env digest) goes to rank 0.
+    CheckpointBlobs mine;
+    for (const std::string& name : algorithm_->rank_blobs()) mine[name] = blobs.at(name);
+    if (algorithm_->env_action_log_complete()) mine["env_actions"] = algorithm_->env_action_log();
+    json rank_meta = meta;
+    rank_meta["env_digest"] = algorithm_->env_digest();
+    mine["meta"] = rank_meta.dump();
+    const std::vector<std::string> parts = communicator_->gather_bytes(
+        pack_blobs(mine), "the checkpoint of update " + std::to_string(algorithm_->updates()));
+    if (!lead()) return;
+    for (std::size_t r = 1; r < parts.size(); ++r) {
+      for (auto& [name, bytes] : unpack_blobs(parts[r], "rank " + std::to_string(r) + "'s part")) {
+        blobs[rank_prefix(static_cast<int>(r)) + name] = std::move(bytes);
+      }
+    }
+  }
+  // The run's settings, so that a checkpoint file evaluates on its own (away from its folder).
+  blobs["config"] = settings_to_json(settings_).dump();
   meta["env_steps"] = algorithm_->env_steps();
   meta["updates"] = algorithm_->updates();
   meta["wall_time_s"] = elapsed_s();
@@ -411,6 +606,12 @@ json TrainingRun::evaluate_and_summarize() {
   summary["wall_time_s"] = elapsed_s();
   summary["evaluation"] = evaluation_json(evaluation, request);
   summary["video"] = video.filename().string();
+  if (distributed()) {
+    json digests = json::array();
+    for (const std::uint64_t digest : parameter_digests_) digests.push_back(hex_digest(digest));
+    summary["distributed"] = {{"world_size", communicator_->world_size()},
+                              {"parameter_digests", digests}};
+  }
   run_->write_summary(summary);
   output_.out << "evaluation: return " << evaluation.mean << " +/- " << evaluation.std << " over "
               << evaluation.returns.size() << " episodes\n"

@@ -119,6 +119,27 @@ class TrainingRun {
   /// output.out, changes nothing and returns nullopt.
   std::optional<nlohmann::json> train();
 
+  /// Makes this run rank 0 of `communicator`'s data-parallel run of world_size() ranks (call
+  /// before train(); the communicator must outlive the run). Rank 0 alone writes the run folder
+  /// and progress, evaluates and writes final.mp4 and summary.json. At train() it sends every
+  /// other rank (each built by `join`) the run's settings and, on resume, its own part of the
+  /// checkpoint; every rank trains (the algorithm averages across ranks) until rank 0 finds the
+  /// budget spent, the episodes of every rank count in progress.csv, and the ranks' parameter
+  /// digests are compared every kDigestEvery updates, at every checkpoint and at the end
+  /// (DistributedError on a mismatch, naming the ranks). A checkpoint holds rank 0's blobs and,
+  /// for each other rank r, its Algorithm::rank_blobs, env actions and meta as "rank{r}.*";
+  /// a resume must have the run's world size (RunRequestError otherwise). summary.json gets
+  /// "distributed": {"world_size", "parameter_digests"}.
+  void distribute(Communicator& communicator);
+  /// Rank communicator.rank() > 0 of a data-parallel run whose rank 0 runs `distribute`: its
+  /// settings, budget and resume point come from rank 0 at train(), which writes no file and
+  /// returns nullopt.
+  static TrainingRun join(const AlgorithmFactories& algorithms, EnvKwargsParser parse_sets,
+                          Communicator& communicator, RunOutput output);
+
+  /// Updates between two comparisons of the ranks' parameter digests.
+  static constexpr std::int64_t kDigestEvery = 10;
+
   const RunSettings& settings() const { return settings_; }
   const std::filesystem::path& folder() const { return folder_; }
 
@@ -144,6 +165,17 @@ class TrainingRun {
   void save_checkpoint();
   nlohmann::json evaluate_and_summarize();
   double elapsed_s() const;
+  // Distributed.
+  bool lead() const;  // rank 0, or a single process
+  bool distributed() const;
+  // Rank 0: sends each rank its start (settings, budget, its part of the checkpoint); the
+  // others: receive theirs. Returns false when there is nothing to do.
+  void send_start(bool nothing_to_do);
+  bool receive_start();
+  // Rank 0's decision, shared: whether to go on training.
+  bool keep_training(bool lead_says);
+  // Gathers every rank's episode returns to rank 0 (rank order).
+  std::vector<double> gather_returns(const std::vector<double>& mine);
 
   const AlgorithmFactory* factory_;
   EnvKwargsParser parse_sets_;
@@ -164,6 +196,9 @@ class TrainingRun {
   std::vector<EvalRow> evals_;  // eval.csv's rows
   double eval_seconds_ = 0.0;   // spent in evaluations during training by this process
   std::chrono::steady_clock::time_point start_;
+  Communicator* communicator_ = nullptr;
+  std::vector<std::uint64_t> parameter_digests_;  // every rank's, at the last check
+  AlgorithmFactories join_algorithms_;            // join: the algorithm rank 0's config names
 };
 
 }  // namespace pixelgym::trainer

@@ -166,6 +166,9 @@ TEST(PpoConfig, JsonRoundTripKeepsEveryField) {
   config.target_kl = 0.05;
   config.augment = true;
   config.shift_pad = 2;
+  config.preempt_stragglers = true;
+  config.preempt_done_fraction = 0.75;
+  config.preempt_min_steps_fraction = 0.5;
   config.policy.cnn = CnnArchitecture::kNature;
   config.policy.cnn_features = 128;
   config.policy.mlp_hidden = {32, 16, 8};
@@ -181,9 +184,12 @@ TEST(PpoConfig, JsonRoundTripKeepsEveryField) {
   EXPECT_EQ(back.policy.cnn, CnnArchitecture::kNature);
   EXPECT_EQ(back.policy.mlp_hidden, config.policy.mlp_hidden);
   EXPECT_DOUBLE_EQ(back.adam_epsilon, 1e-7);
+  EXPECT_TRUE(back.preempt_stragglers);
+  EXPECT_DOUBLE_EQ(back.preempt_done_fraction, 0.75);
+  EXPECT_DOUBLE_EQ(back.preempt_min_steps_fraction, 0.5);
   // Every field is a member (one per field of the structs, policy nested).
   const nlohmann::json json = nlohmann::json::parse(text);
-  EXPECT_EQ(json.size(), 22u);
+  EXPECT_EQ(json.size(), 25u);
   EXPECT_EQ(json.at("policy").size(), 8u);
   EXPECT_EQ(json.at("policy").at("cnn"), "nature");
 }
@@ -210,6 +216,30 @@ TEST(PpoConfig, JsonTakesASubsetAndRefusesUnknownOrIllTypedMembers) {
 
 // The configs shipped in examples/trainer/ppo/configs (the README's commands name them) parse and
 // validate: a misspelt member or an out-of-range value there would only fail a user's run.
+// Straggler preemption's fractions are in [0, 1], and a rollout cut at its minimum must still
+// fill every minibatch.
+TEST(PpoConfig, PreemptionSettingsAreChecked) {
+  const auto message = [](const std::string& text) {
+    try {
+      config_from_json(text);
+    } catch (const std::invalid_argument& error) {
+      return std::string(error.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(message(R"({"preempt_done_fraction": 1.5})").find("preempt_done_fraction"),
+            std::string::npos);
+  EXPECT_NE(message(R"({"preempt_min_steps_fraction": -0.1})").find("preempt_min_steps_fraction"),
+            std::string::npos);
+  // 8 envs x ceil(0.25 * 16) = 32 transitions at the minimum: fewer than 64 minibatches.
+  const std::string few = message(
+      R"({"preempt_stragglers": true, "num_envs": 8, "num_steps": 16, "num_minibatches": 64})");
+  EXPECT_NE(few.find("fewer than num_minibatches (64)"), std::string::npos) << few;
+  EXPECT_EQ(message(R"({"preempt_stragglers": true, "num_envs": 8, "num_steps": 16,
+                        "num_minibatches": 32})"),
+            "accepted");
+}
+
 TEST(PpoConfig, EveryShippedConfigParses) {
   const std::filesystem::path folder =
       std::filesystem::path(PIXELGYM_SOURCE_DIR) / "examples" / "trainer" / "ppo" / "configs";

@@ -175,7 +175,8 @@ class CountingFactory final : public AlgorithmFactory {
     return config;
   }
   int set_threads(int requested) const override { return requested == 0 ? 3 : requested; }
-  std::unique_ptr<Algorithm> make(vector::VectorEnv& env, const json& config) const override {
+  std::unique_ptr<Algorithm> make(vector::VectorEnv& env, const json& config,
+                                  Communicator* /*communicator*/ = nullptr) const override {
     auto algorithm = std::make_unique<CountingAlgorithm>(env, config);
     algorithm->actor_.sleep_ms = actor_sleep_ms;
     last = algorithm.get();

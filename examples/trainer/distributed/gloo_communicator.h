@@ -1,0 +1,114 @@
+// The trainer's Communicator on PyTorch's distributed package (c10d): a TCPStore for the
+// rendezvous, ProcessGroupGloo for the collectives, and a watchdog that names a rank that died or
+// stopped answering. Started the way torchrun starts workers: from the variables MASTER_ADDR,
+// MASTER_PORT, WORLD_SIZE, RANK and LOCAL_RANK.
+#pragma once
+
+#include <c10/util/intrusive_ptr.h>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "examples/trainer/run/communicator.h"
+
+namespace c10d {
+class ProcessGroupGloo;
+class TCPStore;
+}  // namespace c10d
+
+namespace pixelgym::distributed {
+
+/// Where a rank finds the others, as torchrun's variables give it.
+struct DistributedSettings {
+  std::string master_address = "127.0.0.1";  // MASTER_ADDR: rank 0's host, which holds the store
+  int master_port = 29500;                   // MASTER_PORT
+  int world_size = 1;                        // WORLD_SIZE
+  int rank = 0;                              // RANK
+  int local_rank = 0;                        // LOCAL_RANK (0 when unset)
+  /// Seconds a rank may go without a sign of life (its heartbeat) before the others stop the
+  /// run naming it; also the limit on the rendezvous, at least 60 s.
+  double timeout_s = 60.0;
+
+  /// The settings of the environment's WORLD_SIZE, RANK, MASTER_ADDR, MASTER_PORT and LOCAL_RANK;
+  /// nullopt when WORLD_SIZE is not set. Throws std::invalid_argument naming the variable and its
+  /// value when one is not a number in range or one that is needed is missing.
+  static std::optional<DistributedSettings> from_environment(double timeout_s);
+};
+
+/// A rank of a run over Gloo. Construction is the rendezvous: rank 0 opens the TCPStore on
+/// MASTER_PORT, every rank connects to it, and the Gloo process group joins all world_size ranks
+/// (throws DistributedError when they do not all arrive within the rendezvous limit). Gloo's own
+/// socket goes on the interface named by GLOO_SOCKET_IFNAME (as in PyTorch) or else on the local
+/// address this host uses to reach MASTER_ADDR.
+///
+/// Liveness: a thread of each rank adds to its heartbeat counter in the store twice a second
+/// and watches the others'. A rank whose counter stands still for timeout_s (dead, stopped or
+/// hung), or rank 0's store going away, makes every other rank print
+/// "rank R: rank Q has not answered for S s (...)" to stderr and exit with status 3, even from
+/// inside a collective that would otherwise wait; a collective that fails at once (a peer's
+/// connection reset) throws DistributedError naming the rank whose heartbeat then stops.
+/// Nothing is written by the watchdog, so files written atomically stay whole.
+class GlooCommunicator final : public trainer::Communicator {
+ public:
+  explicit GlooCommunicator(const DistributedSettings& settings);
+  ~GlooCommunicator() override;
+  GlooCommunicator(const GlooCommunicator&) = delete;
+  GlooCommunicator& operator=(const GlooCommunicator&) = delete;
+
+  int rank() const override { return settings_.rank; }
+  int world_size() const override { return settings_.world_size; }
+  void all_reduce_sum(float* data, std::size_t count, const std::string& what) override;
+  void all_reduce_sum(double* data, std::size_t count, const std::string& what) override;
+  void broadcast(float* data, std::size_t count, const std::string& what) override;
+  std::vector<std::uint64_t> all_gather(std::uint64_t value, const std::string& what) override;
+  std::vector<std::string> gather_bytes(const std::string& bytes, const std::string& what) override;
+  std::string scatter_bytes(const std::vector<std::string>& per_rank,
+                            const std::string& what) override;
+  int mark_rollout_done(std::int64_t round) override;
+  int rollouts_done(std::int64_t round) override;
+  void finish() override;
+
+  const DistributedSettings& settings() const { return settings_; }
+
+ private:
+  // Runs `operation`; on failure throws DistributedError naming the rank that stopped, once the
+  // watchdog has found it (or the failure itself when none has stopped).
+  template <typename Operation>
+  void collective(const std::string& what, const Operation& operation);
+  void watch();
+  std::string key(const std::string& what);
+
+  DistributedSettings settings_;
+  c10::intrusive_ptr<c10d::TCPStore> store_;
+  c10::intrusive_ptr<c10d::ProcessGroupGloo> group_;
+  std::int64_t sequence_ = 0;  // collectives through the store so far (unique keys)
+
+  // The watchdog.
+  std::thread watchdog_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stop_ = false;
+  bool collective_failed_ = false;   // shortens the watchdog's wait to kFailedStaleSeconds
+  std::optional<std::string> lost_;  // why a rank is lost, once the watchdog knows
+};
+
+/// Runs `arguments` (a pixelgym command line without --nproc; arguments[0] is ignored: this
+/// executable runs) as `nproc` local ranks, as torchrun --standalone does: child processes with
+/// MASTER_ADDR 127.0.0.1, a free MASTER_PORT, WORLD_SIZE, RANK, LOCAL_RANK and LOCAL_WORLD_SIZE
+/// set, and OMP_NUM_THREADS set to the cores divided among them unless it is set. Waits for all;
+/// when one fails, gives the others timeout_s + 10 s to stop on their own, then kills them.
+/// Forwards SIGINT and SIGTERM. Reports each rank that failed to `errors` ("rank 1 (pid 123)
+/// was killed by signal 9 (Killed)"). Returns 0 when every rank exited 0, else 1.
+int run_local_ranks(int nproc, const std::vector<std::string>& arguments, double timeout_s,
+                    std::ostream& errors);
+
+}  // namespace pixelgym::distributed
