@@ -332,7 +332,7 @@ bool TrainingRun::receive_start() {
 bool TrainingRun::keep_training(bool lead_says) {
   if (!distributed()) return lead_says;
   double go = lead() && lead_says ? 1.0 : 0.0;
-  communicator_->all_reduce_sum(&go, 1, "rank 0's go-on");
+  communicator_->all_reduce_sum(&go, 1, "rank 0's decision to train on");
   return go > 0.5;
 }
 
