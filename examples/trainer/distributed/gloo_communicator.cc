@@ -262,22 +262,22 @@ void GlooCommunicator::collective(const std::string& what, const Operation& oper
   }
 }
 
-void GlooCommunicator::all_reduce_sum(float* data, std::size_t count, const std::string& what) {
+template <typename T>
+void GlooCommunicator::all_reduce(T* data, std::size_t count, const std::string& what) {
   if (count == 0) return;
   collective(what, [&] {
-    std::vector<at::Tensor> tensors{
-        torch::from_blob(data, {static_cast<std::int64_t>(count)}, torch::kFloat32)};
+    std::vector<at::Tensor> tensors{torch::from_blob(data, {static_cast<std::int64_t>(count)},
+                                                     c10::CppTypeToScalarType<T>::value)};
     group_->allreduce(tensors)->wait();
   });
 }
 
+void GlooCommunicator::all_reduce_sum(float* data, std::size_t count, const std::string& what) {
+  all_reduce(data, count, what);
+}
+
 void GlooCommunicator::all_reduce_sum(double* data, std::size_t count, const std::string& what) {
-  if (count == 0) return;
-  collective(what, [&] {
-    std::vector<at::Tensor> tensors{
-        torch::from_blob(data, {static_cast<std::int64_t>(count)}, torch::kFloat64)};
-    group_->allreduce(tensors)->wait();
-  });
+  all_reduce(data, count, what);
 }
 
 void GlooCommunicator::broadcast(float* data, std::size_t count, const std::string& what) {

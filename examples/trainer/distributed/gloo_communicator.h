@@ -84,6 +84,9 @@ class GlooCommunicator final : public trainer::Communicator {
   // watchdog has found it (or the failure itself when none has stopped).
   template <typename Operation>
   void collective(const std::string& what, const Operation& operation);
+  // A sum all-reduce of `count` values of T (float or double).
+  template <typename T>
+  void all_reduce(T* data, std::size_t count, const std::string& what);
   void watch();
   std::string key(const std::string& what);
 

@@ -89,6 +89,15 @@ std::vector<WorkerResult> run_workers(const std::string& scenario, const fs::pat
   return results;
 }
 
+// Runs a scenario of distributed_worker as two ranks; each must exit 0.
+void expect_both_ranks_pass(const std::string& scenario) {
+  const fs::path folder = fresh_folder(scenario);
+  for (const WorkerResult& result : run_workers(scenario, folder, test_port())) {
+    EXPECT_EQ(result.exit_code, 0) << result.output;
+  }
+  fs::remove_all(folder);
+}
+
 // The comparison is made exact in what it compares: both ranks learn from the halves (envs 0-3
 // and 4-7) of one 8-env rollout that each also gives, whole, to a single-process trainer; each
 // rank visits its half in an order of its own, and the single process visits, in minibatch m,
@@ -96,35 +105,21 @@ std::vector<WorkerResult> run_workers(const std::string& scenario, const fs::pat
 // single process takes over the union (advantages standardized over the union too), so the
 // parameters agree to float rounding, and the observation statistics to double rounding.
 TEST(DistributedTest, AnUpdateOfTwoRanksOfFourEnvsIsAnUpdateOfOneProcessOfEight) {
-  const fs::path folder = fresh_folder("equivalence");
-  const auto results = run_workers("equivalence", folder, test_port());
-  for (const WorkerResult& result : results) EXPECT_EQ(result.exit_code, 0) << result.output;
-  fs::remove_all(folder);
+  expect_both_ranks_pass("equivalence");
 }
 
 TEST(DistributedTest, StatisticsMergedAcrossRanksAreThoseOfOneBatch) {
-  const fs::path folder = fresh_folder("statistics");
-  const auto results = run_workers("statistics", folder, test_port() + 1);
-  for (const WorkerResult& result : results) EXPECT_EQ(result.exit_code, 0) << result.output;
-  fs::remove_all(folder);
+  expect_both_ranks_pass("statistics");
 }
 
 TEST(DistributedTest, RanksWhoseParametersDifferAreStoppedByTheDigestCheck) {
-  const fs::path folder = fresh_folder("digest");
-  const auto results = run_workers("digest_mismatch", folder, test_port());
-  for (const WorkerResult& result : results) EXPECT_EQ(result.exit_code, 0) << result.output;
-  fs::remove_all(folder);
+  expect_both_ranks_pass("digest_mismatch");
 }
 
 // DD-PPO's preemption: with rank 1 a straggler, its rollouts stop once rank 0 has finished (and
 // it has a quarter of its steps); the ranks learn from rollouts of different lengths and stay
 // identical.
-TEST(DistributedTest, AStragglersRolloutIsPreempted) {
-  const fs::path folder = fresh_folder("preemption");
-  const auto results = run_workers("preemption", folder, test_port() + 1);
-  for (const WorkerResult& result : results) EXPECT_EQ(result.exit_code, 0) << result.output;
-  fs::remove_all(folder);
-}
+TEST(DistributedTest, AStragglersRolloutIsPreempted) { expect_both_ranks_pass("preemption"); }
 
 constexpr const char* kTinyConfig =
     R"({"num_steps": 16, "num_minibatches": 2, "update_epochs": 2, "anneal_learning_rate": false})";
