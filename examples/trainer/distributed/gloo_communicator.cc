@@ -12,6 +12,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
@@ -87,6 +88,12 @@ std::string local_address_towards(const std::string& host, int port) {
   return address;
 }
 
+// Whether a torchrun agent already serves the store at MASTER_ADDR:MASTER_PORT.
+bool agent_store() {
+  const std::string value = env_or_empty("TORCHELASTIC_USE_AGENT_STORE");
+  return value == "True" || value == "true" || value == "1";
+}
+
 std::string seconds_text(double s) {
   std::ostringstream text;
   text << std::round(s * 10.0) / 10.0;
@@ -133,10 +140,15 @@ GlooCommunicator::GlooCommunicator(const DistributedSettings& settings) : settin
   const auto rendezvous = std::chrono::milliseconds(
       static_cast<std::int64_t>(std::max(settings_.timeout_s, 60.0) * 1000.0));
   const std::string where = settings_.master_address + ":" + std::to_string(settings_.master_port);
+  // A peer that went away must not kill this rank with SIGPIPE when Gloo writes to it: the
+  // write fails and the error names the rank.
+  std::signal(SIGPIPE, SIG_IGN);
   try {
     c10d::TCPStoreOptions options;
     options.port = static_cast<std::uint16_t>(settings_.master_port);
-    options.isServer = settings_.rank == 0;
+    // torchrun from PyTorch 2.4 on runs the store itself (its agent's) on MASTER_PORT and says
+    // so: every rank is then a client.
+    options.isServer = settings_.rank == 0 && !agent_store();
     options.numWorkers = static_cast<std::size_t>(settings_.world_size);
     options.waitWorkers = true;
     options.timeout = rendezvous;
@@ -178,6 +190,7 @@ void GlooCommunicator::watch() {
     std::unique_lock<std::mutex> lock(mutex_);
     if (stop_) return;
     lost_ = why;
+    wake_.notify_all();
     if (collective_failed_) return;  // the main thread throws it
     // The main thread may be inside a collective that waits for the lost rank: stop here.
     std::cerr << "train: " << me << ": " << why << "; stopping this rank\n" << std::flush;
@@ -355,7 +368,11 @@ std::string GlooCommunicator::scatter_bytes(const std::vector<std::string>& per_
     const std::string name = prefix + "/" + std::to_string(settings_.rank);
     const std::vector<std::uint8_t> value = store_->get(name);
     mine.assign(value.begin(), value.end());
-    store_->deleteKey(name);
+    try {
+      store_->deleteKey(name);
+    } catch (const std::exception&) {
+      // Rank 0 has finished and its store is gone: the bytes are here.
+    }
   });
   return mine;
 }
@@ -371,6 +388,18 @@ int GlooCommunicator::rollouts_done(std::int64_t round) {
 void GlooCommunicator::finish() {
   try {
     store_->set("finished/" + std::to_string(settings_.rank), std::vector<std::uint8_t>{1});
+    if (settings_.rank == 0 && !agent_store()) {
+      // Rank 0 holds the store: it stays until every rank has finished with it (at most the
+      // timeout), so that none finds it gone on its way out.
+      const auto deadline =
+          Clock::now() +
+          std::chrono::milliseconds(static_cast<std::int64_t>(settings_.timeout_s * 1000.0));
+      for (int r = 1; r < settings_.world_size && Clock::now() < deadline; ++r) {
+        while (!store_->check({"finished/" + std::to_string(r)}) && Clock::now() < deadline) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        }
+      }
+    }
   } catch (const std::exception&) {
     // Rank 0 (the store) has finished first: nobody watches this rank any more.
   }

@@ -56,7 +56,15 @@ struct DistributedSettings {
 /// "rank R: rank Q has not answered for S s (...)" to stderr and exit with status 3, even from
 /// inside a collective that would otherwise wait; a collective that fails at once (a peer's
 /// connection reset) throws DistributedError naming the rank whose heartbeat then stops.
-/// Nothing is written by the watchdog, so files written atomically stay whole.
+/// Nothing is written by the watchdog, so files written atomically stay whole. A rank whose
+/// process lives (its watchdog beats) but whose training thread hangs outside a collective is
+/// caught only by Gloo's own limit on a collective, 30 minutes. SIGPIPE is ignored from
+/// construction on (a write to a peer that died then fails with an error instead). finish() on
+/// rank 0, which holds the store, waits (at most the timeout) for every other rank to finish.
+///
+/// Under torchrun from PyTorch 2.4 on (TORCHELASTIC_USE_AGENT_STORE set), torchrun's agent
+/// serves the store and every rank connects to it as a client (not tried here: Debian's
+/// torchrun is 1.13's).
 class GlooCommunicator final : public trainer::Communicator {
  public:
   explicit GlooCommunicator(const DistributedSettings& settings);

@@ -1,6 +1,7 @@
 #include "examples/trainer/run/run_folder.h"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -71,6 +72,52 @@ RunFolder& RunFolder::operator=(RunFolder&& other) noexcept {
 
 RunFolder::~RunFolder() {
   if (progress_fd_ >= 0) ::close(progress_fd_);
+}
+
+RunLock RunLock::acquire(const fs::path& folder, const std::string& what) {
+  std::error_code error;
+  fs::create_directories(folder, error);
+  const fs::path path = folder / ".lock";
+  const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (error || fd < 0) {
+    throw std::runtime_error(what + ": cannot lock the run folder " + quoted(folder) + ": " +
+                             (error ? error.message() : std::string(std::strerror(errno))));
+  }
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    const int reason = errno;
+    char text[32] = {};
+    const ssize_t got = ::pread(fd, text, sizeof(text) - 1, 0);
+    ::close(fd);
+    std::string holder = got > 0 ? std::string(text, static_cast<std::size_t>(got)) : "";
+    holder.erase(holder.find_last_not_of(" \n") + 1);
+    if (reason != EWOULDBLOCK) {
+      throw std::runtime_error(what + ": cannot lock the run folder " + quoted(folder) + ": " +
+                               std::strerror(reason));
+    }
+    throw std::runtime_error(
+        what + ": " + quoted(folder) + " is in use: another process" +
+        (holder.empty() ? std::string() : " (pid " + holder + ")") +
+        " is training in it; wait for it to end, or stop it, before training there");
+  }
+  const std::string pid = std::to_string(::getpid()) + "\n";
+  if (::ftruncate(fd, 0) != 0 || ::pwrite(fd, pid.data(), pid.size(), 0) < 0) {
+    // The lock holds; only the PID in the message of a second process is lost.
+  }
+  return RunLock(fd);
+}
+
+RunLock::RunLock(RunLock&& other) noexcept : fd_(std::exchange(other.fd_, -1)) {}
+
+RunLock& RunLock::operator=(RunLock&& other) noexcept {
+  if (this != &other) {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = std::exchange(other.fd_, -1);
+  }
+  return *this;
+}
+
+RunLock::~RunLock() {
+  if (fd_ >= 0) ::close(fd_);
 }
 
 RunFolder RunFolder::create(const fs::path& folder, nlohmann::json config,

@@ -79,6 +79,28 @@ class RunFolder {
   int progress_fd_ = -1;
 };
 
+/// The lock of a run folder while a process trains in it: an exclusive flock(2) on
+/// {folder}/.lock, which holds the holder's PID. The kernel releases it when the holder exits
+/// (however it ends), so a lock left by a dead process never blocks; the file stays.
+class RunLock {
+ public:
+  /// Takes the lock of `folder` (created with its parents). Throws std::runtime_error
+  /// "{what}: {folder} is in use: another process (pid N) is training in it; ..." when another
+  /// process (or another RunLock of this one) holds it, and naming the folder when the lock file
+  /// cannot be made.
+  static RunLock acquire(const std::filesystem::path& folder, const std::string& what);
+  RunLock(RunLock&& other) noexcept;
+  RunLock& operator=(RunLock&& other) noexcept;
+  RunLock(const RunLock&) = delete;
+  RunLock& operator=(const RunLock&) = delete;
+  /// Releases it.
+  ~RunLock();
+
+ private:
+  explicit RunLock(int fd) : fd_(fd) {}
+  int fd_ = -1;
+};
+
 /// Writes `json` to `path` atomically, pretty-printed with a final newline. Throws
 /// std::runtime_error "{what}: cannot write {path}: {reason}".
 void write_json_atomically(const std::filesystem::path& path, const nlohmann::json& json,

@@ -191,7 +191,10 @@ TrainingRun TrainingRun::resume(const AlgorithmFactory& algorithm, EnvKwargsPars
   const json config = json::parse(config_file);
   RunSettings settings = settings_from_json(config, folder / "config.json", algorithm);
   check_resume_settings(given, settings, folder);
+  // Before the checkpoint is read: a run being trained by another process is left to it.
+  RunLock lock = RunLock::acquire(folder, "train --resume");
   TrainingRun run(algorithm, std::move(parse_sets), std::move(settings), std::move(folder), output);
+  run.lock_ = std::move(lock);
   run.load_resume_point(config);
   run.apply_budget(budget);
   return run;
@@ -351,6 +354,11 @@ std::vector<double> TrainingRun::gather_returns(const std::vector<double>& mine)
 }
 
 std::optional<json> TrainingRun::train() {
+  // The run folder is locked until train() returns or throws.
+  struct ReleaseLock {
+    std::optional<RunLock>& lock;
+    ~ReleaseLock() { lock.reset(); }
+  } release_lock{lock_};
   const int world = communicator_ == nullptr ? 1 : communicator_->world_size();
   if (lead()) {
     if (checkpoint_ && settings_.world_size != world) {
@@ -383,6 +391,7 @@ std::optional<json> TrainingRun::train() {
     }
     settings_.torch_threads = factory_->set_threads(settings_.torch_threads);
   }
+  if (lead() && !lock_) lock_ = RunLock::acquire(folder_, "train");
   env_ = make_training_env(settings_, parse_sets_);
   algorithm_ = factory_->make(*env_, settings_.algorithm_config, communicator_);
   if (checkpoint_) {

@@ -112,6 +112,8 @@ class TrainingRun {
                             std::filesystem::path folder, TrainBudget budget,
                             const ResumeChecks& given, RunOutput output);
 
+  /// The run folder is locked (RunLock) from resume() or the start of train() until train()
+  /// returns or throws: a second process is refused meanwhile.
   /// Trains until the budget is spent, writes the last checkpoint, evaluates the policy
   /// (eval_episodes deterministic episodes from seed + 1,000,000, the first recorded to
   /// final.mp4) and writes summary.json, which it returns. A resumed run whose budget is spent
@@ -198,6 +200,7 @@ class TrainingRun {
   std::chrono::steady_clock::time_point start_;
   Communicator* communicator_ = nullptr;
   std::vector<std::uint64_t> parameter_digests_;  // every rank's, at the last check
+  std::optional<RunLock> lock_;                   // the run folder's, from resume or train
   AlgorithmFactories join_algorithms_;            // join: the algorithm rank 0's config names
 };
 

@@ -3,8 +3,11 @@
 // run resumes as the run that did not stop, and a rank that dies or hangs stops the run within
 // the timeout with an error naming it. Tiny settings (32x32 pixels, 16-step rollouts) keep each
 // to seconds.
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
 #include <signal.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -45,8 +48,22 @@ std::string read_text(const fs::path& path) {
   return text.str();
 }
 
-// A free port on 127.0.0.1 for a test's rendezvous (the launcher finds its own).
-int test_port() { return 29000 + static_cast<int>(::getpid() % 1000) * 2; }
+// A free port on 127.0.0.1 for a test's rendezvous, from the kernel (the launcher finds its
+// own the same way).
+int test_port() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t length = sizeof(address);
+  if (fd < 0 || ::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0 ||
+      ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) != 0) {
+    if (fd >= 0) ::close(fd);
+    return 29000 + static_cast<int>(::getpid() % 1000) * 2;
+  }
+  ::close(fd);
+  return ntohs(address.sin_port);
+}
 
 struct WorkerResult {
   int exit_code = -1;

@@ -83,6 +83,27 @@ TEST(RunFolderTest, CreateRefusesAFolderThatHoldsARun) {
   EXPECT_EQ(file_text(folder / "config.json"), before);
 }
 
+// A run folder is locked while a process trains in it: a second lock is refused naming the
+// holder's PID; released, or left by a dead process (its PID still in the file), it is free.
+TEST(RunLockTest, ASecondLockIsRefusedNamingTheHolderAndAStaleOneDoesNotBlock) {
+  const fs::path folder = fresh_folder("run_lock");
+  {
+    const RunLock held = RunLock::acquire(folder, "train");
+    try {
+      RunLock::acquire(folder, "train --resume");
+      FAIL() << "a second lock was granted";
+    } catch (const std::runtime_error& error) {
+      EXPECT_THAT(error.what(), HasSubstr("train --resume: \"" + folder.string() +
+                                          "\" is in use: another process (pid " +
+                                          std::to_string(::getpid()) + ") is training in it"));
+    }
+  }
+  EXPECT_NO_THROW(RunLock::acquire(folder, "train"));
+  // What a killed process leaves: the file with its PID, and no lock (the kernel dropped it).
+  std::ofstream(folder / ".lock") << "999999\n";
+  EXPECT_NO_THROW(RunLock::acquire(folder, "train"));
+}
+
 TEST(RunFolderTest, CreateRejectsABadConfig) {
   const fs::path folder = fresh_folder("run_bad_config");
   EXPECT_THROW(RunFolder::create(folder, nlohmann::json::array()), std::invalid_argument);

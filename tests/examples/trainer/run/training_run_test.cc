@@ -237,9 +237,10 @@ TEST(TrainingRunTest, ANewRunTrainsToItsStepBudgetAndWritesTheRunFolder) {
   EXPECT_EQ(progress.column("steps"), (std::vector<double>{8, 16, 24, 32, 40}));
   EXPECT_EQ(progress.column("counter"), (std::vector<double>{1, 2, 3, 4, 5}));
   EXPECT_EQ(progress.column("policy_loss"), progress.column("counter"));
-  EXPECT_EQ(test_folders::entries(folder),
-            (std::vector<std::string>{"ckpt-000004.pgck", "ckpt-000005.pgck", "config.json",
-                                      "curve.png", "final.mp4", "progress.csv", "summary.json"}));
+  EXPECT_EQ(
+      test_folders::entries(folder),
+      (std::vector<std::string>{".lock", "ckpt-000004.pgck", "ckpt-000005.pgck", "config.json",
+                                "curve.png", "final.mp4", "progress.csv", "summary.json"}));
   const CheckpointBlobs blobs = read_checkpoint(folder / "ckpt-000005.pgck");
   EXPECT_EQ(blobs.at("counter"), "5");
   EXPECT_EQ(blobs.at("env_actions").size(), 20U * 2U * sizeof(std::int64_t));
@@ -385,6 +386,19 @@ TEST(TrainingRunTest, AResumeKeepsTheRunsBudgetAndRefusesWhatDoesNotFit) {
   EXPECT_THROW(
       TrainingRun::resume(factory, integer_kwargs, folder, TrainBudget{16, 0.0}, {}, {out, errors}),
       RunRequestError);
+  {
+    // Another process training in the folder: a resume is refused before it reads anything.
+    const RunLock other = RunLock::acquire(folder, "train");
+    try {
+      TrainingRun::resume(factory, integer_kwargs, folder, TrainBudget{24, 0.0}, {}, {out, errors});
+      ADD_FAILURE() << "a resume of a folder in use was accepted";
+    } catch (const std::runtime_error& error) {
+      EXPECT_NE(std::string(error.what()).find("is in use: another process (pid"),
+                std::string::npos)
+          << error.what();
+    }
+    EXPECT_EQ(rows(), 2U);
+  }
   ResumeChecks given;
   given.num_threads = 1;  // the run's
   given.eval_episodes = 3;
