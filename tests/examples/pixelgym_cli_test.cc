@@ -220,6 +220,13 @@ TEST(PixelgymCliTest, UsageErrorsExitTwoWithAClearMessage) {
       {"check GridWorld-v0 --set novalue", "--set expects key=value, got \"novalue\""},
       {"info GridWorld-v0 --set colour=red", "unknown kwarg \"colour\""},
       {"info GridWorld-v0 --set render_width=wide", "cannot read \"wide\" as an int"},
+      // Spaces around a key or a number are refused alike, before or after.
+      {"info GridWorld-v0 --set 'render_width= 64'",
+       "--set render_width: \" 64\" has spaces around it; write render_width=64"},
+      {"info GridWorld-v0 --set 'render_width=64 '",
+       "--set render_width: \"64 \" has spaces around it; write render_width=64"},
+      {"info GridWorld-v0 --set ' render_width=64'",
+       "the key has spaces around it; write render_width=64"},
       {"snapshot GridWorld-v0 --observation --out " + out, "try --set obs_mode=pixels"},
       {"help nope", "help: unknown subcommand \"nope\""},
   };
