@@ -66,6 +66,7 @@ _core._set_reset_needed_type(ResetNeeded)
 from . import _env, _vector  # noqa: E402
 from ._env import Env, make  # noqa: E402
 from ._vector import VectorEnv, make_vec  # noqa: E402
+from ._core_backed import wrap_list as _wrap_list  # noqa: E402
 
 
 def ids():
@@ -77,7 +78,7 @@ def info(id, wrap=(), **kwargs):
     """What ``make(id, wrap=wrap, **kwargs)`` gives, without making it (no world, no GL context):
     a dict with the spaces (pixelgym's own), max_episode_steps, cameras, metadata, and the kwargs
     the env accepts (name, type, default, doc). Raises as ``make`` does."""
-    return _core.describe(id, kwargs, list(wrap))
+    return _core.describe(id, kwargs, _wrap_list(wrap))
 
 
 def wrapper_specs():

@@ -7,7 +7,7 @@ import types
 
 from . import _core
 from . import _gymnasium as gymnasium
-from ._core_backed import CoreBacked
+from ._core_backed import CoreBacked, wrap_list
 from ._random import NumpyRandom, seed_np_random
 from ._spaces import to_gymnasium
 
@@ -64,7 +64,8 @@ class Env(CoreBacked, _Base):
             raise ValueError(
                 f"{id}: render_mode must be one of {list(_RENDER_MODES)}, got {render_mode!r}"
             )
-        self._core = _core.Env(id, kwargs, list(wrap))
+        wrap = wrap_list(wrap)
+        self._core = _core.Env(id, kwargs, wrap)
         self._id = id
         self._wrap = tuple(wrap)
         self._kwargs = dict(kwargs)

@@ -5,7 +5,7 @@ import numpy as np
 
 from . import _core
 from . import _gymnasium as gymnasium
-from ._core_backed import CoreBacked
+from ._core_backed import CoreBacked, wrap_list
 from ._random import NumpyRandom, seed_np_random
 from ._spaces import to_gymnasium
 
@@ -76,7 +76,8 @@ class VectorEnv(CoreBacked, _Base):
             raise ValueError(
                 f"{id}: render_mode must be None or 'rgb_array', got {render_mode!r}"
             )
-        self._core = _core.VectorEnv(id, num_envs, kwargs, list(wrap), mode, num_threads,
+        wrap = wrap_list(wrap)
+        self._core = _core.VectorEnv(id, num_envs, kwargs, wrap, mode, num_threads,
                                      _mode_name(autoreset_mode), share_gl_contexts)
         self._id = id
         self._args = dict(num_envs=num_envs, num_threads=num_threads,

@@ -62,6 +62,22 @@ def test_bad_wrapper_specs_and_vector_options():
         pixelgym.make_vec("GridWorld-v0", 2, mode="sync").step_async(np.zeros(2, np.int64))
 
 
+def test_one_wrapper_spec_may_be_given_as_a_string():
+    # A str is one spec, not a sequence of one-letter specs ("unknown wrapper 'g'").
+    env = pixelgym.make("CartPoleSwingup-v0", wrap="grayscale", obs_mode="pixels")
+    assert env.observation_space["pixels"].shape == (84, 84)
+    env.close()
+    vec = pixelgym.make_vec("CartPoleSwingup-v0", 2, wrap="grayscale", obs_mode="pixels",
+                            mode="sync")
+    assert vec.single_observation_space["pixels"].shape == (84, 84)
+    vec.close()
+    assert pixelgym.info("CartPoleSwingup-v0", wrap="grayscale", obs_mode="pixels")
+    with pytest.raises(TypeError, match="wrap= takes a wrapper spec"):
+        pixelgym.make("CartPoleSwingup-v0", wrap=5)
+    with pytest.raises(TypeError, match="got int 3"):
+        pixelgym.make("CartPoleSwingup-v0", wrap=["grayscale", 3])
+
+
 def test_wrong_actions_raise_value_errors_naming_the_space():
     env = made()
     with pytest.raises(ValueError, match=r"not in Box\(-1.0, 1.0, \(1,\), float32\): shape \(2,\)"):
