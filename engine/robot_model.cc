@@ -6,7 +6,10 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cctype>
+#include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -63,9 +66,153 @@ std::string read_file(const std::string& path) {
   return text.str();
 }
 
+// The deepest nesting of elements in `text`, counted without parsing it (tinyxml, under urdfdom,
+// parses recursively: a file nested 50,000 deep overflowed the stack). Comments, declarations,
+// processing instructions, CDATA and quoted attribute values are skipped; it need not be exact
+// for malformed XML, which the parser then refuses.
+std::size_t element_depth(const std::string& text) {
+  std::size_t depth = 0;
+  std::size_t deepest = 0;
+  std::size_t i = 0;
+  const auto skip_past = [&](const char* end) {
+    const std::size_t found = text.find(end, i);
+    i = found == std::string::npos ? text.size() : found + std::strlen(end);
+  };
+  while (i < text.size()) {
+    if (text[i] != '<') {
+      ++i;
+      continue;
+    }
+    if (text.compare(i, 4, "<!--") == 0) {
+      skip_past("-->");
+    } else if (text.compare(i, 9, "<![CDATA[") == 0) {
+      skip_past("]]>");
+    } else if (text.compare(i, 2, "<?") == 0 || text.compare(i, 2, "<!") == 0) {
+      skip_past(">");
+    } else if (text.compare(i, 2, "</") == 0) {
+      if (depth > 0) --depth;
+      skip_past(">");
+    } else {
+      // An opening tag: to its '>' outside quotes; "/>" closes it at once.
+      char quote = 0;
+      std::size_t j = i + 1;
+      for (; j < text.size(); ++j) {
+        const char c = text[j];
+        if (quote != 0) {
+          if (c == quote) quote = 0;
+        } else if (c == '"' || c == '\'') {
+          quote = c;
+        } else if (c == '>') {
+          break;
+        }
+      }
+      const bool self_closing = j < text.size() && j > i + 1 && text[j - 1] == '/';
+      if (!self_closing) deepest = std::max(deepest, ++depth);
+      i = j + 1;
+    }
+  }
+  return deepest;
+}
+
+// The numbers in attribute `attribute` of `element`, when it has one: `count` of them, each
+// finite and (when `positive`) > 0, or the file is refused naming `where`. urdfdom reads them
+// leniently: a box size of "nan 1 1" made it drop the whole visual without an error.
+void check_numbers(const TiXmlElement* element, const char* attribute, std::size_t count,
+                   bool positive, const std::string& path, const std::string& where) {
+  if (element == nullptr) return;
+  const char* text = element->Attribute(attribute);
+  if (text == nullptr) return;
+  std::vector<double> values;
+  const char* at = text;
+  for (;;) {
+    while (*at != '\0' && std::isspace(static_cast<unsigned char>(*at)) != 0) ++at;
+    if (*at == '\0') break;
+    char* end = nullptr;
+    const double value = std::strtod(at, &end);
+    const bool number =
+        end != at && (*end == '\0' || std::isspace(static_cast<unsigned char>(*end)) != 0);
+    if (!number || !std::isfinite(value) || (positive && !(value > 0))) {
+      values.clear();
+      break;
+    }
+    values.push_back(value);
+    at = end;
+  }
+  if (values.size() != count) {
+    fail(path, where + " <" + element->Value() + " " + attribute + "=\"" + text + "\">: expected " +
+                   (count == 1 ? std::string("a finite number")
+                               : std::to_string(count) + " finite numbers") +
+                   (positive ? " > 0" : ""));
+  }
+}
+
+// An origin's xyz and rpy: three finite numbers each.
+void check_origin(const TiXmlElement* parent, const std::string& path, const std::string& where) {
+  if (parent == nullptr) return;
+  const TiXmlElement* origin = parent->FirstChildElement("origin");
+  check_numbers(origin, "xyz", 3, false, path, where);
+  check_numbers(origin, "rpy", 3, false, path, where);
+}
+
+// The numbers of a link's inertial, visuals and collisions: finite, sizes > 0, mass >= 0.
+void check_link_numbers(const TiXmlElement* link, const std::string& name,
+                        const std::string& path) {
+  const std::string where = "link \"" + name + "\"";
+  if (const TiXmlElement* inertial = link->FirstChildElement("inertial")) {
+    check_origin(inertial, path, where + " inertial");
+    const TiXmlElement* mass = inertial->FirstChildElement("mass");
+    check_numbers(mass, "value", 1, false, path, where + " inertial");
+    if (mass != nullptr && mass->Attribute("value") != nullptr &&
+        std::strtod(mass->Attribute("value"), nullptr) < 0) {
+      fail(path, where + " has mass " + mass->Attribute("value") +
+                     " kg; a mass must be >= 0 (and > 0 for a link that moves)");
+    }
+    const TiXmlElement* inertia = inertial->FirstChildElement("inertia");
+    for (const char* moment : {"ixx", "ixy", "ixz", "iyy", "iyz", "izz"}) {
+      check_numbers(inertia, moment, 1, false, path, where + " inertial");
+    }
+  }
+  for (const char* kind : {"visual", "collision"}) {
+    int index = 0;
+    for (const TiXmlElement* element = link->FirstChildElement(kind); element != nullptr;
+         element = element->NextSiblingElement(kind), ++index) {
+      const std::string element_where = where + " " + kind + " " + std::to_string(index);
+      check_origin(element, path, element_where);
+      const TiXmlElement* geometry = element->FirstChildElement("geometry");
+      if (geometry == nullptr) continue;
+      check_numbers(geometry->FirstChildElement("box"), "size", 3, true, path, element_where);
+      check_numbers(geometry->FirstChildElement("sphere"), "radius", 1, true, path, element_where);
+      for (const char* round : {"cylinder", "capsule"}) {
+        check_numbers(geometry->FirstChildElement(round), "radius", 1, true, path, element_where);
+        check_numbers(geometry->FirstChildElement(round), "length", 1, true, path, element_where);
+      }
+      check_numbers(geometry->FirstChildElement("mesh"), "scale", 3, false, path, element_where);
+    }
+  }
+}
+
+// A joint's origin, axis, limits and dynamics: finite numbers.
+void check_joint_numbers(const TiXmlElement* joint, const std::string& name,
+                         const std::string& path) {
+  const std::string where = "joint \"" + name + "\"";
+  check_origin(joint, path, where);
+  check_numbers(joint->FirstChildElement("axis"), "xyz", 3, false, path, where);
+  for (const char* limit : {"lower", "upper", "effort", "velocity"}) {
+    check_numbers(joint->FirstChildElement("limit"), limit, 1, false, path, where);
+  }
+  for (const char* dynamics : {"damping", "friction"}) {
+    check_numbers(joint->FirstChildElement("dynamics"), dynamics, 1, false, path, where);
+  }
+}
+
 // Checks the structure that urdfdom reports poorly (or not at all) and rewrites capsules.
 XmlFacts inspect_xml(const std::string& path) {
   const std::string text = read_file(path);
+  const std::size_t depth = element_depth(text);
+  if (depth > kMaxElementDepth) {
+    fail(path, "elements nested " + std::to_string(depth) + " deep; a URDF nests at most " +
+                   std::to_string(kMaxElementDepth) + " (a robot's file needs about 6)");
+  }
   TiXmlDocument document;
   document.Parse(text.c_str());
   if (document.Error()) {
@@ -87,6 +234,7 @@ XmlFacts inspect_xml(const std::string& path) {
       fail(path, "two links are named \"" + std::string(name) + "\"");
     }
     links.emplace_back(name);
+    check_link_numbers(link, name, path);
     for (const char* kind : {"visual", "collision"}) {
       int index = 0;
       for (TiXmlElement* element = link->FirstChildElement(kind); element != nullptr;
@@ -102,6 +250,12 @@ XmlFacts inspect_xml(const std::string& path) {
     }
   }
   if (links.empty()) fail(path, "has no links (a robot needs at least one <link>)");
+  if (links.size() > kMaxLinks) {
+    fail(path, "has " + std::to_string(links.size()) +
+                   " links; pixelgym simulates robots of at most " + std::to_string(kMaxLinks) +
+                   " (Bullet keeps, for each joint limit and contact, a Jacobian over all of the "
+                   "robot's degrees of freedom: memory grows with the square of the link count)");
+  }
 
   std::map<std::string, std::string> parent_joint_of;  // child link -> joint
   std::map<std::string, std::vector<std::string>> children_of;
@@ -110,6 +264,7 @@ XmlFacts inspect_xml(const std::string& path) {
     const std::string name = joint->Attribute("name") != nullptr ? joint->Attribute("name") : "";
     const std::string type = joint->Attribute("type") != nullptr ? joint->Attribute("type") : "";
     if (name.empty()) fail(path, "a <joint> has no name");
+    check_joint_numbers(joint, name, path);
     if (type == "planar" || type == "floating") {
       fail(path, "joint \"" + name + "\" has type " + type +
                      ", which pixelgym does not support inside a robot (supported: revolute, "

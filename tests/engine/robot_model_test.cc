@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <string>
 
 namespace pixelgym::engine {
 namespace {
@@ -151,7 +152,15 @@ INSTANTIATE_TEST_SUITE_P(
                       BadCase{"mesh_without_triangles.urdf", "has no triangles"},
                       BadCase{"unreadable_mesh.urdf", "garbage.stl: cannot be read"},
                       BadCase{"unresolvable_package.urdf", "cannot resolve \"package://"},
-                      BadCase{"does_not_exist.urdf", "cannot be read"}),
+                      BadCase{"does_not_exist.urdf", "cannot be read"},
+                      BadCase{"nan_box_size.urdf",
+                              "link \"base\" visual 0 <box size=\"nan 0.1 0.1\">: expected 3 "
+                              "finite numbers > 0"},
+                      BadCase{"negative_root_mass.urdf", "link \"base\" has mass -3 kg"},
+                      BadCase{"infinite_origin.urdf",
+                              "joint \"j1\" <origin xyz=\"0 inf 0.1\">: expected 3 finite numbers"},
+                      BadCase{"negative_radius.urdf",
+                              "<cylinder radius=\"-0.1\">: expected a finite number > 0"}),
     [](const ::testing::TestParamInfo<BadCase>& param_info) {
       return std::filesystem::path(param_info.param.file).stem().string();
     });
@@ -162,7 +171,67 @@ TEST(RobotModelTest, EveryBadFileHasACase) {
     if (entry.path().extension() == ".urdf" && entry.path().filename() != "minimal_valid.urdf")
       ++count;
   }
-  EXPECT_EQ(count, 18);
+  EXPECT_EQ(count, 22);
+}
+
+// A file of `text` in the test's temporary folder.
+std::string write_temporary(const std::string& name, const std::string& text) {
+  const auto path = std::filesystem::temp_directory_path() / ("pixelgym_robot_model_" + name);
+  std::ofstream(path) << text;
+  return path.string();
+}
+
+TEST(RobotModelTest, DeeplyNestedElementsAreRefusedBeforeParsing) {
+  // 50,000 nested elements overflowed tinyxml's recursion (a segfault of pixelgym inspect).
+  std::string text = "<robot name=\"deep\"><link name=\"base\"/>";
+  for (int i = 0; i < 50000; ++i) text += "<a x=\"<b>\">";
+  for (int i = 0; i < 50000; ++i) text += "</a>";
+  text += "</robot>";
+  const std::string path = write_temporary("deep.urdf", text);
+  MeshCache meshes;
+  try {
+    parse_urdf(path, meshes);
+    FAIL() << "a URDF nested 50,001 deep was accepted";
+  } catch (const UrdfError& error) {
+    EXPECT_THAT(error.what(), HasSubstr("elements nested 50001 deep; a URDF nests at most 100"));
+  }
+  // Comments, CDATA, self-closing tags and quoted '>' do not count as nesting.
+  std::string flat = "<robot name=\"flat\"><!-- <a><a><a> --><link name=\"base\" n=\">\"/>";
+  for (int i = 0; i < 200; ++i) flat += "<a/><![CDATA[<b><b>]]><?pi <c>?>";
+  flat += "</robot>";
+  EXPECT_EQ(parse_urdf(write_temporary("flat.urdf", flat), meshes)->links().size(), 1U);
+}
+
+std::string chain_urdf(std::size_t links) {
+  std::string text = "<robot name=\"chain\">";
+  const std::string inertial =
+      "<inertial><mass value=\"1\"/><inertia ixx=\"0.01\" iyy=\"0.01\" izz=\"0.01\" "
+      "ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>";
+  for (std::size_t i = 0; i < links; ++i) {
+    text += "<link name=\"l" + std::to_string(i) + "\">" + inertial + "</link>";
+  }
+  for (std::size_t i = 1; i < links; ++i) {
+    text += "<joint name=\"j" + std::to_string(i) + "\" type=\"revolute\"><parent link=\"l" +
+            std::to_string(i - 1) + "\"/><child link=\"l" + std::to_string(i) +
+            "\"/><axis xyz=\"0 1 0\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" "
+            "velocity=\"1\"/></joint>";
+  }
+  return text + "</robot>";
+}
+
+TEST(RobotModelTest, RobotsOfMoreThanTheLinkLimitAreRefused) {
+  // A chain of 3,000 links took 722 MB in Bullet, one of 10,000 5.7 GB: refused, naming the limit.
+  MeshCache meshes;
+  EXPECT_EQ(
+      parse_urdf(write_temporary("chain512.urdf", chain_urdf(kMaxLinks)), meshes)->links().size(),
+      kMaxLinks);
+  try {
+    parse_urdf(write_temporary("chain3000.urdf", chain_urdf(3000)), meshes);
+    FAIL() << "a chain of 3,000 links was accepted";
+  } catch (const UrdfError& error) {
+    EXPECT_THAT(error.what(),
+                HasSubstr("has 3000 links; pixelgym simulates robots of at most 512"));
+  }
 }
 
 TEST(RobotModelTest, InlineColoursAndTextureFileNames) {
