@@ -2,8 +2,12 @@
 # (Release, in build/), then run.
 #   make demo   the main job
 #   make test   every test, through ctest (FormatCheck among them: see format-check)
-#   make test-tsan   the tests labelled threads, built with ThreadSanitizer in build-tsan/ (not in
-#                    `make test`: about 4 minutes of tests, plus the build)
+#   make test-asan   every test, built with AddressSanitizer and UBSan in build-asan/ (CI runs it
+#                    after `make test`)
+#   make test-tsan   the tests labelled threads, built with ThreadSanitizer in build-tsan/ (CI runs
+#                    it after test-asan)
+#   make fuzz        builds the fuzz targets with libFuzzer (clang) in build-fuzz/ and fuzzes one:
+#                    FUZZ_TARGET=urdf FUZZ_SECONDS=600 (docs/reliability.md)
 #   make format-check   the project's C++ files against .clang-format (clang-format 14); exits 1
 #                       naming the files that differ. `make format` rewrites them.
 BUILD_DIR ?= build
@@ -11,7 +15,7 @@ BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 PIXELGYM := $(BUILD_DIR)/examples/pixelgym
 
-.PHONY: all deps configure build demo test test-tsan format-check format goldens bench clean
+.PHONY: all deps configure build demo test test-asan test-tsan fuzz format-check format goldens bench clean
 
 all: build
 
@@ -40,6 +44,21 @@ demo: build
 test: build
 	ctest --test-dir $(BUILD_DIR) --output-on-failure --parallel $(JOBS)
 
+# AddressSanitizer (with LeakSanitizer) and UndefinedBehaviorSanitizer over every test, the fuzz
+# corpora's replays (Fuzz.*) among them, in a Debug build at -O1 (asserts on; warnings are not
+# errors here: GCC's are false alarms under the sanitizers' instrumentation). lsan.supp names the
+# third-party leaks suppressed, each with its reason; ASAN_EXCLUDE the tests left out, and why.
+ASAN_BUILD_DIR ?= build-asan
+ASAN_EXCLUDE ?=
+test-asan: deps
+	cmake -S . -B $(ASAN_BUILD_DIR) -DCMAKE_BUILD_TYPE=Debug -DPIXELGYM_SANITIZE=address \
+	  -DPIXELGYM_BUILD_BENCH=OFF -DPIXELGYM_WERROR=OFF
+	cmake --build $(ASAN_BUILD_DIR) --parallel $(JOBS)
+	ASAN_OPTIONS="detect_stack_use_after_return=0 strict_init_order=1 $(ASAN_OPTIONS)" \
+	UBSAN_OPTIONS="print_stacktrace=1 halt_on_error=1 $(UBSAN_OPTIONS)" \
+	LSAN_OPTIONS="suppressions=$(CURDIR)/lsan.supp print_suppressions=0 $(LSAN_OPTIONS)" \
+	  ctest --test-dir $(ASAN_BUILD_DIR) --output-on-failure --parallel $(JOBS) $(ASAN_EXCLUDE)
+
 # ThreadSanitizer over the threading tests (ctest label threads; a test joins with
 # `pixelgym_add_test(... LABELS threads)`). Only the tests labelled threads are built. tsan.supp
 # names the third-party libraries whose reports are suppressed, each with its reason, and why
@@ -51,6 +70,22 @@ test-tsan: deps
 	cmake --build $(TSAN_BUILD_DIR) --parallel $(JOBS) --target threads_tests
 	TSAN_OPTIONS="suppressions=$(CURDIR)/tsan.supp halt_on_error=1 detect_deadlocks=0 $(TSAN_OPTIONS)" \
 	  ctest --test-dir $(TSAN_BUILD_DIR) -L threads --output-on-failure --parallel $(JOBS)
+
+# libFuzzer over one fuzz target (fuzz/NAME_fuzz.cc) for FUZZ_SECONDS, growing fuzz/corpus/NAME/
+# in place; a finding is written to build-fuzz/findings/NAME/ (fix it, and add the file to the
+# corpus: every build replays it). Built with clang, everything instrumented for coverage, ASan and
+# UBSan.
+FUZZ_BUILD_DIR ?= build-fuzz
+FUZZ_TARGET ?= urdf
+FUZZ_SECONDS ?= 600
+fuzz: deps
+	cmake -S . -B $(FUZZ_BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=clang++ \
+	  -DPIXELGYM_FUZZ=ON -DPIXELGYM_BUILD_BENCH=OFF -DPIXELGYM_BUILD_PYTHON=OFF
+	cmake --build $(FUZZ_BUILD_DIR) --parallel $(JOBS) --target $(FUZZ_TARGET)_fuzz
+	mkdir -p $(FUZZ_BUILD_DIR)/findings/$(FUZZ_TARGET)
+	$(FUZZ_BUILD_DIR)/fuzz/$(FUZZ_TARGET)_fuzz -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1 \
+	  -artifact_prefix=$(FUZZ_BUILD_DIR)/findings/$(FUZZ_TARGET)/ $(FUZZ_FLAGS) \
+	  fuzz/corpus/$(FUZZ_TARGET)
 
 # CI runs `make test`, which runs this same check as the ctest test FormatCheck
 # (tests/examples/CMakeLists.txt): it then shows in ctest's summary beside the other tests, and a
