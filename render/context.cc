@@ -1,6 +1,8 @@
 #include "render/context.h"
 
+#include <cstdlib>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "render/gl.h"
@@ -16,8 +18,27 @@ struct Context::Impl {
   std::vector<unsigned char> dummy = std::vector<unsigned char>(4);
 };
 
+namespace {
+
+// libOSMesa draws with a software Gallium driver, and with GALLIUM_DRIVER naming one it cannot
+// load (say "bogus", or a GPU's) Mesa 22's OSMesaCreateContextAttribs crashes (a null call in
+// glLabelObjectEXT) instead of failing: refused here first.
+void check_gallium_driver() {
+  const char* driver = std::getenv("GALLIUM_DRIVER");
+  if (driver == nullptr || *driver == '\0') return;
+  const std::string name = driver;
+  if (name == "llvmpipe" || name == "softpipe") return;
+  throw std::runtime_error("Context: GALLIUM_DRIVER is \"" + name +
+                           "\", which libOSMesa cannot draw with (it draws with llvmpipe or "
+                           "softpipe, and crashes on any other); unset GALLIUM_DRIVER or set it to "
+                           "llvmpipe");
+}
+
+}  // namespace
+
 Context::Context(GlBackend backend, int mesa_copy)
     : backend_(backend), impl_(std::make_unique<Impl>()) {
+  check_gallium_driver();
   impl_->library = &library_for_new_context(mesa_copy);
   prepare_thread(*impl_->library);
   const int attributes[] = {OSMESA_FORMAT,
@@ -33,9 +54,15 @@ Context::Context(GlBackend backend, int mesa_copy)
                             0};
   impl_->context = impl_->library->create_context_attribs(attributes, nullptr);
   if (impl_->context == nullptr) {
-    throw std::runtime_error(
+    const char* version = std::getenv("MESA_GL_VERSION_OVERRIDE");
+    std::string reason =
         "Context: OSMesa could not create an OpenGL 3.3 core context (OSMesaCreateContextAttribs "
-        "failed; is libOSMesa from Mesa < 25.1 installed, and does llvmpipe load?)");
+        "failed; is libOSMesa from Mesa < 25.1 installed, and does llvmpipe load?";
+    if (version != nullptr) {
+      reason += std::string(" MESA_GL_VERSION_OVERRIDE=") + version +
+                " caps the version below 3.3: unset it";
+    }
+    throw std::runtime_error(reason + ")");
   }
   make_current();
 }
