@@ -116,6 +116,27 @@ class RecordVideo::Clip {
   Clip& operator=(const Clip&) = delete;
 
  private:
+  // The OS's reason why 64 kB (a video header and a first frame, or so) cannot be written to the
+  // temporary file, or "" when they can.
+  std::string probe_write() const {
+    const int fd = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (fd < 0) return std::strerror(errno);
+    const std::string zeros(64 * 1024, '\0');
+    std::size_t written = 0;
+    int error = 0;
+    while (written < zeros.size() && error == 0) {
+      const ssize_t n = ::write(fd, zeros.data() + written, zeros.size() - written);
+      if (n < 0) {
+        if (errno != EINTR) error = errno;
+      } else {
+        written += static_cast<std::size_t>(n);
+      }
+    }
+    if (error == 0 && ::fsync(fd) != 0) error = errno;
+    ::close(fd);
+    return error == 0 ? "" : std::strerror(error);
+  }
+
   void open_encoder(double fps) {
     const std::string preferred = preferred_fourcc();
     if (open(preferred, fps)) return;
@@ -129,6 +150,12 @@ class RecordVideo::Clip {
                      "once per process)\n";
       }
       return;
+    }
+    // The encoders also fail to open when the file cannot be written (a full disk): say so.
+    const std::string write_error = probe_write();
+    if (!write_error.empty()) {
+      throw std::runtime_error("RecordVideo: cannot write " + quoted(final_path_) + ": " +
+                               write_error + " (the video encoder could not open its file)");
     }
     throw std::runtime_error("RecordVideo: cannot open a video encoder for " + quoted(final_path_) +
                              ": neither " + preferred + " nor " + kFallbackFourcc +

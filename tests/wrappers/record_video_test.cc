@@ -35,6 +35,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 // Renders (height, width, 3) frames: a gradient background with a white square that moves one
 // pixel per step (or per-pixel noise, which compresses badly, with `noise`). Episodes end after
@@ -465,6 +466,32 @@ TEST(RecordVideoTest, FullDiskMidClipLeavesNoFile) {
   EXPECT_THAT(message, HasSubstr("nothing was written"));
   EXPECT_EQ(files_in(tiny.path()), std::set<std::string>{}) << message;
   EXPECT_FALSE(record.recording());
+}
+
+// A disk already full when a clip starts: the encoder does not open, and the error says why (it
+// said "cannot open a video encoder ... neither avc1 nor mp4v opened").
+TEST(RecordVideoTest, FullDiskWhenAClipStartsNamesTheFullDisk) {
+  TmpfsMount tiny("size=64k");
+  if (!tiny.mounted()) GTEST_SKIP() << "cannot mount a tmpfs here: " << tiny.why();
+  auto env = std::make_unique<FrameEnv>(64, 64, 20);
+  RecordVideo record(std::move(env), tiny.path(), every_episode);
+  {
+    std::ofstream filler(tiny.path() / "filler", std::ios::binary);
+    const std::string block(4096, 'x');
+    while (filler.write(block.data(), static_cast<std::streamsize>(block.size())) &&
+           filler.flush()) {
+    }
+  }
+  std::string message;
+  try {
+    run_episode(record);
+    record.close();
+  } catch (const std::runtime_error& error) {
+    message = error.what();
+  }
+  EXPECT_THAT(message, HasSubstr("No space left on device")) << message;
+  EXPECT_THAT(message, Not(HasSubstr("cannot open a video encoder"))) << message;
+  EXPECT_EQ(files_in(tiny.path()), std::set<std::string>{"filler"}) << message;
 }
 
 TEST(RecordVideoTest, FullDiskInTheDestructorLeavesNoFileAndSaysSo) {
