@@ -2,6 +2,7 @@
 // run folder, a run killed with SIGKILL resumes from its last checkpoint, and a truncated or
 // corrupt checkpoint is refused, never loaded. Tiny settings (32x32 pixels, 2 envs, 16-step
 // rollouts) keep it to seconds; learning itself is measured in bench/, not here.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <sched.h>
 #include <signal.h>
@@ -283,6 +284,35 @@ TEST(TrainCliTest, ARunKilledMidTrainingResumesFromItsLastCheckpoint) {
   for (std::size_t i = 0; i < steps.size(); ++i) {
     EXPECT_EQ(steps[i], static_cast<double>(i + 1) * 32) << "row " << i;
   }
+  fs::remove_all(folder);
+}
+
+// A run killed before its first checkpoint has nothing to resume from: --resume starts it afresh
+// with its settings (it was refused, "no valid checkpoint there", and so was --out, "already
+// holds a run", leaving the folder with no way forward).
+TEST(TrainCliTest, ARunKilledBeforeItsFirstCheckpointResumesAfresh) {
+  const fs::path folder = fresh_folder("killed_early");
+  const fs::path run = folder / "run";
+  const bool killed = run_cli_until(
+      folder,
+      train_arguments(folder, "--steps 100000 --checkpoint-every 1000 --out " + run.string()),
+      run / "progress.csv");
+  ASSERT_TRUE(killed) << read_text(folder / "log.txt");
+  ASSERT_TRUE(trainer::list_checkpoints(run).empty());
+  const CliRun again = run_cli(train_arguments(folder, "--steps 64 --out " + run.string()));
+  EXPECT_NE(again.exit_code, 0);
+  EXPECT_THAT(again.output, ::testing::HasSubstr("already holds a run (config.json); resume it"));
+
+  const CliRun resumed = run_cli("train --resume " + run.string() + " --steps 64");
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  EXPECT_THAT(resumed.output,
+              ::testing::HasSubstr(run.string() + " stopped before its first checkpoint: "
+                                                  "starting it afresh"));
+  const json summary = json::parse(read_text(run / "summary.json"));
+  EXPECT_EQ(summary.at("env_steps"), 64);
+  const trainer::ProgressTable progress = trainer::read_progress_csv(run / "progress.csv");
+  EXPECT_EQ(progress.column("steps"), (std::vector<double>{32, 64}));
+  EXPECT_FALSE(trainer::list_checkpoints(run).empty());
   fs::remove_all(folder);
 }
 

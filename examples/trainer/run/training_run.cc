@@ -214,8 +214,20 @@ void TrainingRun::load_resume_point(const json& config) {
   for (const auto& skipped : search.skipped) {
     output_.errors << "train: skipping " << skipped.path.string() << ": " << skipped.reason << "\n";
   }
+  if (!search.latest && search.skipped.empty()) {
+    // Stopped before its first checkpoint: nothing was saved to go on from, so the run starts
+    // again from its first step, with the settings of its config.json.
+    restart_ = true;
+    output_.out << "train: " << folder_.string()
+                << " stopped before its first checkpoint: starting it afresh\n";
+    return;
+  }
   if (!search.latest) {
-    throw std::runtime_error("--resume " + folder_.string() + ": no valid checkpoint there");
+    throw std::runtime_error(
+        "--resume " + folder_.string() + ": no valid checkpoint there (the " +
+        std::to_string(search.skipped.size()) +
+        " above cannot be read); remove them to start the run afresh with --resume, or train "
+        "into another --out");
   }
   checkpoint_ = std::move(search.latest);
   meta_ = read_meta(*checkpoint_);
@@ -396,6 +408,12 @@ std::optional<json> TrainingRun::train() {
   algorithm_ = factory_->make(*env_, settings_.algorithm_config, communicator_);
   if (checkpoint_) {
     restore_from_checkpoint();
+  } else if (lead() && restart_) {
+    // Rows logged before the stop are dropped (resumed at step 0), and so are evaluations.
+    fs::remove(folder_ / "eval.csv");
+    json budget = {{"total_env_steps", settings_.total_env_steps()}, {"minutes", budget_minutes_}};
+    if (minutes_given_ > 0.0) budget["minutes_given"] = minutes_given_;
+    run_.emplace(RunFolder::resume(folder_, 0, budget));
   } else if (lead()) {
     run_.emplace(
         RunFolder::create(folder_, settings_to_json(settings_), algorithm_->progress_columns()));

@@ -185,6 +185,8 @@ class TrainingRun {
   std::filesystem::path folder_;
   RunOutput output_;
   std::optional<LoadedCheckpoint> checkpoint_;
+  // A resume of a run stopped before its first checkpoint: it starts afresh in its folder.
+  bool restart_ = false;
   nlohmann::json meta_;          // the checkpoint's
   double budget_minutes_ = 0.0;  // of wall time over the whole run; 0: none
   double minutes_given_ = 0.0;   // TrainBudget::minutes
