@@ -1,8 +1,13 @@
 #include "examples/pixelgym/cli.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <charconv>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <limits>
 
@@ -11,6 +16,8 @@
 #include "wrappers/wrapper_spec.h"
 
 namespace pixelgym::cli {
+
+namespace fs = std::filesystem;
 namespace {
 
 // Whether `text` is wholly a decimal integer of type T (no sign for unsigned T, no spaces).
@@ -149,6 +156,31 @@ std::unique_ptr<Env> make_env(const std::string& id, const std::vector<std::stri
   } catch (const std::invalid_argument& error) {
     throw UsageError(error.what());  // names the spec, the wrapper and the argument
   }
+}
+
+void check_video_file(const std::string& option, const std::string& path) {
+  const fs::path file(path);
+  if (fs::is_directory(file)) {
+    throw UsageError(option + " " + path + " is a folder; name a video file (FILE.mp4)");
+  }
+  const fs::path folder = file.parent_path().empty() ? fs::path(".") : file.parent_path();
+  if (fs::exists(folder) && !fs::is_directory(folder)) {
+    throw UsageError(option + " " + path + ": " + folder.string() + " is a file, not a folder");
+  }
+  std::error_code error;
+  fs::create_directories(folder, error);
+  if (error) {
+    throw std::runtime_error(option + " " + path + ": cannot create the video folder \"" +
+                             folder.string() + "\": " + error.message());
+  }
+  std::string probe = (folder / ".pixelgym-write-check-XXXXXX").string();
+  const int fd = ::mkstemp(probe.data());
+  if (fd < 0) {
+    throw std::runtime_error(option + " " + path + ": cannot create a file in the video folder \"" +
+                             folder.string() + "\": " + std::strerror(errno));
+  }
+  ::close(fd);
+  ::unlink(probe.c_str());
 }
 
 void write_frame_png(const std::string& path, const Array& frame) {

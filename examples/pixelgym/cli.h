@@ -78,6 +78,12 @@ void add_env_options(CLI::App& command, EnvArguments& env);
 std::unique_ptr<Env> make_env(const std::string& id, const std::vector<std::string>& sets,
                               const std::vector<std::string>& wraps = {});
 
+/// Checks, before any work, that a video file can be written at `path` (what `option` named):
+/// throws UsageError when `path` is a folder or its parent is a file, std::runtime_error naming the
+/// folder and the OS's reason when the folder cannot be created or a file cannot be created in it.
+/// Creates the folder when missing (as RecordVideo would).
+void check_video_file(const std::string& option, const std::string& path);
+
 /// Writes an (H, W, 3) uint8 frame as PNG, creating missing parent folders.
 void write_frame_png(const std::string& path, const Array& frame);
 

@@ -63,6 +63,8 @@ int run_record(const RecordArguments& args) {
   if (one_file && fs::path(args.out).filename() == ".mp4") {
     throw UsageError("--out " + args.out + ": the clip needs a name before .mp4");
   }
+  // Before any episode runs: a path that cannot take the clip is found now, not after them.
+  if (one_file) check_video_file("--out", args.out);
   std::unique_ptr<Env> env = make_recorded_env(args.id, args.sets, args.wraps);
   // A folder: one clip per episode, "{folder}/{id}-episode-{N}.mp4". One file: the clip is
   // started by hand before the first reset, under the file's own name.

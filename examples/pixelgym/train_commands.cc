@@ -352,6 +352,8 @@ int run_eval(const EvalArguments& args) {
       (fs::path(args.video).extension() != ".mp4" || fs::path(args.video).stem().empty())) {
     throw UsageError("eval --video: expected a FILE.mp4, got \"" + args.video + "\"");
   }
+  // Before any episode runs: a path that cannot take the video is found now, not after them.
+  if (!args.video.empty()) check_video_file("eval --video", args.video);
   trainer::tune_process_for_training();
   trainer::EvaluationRequest request{args.episodes, args.seed, args.stochastic, std::nullopt};
   if (!args.video.empty()) request.video = fs::path(args.video);

@@ -120,6 +120,19 @@ TEST(RecordCliTest, UsageErrorsExitTwo) {
   EXPECT_FALSE(fs::exists(folder));
 }
 
+// An --out that cannot take the clip is refused before any episode runs (a folder named a.mp4
+// was found only after the episode, by the rename).
+TEST(RecordCliTest, AnOutputFileThatIsAFolderIsRefusedBeforeAnyEpisode) {
+  const fs::path folder = fresh_folder();
+  fs::create_directories(folder / "a.mp4");
+  const CliRun result = run("record CartPoleSwingup-v0 --out " + (folder / "a.mp4").string());
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("--out " + (folder / "a.mp4").string() +
+                                       " is a folder; name a video file (FILE.mp4)"));
+  EXPECT_THAT(result.output, Not(HasSubstr("cannot rename")));
+  EXPECT_EQ(files_in(folder), std::set<std::string>{"a.mp4"});
+}
+
 TEST(RecordCliTest, HelpIsTheSubcommandsOwn) {
   const CliRun help = run("record --help");
   EXPECT_EQ(help.exit_code, 0);

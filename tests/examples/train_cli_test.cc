@@ -152,6 +152,15 @@ TEST(TrainCliTest, AShortRunWritesACompleteRunFolder) {
   EXPECT_NE(avi.output.find("expected a FILE.mp4, got"), std::string::npos) << avi.output;
   EXPECT_FALSE(fs::exists(folder / "clip.mp4"));
   EXPECT_FALSE(fs::exists(folder / "clip.avi"));
+  // So is a path that cannot take the video, before the episodes (a folder named clip.mp4 was
+  // found by the rename, after them, and no return was printed).
+  fs::create_directories(folder / "folder.mp4");
+  const CliRun into_folder =
+      run_cli("eval " + run.string() + " --episodes 1 --video " + (folder / "folder.mp4").string());
+  EXPECT_EQ(into_folder.exit_code, 2) << into_folder.output;
+  EXPECT_THAT(into_folder.output, ::testing::HasSubstr("is a folder; name a video file"));
+  EXPECT_THAT(into_folder.output, ::testing::Not(::testing::HasSubstr("episode 0")));
+  fs::remove(folder / "folder.mp4");
   // A second run into the same folder is refused; the run is left as it was.
   const CliRun again = run_cli(train_arguments(folder, "--steps 32 --out " + run.string()));
   EXPECT_EQ(again.exit_code, 1) << again.output;
