@@ -401,17 +401,16 @@ struct World::Impl {
       if (!std::isfinite(origin.length2()) ||
           !std::isfinite(body.rigid->getLinearVelocity().length2()) ||
           !std::isfinite(body.rigid->getAngularVelocity().length2())) {
-        throw std::runtime_error("World: body \"" + body.options.name +
-                                 "\" has a non-finite state after step " + std::to_string(step));
+        throw NonFiniteState("World: body \"" + body.options.name +
+                             "\" has a non-finite state after step " + std::to_string(step));
       }
     }
   }
 
   [[noreturn]] static void throw_non_finite(const Robot& robot, const std::string& where,
                                             std::int64_t step) {
-    throw std::runtime_error("World: robot \"" + robot.model->name() +
-                             "\" has a non-finite state (" + where + ") after step " +
-                             std::to_string(step));
+    throw NonFiniteState("World: robot \"" + robot.model->name() + "\" has a non-finite state (" +
+                         where + ") after step " + std::to_string(step));
   }
 
   Eigen::Isometry3d link_pose(const Robot& robot, int link) const {
@@ -719,8 +718,8 @@ void World::set_joint_commands(RobotId robot, const Eigen::Ref<const Eigen::Vect
   check_dof_count("set_joint_commands", r.model->name(), r.dofs.size(), commands.size(),
                   "commands");
   if (!commands.allFinite()) {
-    throw std::invalid_argument("World::set_joint_commands: non-finite command for robot \"" +
-                                r.model->name() + "\"");
+    throw NonFiniteCommand("World::set_joint_commands: non-finite command for robot \"" +
+                           r.model->name() + "\"");
   }
   for (std::size_t d = 0; d < r.dofs.size(); ++d)
     r.dofs[d].command = commands[static_cast<Eigen::Index>(d)];

@@ -73,6 +73,20 @@ struct Contact {
 };
 
 /// Names a robot of one World: what `World::add_robot` returned. Only meaningful for that world.
+/// Thrown by World::step when the simulation went non-finite (a robot's base or joint, or a
+/// body), naming what and the simulation step.
+class NonFiniteState : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Thrown by World::set_joint_commands for a command that is not finite (a std::invalid_argument,
+/// as any bad value given to the World).
+class NonFiniteCommand : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
 struct RobotId {
   int index = -1;
 };

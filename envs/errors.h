@@ -19,8 +19,9 @@ namespace pixelgym {
 //   ended, anything but close after close). Python: gymnasium.error.ResetNeeded, or
 //   RuntimeError without gymnasium.
 // - std::runtime_error: the environment failing, not the caller (a file that cannot be read or
-//   written, a GL context that cannot be made, a simulation that went non-finite).
-//   Python: RuntimeError.
+//   written, a GL context that cannot be made). Python: RuntimeError.
+// - PhysicsDivergence (a std::runtime_error): a simulation that went non-finite. Python:
+//   RuntimeError.
 //
 // std::out_of_range and std::invalid_argument both derive from std::logic_error, and so does
 // ResetNeeded: catch ResetNeeded before std::logic_error when the difference matters.
@@ -31,6 +32,15 @@ namespace pixelgym {
 class ResetNeeded : public std::logic_error {
  public:
   using std::logic_error::logic_error;
+};
+
+/// Thrown by an env whose simulation diverged: a state, observation or reward that is not finite
+/// (an absurd force, a stiff setting). The message names the env, the step of the episode and what
+/// went non-finite; the episode is over, and reset() starts a new one. An env never returns a
+/// non-finite observation or reward instead.
+class PhysicsDivergence : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
 };
 
 }  // namespace pixelgym

@@ -4,7 +4,9 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
 
+#include "envs/errors.h"
 #include "envs/spaces/box.h"
 #include "envs/spaces/dict.h"
 
@@ -184,14 +186,32 @@ void PixelEnv::do_reset(std::optional<std::uint64_t> /*seed*/, const Options& op
 
 void PixelEnv::do_step(const Value& action, StepResult& out) {
   for (int r = 0; r < config_.action_repeat; ++r) {
-    task_->before_step(action, *world_);
-    world_->step(substeps_);
+    try {
+      task_->before_step(action, *world_);
+      world_->step(substeps_);
+    } catch (const engine::NonFiniteCommand& error) {
+      ++control_steps_;
+      diverged(error.what());
+    } catch (const engine::NonFiniteState& error) {
+      ++control_steps_;
+      diverged(error.what());
+    }
     ++control_steps_;
-    out.reward += task_->reward(*world_);
+    const double reward = task_->reward(*world_);
+    if (!std::isfinite(reward)) diverged("the reward is " + std::to_string(reward));
+    out.reward += reward;
     out.terminated = task_->terminated(*world_);
     if (out.terminated) break;
   }
   observe(out.obs);
+  if (!std::isfinite(out.reward)) diverged("the summed reward is " + std::to_string(out.reward));
+}
+
+void PixelEnv::diverged(const std::string& what) const {
+  throw PhysicsDivergence(name() + ": the simulation diverged at control step " +
+                          std::to_string(control_steps_) + " of the episode: " + what +
+                          " (an action, force or setting too large to simulate); reset() starts "
+                          "a new episode");
 }
 
 void PixelEnv::observe(Value& obs) {
@@ -202,6 +222,17 @@ void PixelEnv::observe(Value& obs) {
   if (config_.has_state()) {
     StateSlots state(state_specs_, slots.data() + next);
     task_->observe(*world_, state);
+    // float32 slots: a large but finite double state (1e39) becomes inf here.
+    for (std::size_t s = 0; s < state_specs_.size(); ++s) {
+      const Array& array = slots[next + s].array();
+      const float* values = array.data<float>();
+      for (std::int64_t i = 0; i < array.size(); ++i) {
+        if (!std::isfinite(values[i])) {
+          diverged("observation \"" + state_specs_[s].name + "\"[" + std::to_string(i) + "] is " +
+                   std::to_string(values[i]));
+        }
+      }
+    }
   }
 }
 

@@ -75,6 +75,8 @@ class PixelEnv final : public Env {
 
  private:
   void observe(Value& obs);
+  // Throws PhysicsDivergence naming the env, the control step and `what` went non-finite.
+  [[noreturn]] void diverged(const std::string& what) const;
   render::Renderer& renderer();
 
   std::unique_ptr<Task> task_;
