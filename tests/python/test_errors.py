@@ -142,3 +142,50 @@ def test_bad_seeds():
         pixelgym.make_vec("GridWorld-v0", 2).reset(seed=[1, 2.5])
     with pytest.raises(ValueError, match=r"seed must be in \[0, 2\*\*64\), got -3"):
         pixelgym.make_vec("GridWorld-v0", 2).reset(seed=[1, -3])
+
+
+def test_objects_used_after_close_raise():
+    env = made(obs_mode="state")
+    env.close()
+    for call in (lambda: env.step(np.zeros(1, np.float32)), env.reset, env.render):
+        with pytest.raises(pixelgym.ResetNeeded, match="after close"):
+            call()
+    env.close()  # closing twice is allowed, as in Gymnasium
+    for mode in ("sync", "async"):
+        envs = pixelgym.make_vec("CartPoleSwingup-v0", 2, mode=mode, obs_mode="state")
+        envs.reset(seed=0)
+        envs.close()
+        with pytest.raises(pixelgym.ResetNeeded, match="after close"):
+            envs.step(np.zeros((2, 1), np.float32))
+        with pytest.raises(pixelgym.ResetNeeded, match="after close"):
+            envs.reset()
+        envs.close()
+
+
+def test_a_vector_env_stepped_from_two_python_threads_is_serialized():
+    import threading
+
+    envs = pixelgym.make_vec("CartPoleSwingup-v0", 4, num_threads=2, obs_mode="state",
+                             max_episode_steps=50)
+    envs.reset(seed=0)
+    errors = []
+    steps = [0, 0]
+
+    def run(index):
+        try:
+            for _ in range(1500):
+                obs, rewards, terminated, truncated, _ = envs.step(
+                    np.full((4, 1), 0.5 - index, np.float32))
+                assert np.all(np.isfinite(rewards)) and np.all(np.isfinite(obs["joint_pos"]))
+                steps[index] += 1
+        except Exception as error:  # noqa: BLE001: any error is the finding
+            errors.append(repr(error))
+
+    threads = [threading.Thread(target=run, args=(i,)) for i in range(2)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    envs.close()
+    assert errors == []
+    assert steps == [1500, 1500]
