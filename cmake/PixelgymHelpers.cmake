@@ -30,8 +30,15 @@ endfunction()
 # PIXELGYM_TEST_OUTPUT_DIR naming where they may write files a person should look at. LABELS
 # gives every test of the file those ctest labels (`threads`: built by the target threads_tests
 # and run under ThreadSanitizer by `make test-tsan`).
+#
+# COUNTS_ALLOCATIONS marks a test that defines malloc and operator new to count allocations
+# (tests/alloc_counter.h): a sanitizer's allocator cannot be replaced, so a sanitizer build leaves
+# it out (what it measures, allocations per step, is the Release build's anyway).
 function(pixelgym_add_test source)
-  cmake_parse_arguments(ARG "" "" "LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "COUNTS_ALLOCATIONS" "" "LIBS;LABELS" ${ARGN})
+  if(ARG_COUNTS_ALLOCATIONS AND NOT PIXELGYM_SANITIZE STREQUAL "")
+    return()
+  endif()
   file(RELATIVE_PATH relative ${PROJECT_SOURCE_DIR}/tests ${CMAKE_CURRENT_SOURCE_DIR}/${source})
   string(REGEX REPLACE "\\.cc$" "" target ${relative})
   string(REPLACE "/" "_" target ${target})

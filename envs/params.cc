@@ -124,8 +124,9 @@ Params resolve_params(const std::vector<ParamSpec>& specs, const Params& given,
   Params resolved;
   for (const ParamSpec& spec : specs) resolved.emplace(spec.name, spec.default_value);
   for (const auto& [key, value] : given) {
-    const auto spec =
-        std::find_if(specs.begin(), specs.end(), [&](const ParamSpec& s) { return s.name == key; });
+    const std::string& name = key;  // (a structured binding cannot be captured before C++20)
+    const auto spec = std::find_if(specs.begin(), specs.end(),
+                                   [&](const ParamSpec& s) { return s.name == name; });
     if (spec == specs.end()) {
       throw std::invalid_argument(context + ": unknown kwarg \"" + key +
                                   "\"; valid kwargs: " + describe_params(specs));
