@@ -81,12 +81,14 @@ test-tsan: deps
 FUZZ_BUILD_DIR ?= build-fuzz
 FUZZ_TARGET ?= urdf
 FUZZ_SECONDS ?= 600
+FUZZ_TIMEOUT ?= 10
 fuzz: deps
 	cmake -S . -B $(FUZZ_BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=clang++ \
 	  -DPIXELGYM_FUZZ=ON -DPIXELGYM_BUILD_BENCH=OFF -DPIXELGYM_BUILD_PYTHON=OFF
 	cmake --build $(FUZZ_BUILD_DIR) --parallel $(JOBS) --target $(FUZZ_TARGET)_fuzz
 	mkdir -p $(FUZZ_BUILD_DIR)/findings/$(FUZZ_TARGET)
-	$(FUZZ_BUILD_DIR)/fuzz/$(FUZZ_TARGET)_fuzz -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1 \
+	$(FUZZ_BUILD_DIR)/fuzz/$(FUZZ_TARGET)_fuzz -max_total_time=$(FUZZ_SECONDS) -timeout=$(FUZZ_TIMEOUT) \
+	  -print_final_stats=1 \
 	  -artifact_prefix=$(FUZZ_BUILD_DIR)/findings/$(FUZZ_TARGET)/ $(FUZZ_FLAGS) \
 	  fuzz/corpus/$(FUZZ_TARGET)
 

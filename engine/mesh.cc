@@ -8,7 +8,13 @@
 #include <assimp/Importer.hpp>
 #include <cctype>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <set>
+#include <sstream>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 namespace pixelgym::engine {
 namespace {
@@ -60,6 +66,62 @@ void append_node(const aiScene& scene, const aiNode& node, const aiMatrix4x4& pa
   }
 }
 
+// Checks a PLY file's header before assimp reads it: assimp 5.2 loops forever on some malformed
+// headers (a "property" line with bytes that are no type, found by fuzz/mesh_fuzz.cc). A header is
+// "ply", a "format" line, then "comment", "obj_info", "element NAME COUNT", "property TYPE NAME"
+// and "property list TYPE TYPE NAME" lines up to "end_header"; anything else is refused, naming
+// the line.
+void check_ply_header(const std::string& path) {
+  const auto fail = [&](int line, const std::string& problem) {
+    throw std::runtime_error("mesh " + path + ": malformed PLY header at line " +
+                             std::to_string(line) + ": " + problem);
+  };
+  std::ifstream in(path, std::ios::binary);
+  static const std::set<std::string> kTypes = {
+      "char", "uchar", "short", "ushort", "int",   "uint",   "float",   "double",
+      "int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
+  std::string line;
+  for (int number = 1; number <= 10000; ++number) {
+    if (!std::getline(in, line)) fail(number, "the file ends before end_header");
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    for (const char c : line) {
+      if (c != ' ' && c != '\t' && std::isprint(static_cast<unsigned char>(c)) == 0) {
+        fail(number, "a byte that is not printable text");
+      }
+    }
+    std::istringstream words(line);
+    std::vector<std::string> word{std::istream_iterator<std::string>(words),
+                                  std::istream_iterator<std::string>()};
+    if (number == 1) {
+      if (line != "ply") fail(number, "expected \"ply\", got \"" + line + "\"");
+      continue;
+    }
+    if (word.empty()) continue;
+    const std::string& key = word[0];
+    if (key == "end_header") return;
+    if (key == "comment" || key == "obj_info") continue;
+    if (key == "format") {
+      if (word.size() != 3 || (word[1] != "ascii" && word[1] != "binary_little_endian" &&
+                               word[1] != "binary_big_endian")) {
+        fail(number, "expected \"format ascii|binary_little_endian|binary_big_endian 1.0\"");
+      }
+    } else if (key == "element") {
+      if (word.size() != 3 || word[2].find_first_not_of("0123456789") != std::string::npos) {
+        fail(number, "expected \"element NAME COUNT\"");
+      }
+    } else if (key == "property") {
+      const bool scalar = word.size() == 3 && kTypes.count(word[1]) != 0;
+      const bool list = word.size() == 5 && word[1] == "list" && kTypes.count(word[2]) != 0 &&
+                        kTypes.count(word[3]) != 0;
+      if (!scalar && !list) {
+        fail(number, "expected \"property TYPE NAME\" or \"property list TYPE TYPE NAME\"");
+      }
+    } else {
+      fail(number, "unknown keyword \"" + key + "\"");
+    }
+  }
+  fail(10000, "no end_header in the first 10,000 lines");
+}
 }  // namespace
 
 std::shared_ptr<const Mesh> load_mesh(const std::string& path) {
@@ -72,6 +134,7 @@ std::shared_ptr<const Mesh> load_mesh(const std::string& path) {
   if (!std::filesystem::is_regular_file(path, error)) {
     throw std::runtime_error("mesh " + path + ": file not found");
   }
+  if (extension == ".ply") check_ply_header(path);
   Assimp::Importer importer;
   // URDF meshes are in their file's coordinates: keep a Collada file's Z_UP as authored instead of
   // letting assimp turn the scene to its own Y-up convention.
