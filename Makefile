@@ -87,7 +87,8 @@ fuzz: deps
 	  -DPIXELGYM_FUZZ=ON -DPIXELGYM_BUILD_BENCH=OFF -DPIXELGYM_BUILD_PYTHON=OFF
 	cmake --build $(FUZZ_BUILD_DIR) --parallel $(JOBS) --target $(FUZZ_TARGET)_fuzz
 	mkdir -p $(FUZZ_BUILD_DIR)/findings/$(FUZZ_TARGET)
-	$(FUZZ_BUILD_DIR)/fuzz/$(FUZZ_TARGET)_fuzz -max_total_time=$(FUZZ_SECONDS) -timeout=$(FUZZ_TIMEOUT) \
+	LSAN_OPTIONS="suppressions=$(CURDIR)/lsan.supp print_suppressions=0 $(LSAN_OPTIONS)" \
+	  $(FUZZ_BUILD_DIR)/fuzz/$(FUZZ_TARGET)_fuzz -max_total_time=$(FUZZ_SECONDS) -timeout=$(FUZZ_TIMEOUT) \
 	  -print_final_stats=1 \
 	  -artifact_prefix=$(FUZZ_BUILD_DIR)/findings/$(FUZZ_TARGET)/ $(FUZZ_FLAGS) \
 	  fuzz/corpus/$(FUZZ_TARGET)
