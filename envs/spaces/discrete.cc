@@ -1,11 +1,19 @@
 #include "envs/spaces/discrete.h"
 
+#include <limits>
 #include <stdexcept>
+#include <string>
 
 namespace pixelgym::spaces {
 
 Discrete::Discrete(std::int64_t n, std::int64_t start) : n_(n), start_(start) {
   if (n <= 0) throw std::invalid_argument("Discrete: n must be positive, got " + std::to_string(n));
+  // start + n - 1, the largest element, must be an int64 (found by fuzz/spaces_fuzz.cc: it
+  // overflowed in mismatch()).
+  if (start > std::numeric_limits<std::int64_t>::max() - (n - 1)) {
+    throw std::invalid_argument("Discrete: start + n - 1 must fit in int64, got start = " +
+                                std::to_string(start) + ", n = " + std::to_string(n));
+  }
 }
 
 Value Discrete::sample(Rng& rng) const {
@@ -20,7 +28,8 @@ std::string Discrete::mismatch(const Value& value) const {
   }
   if (!array.shape().empty()) return "shape " + shape_to_string(array.shape()) + ", expected ()";
   const auto x = static_cast<std::int64_t>(array.element_as_double(0));
-  if (x < start_ || x >= start_ + n_) {
+  if (x < start_ || static_cast<std::uint64_t>(x) - static_cast<std::uint64_t>(start_) >=
+                        static_cast<std::uint64_t>(n_)) {
     return std::to_string(x) + " is outside {" + std::to_string(start_) + ", ..., " +
            std::to_string(start_ + n_ - 1) + "}";
   }

@@ -3,7 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <set>
+#include <stdexcept>
 
 namespace pixelgym::spaces {
 namespace {
@@ -39,6 +42,17 @@ TEST(DiscreteTest, ContainsRejectsWrongDtypeShapeAndRange) {
 TEST(DiscreteTest, RejectsNonPositiveN) {
   EXPECT_THROW(Discrete(0), std::invalid_argument);
   EXPECT_THROW(Discrete(-3), std::invalid_argument);
+}
+
+// Found by fuzz/spaces_fuzz.cc: start + n overflowed int64 (undefined behaviour) in mismatch().
+TEST(DiscreteTest, RejectsARangePastInt64AndChecksTheEdgesWithoutOverflow) {
+  constexpr std::int64_t kMax = std::numeric_limits<std::int64_t>::max();
+  EXPECT_THROW(Discrete(7016890793931507553, 7006863666131853665), std::invalid_argument);
+  // {int64 min, ..., -2}: the widest range there is, checked without overflow.
+  const Discrete wide(kMax, std::numeric_limits<std::int64_t>::min());
+  EXPECT_TRUE(wide.contains(Array::scalar<std::int64_t>(-2)));
+  EXPECT_FALSE(wide.contains(Array::scalar<std::int64_t>(-1)));
+  EXPECT_FALSE(wide.contains(Array::scalar<std::int64_t>(0)));
 }
 
 TEST(DiscreteTest, ToStringEqualsShape) {
