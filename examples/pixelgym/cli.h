@@ -95,11 +95,11 @@ struct Command {
 
 /// Adds subcommand `name` to `app` whose options parse into an `Arguments` of its own, living as
 /// long as the returned Command: `declare` gives the subcommand its description and options,
-/// and choosing it runs `run` on what was parsed (its exit code).
-template <typename Arguments>
+/// and choosing it runs `run` (a callable taking `const Arguments&`) on what was parsed (its exit
+/// code).
+template <typename Arguments, typename Run>
 Command add_command(CLI::App& app, const std::string& name,
-                    void (*declare)(CLI::App& command, Arguments& args),
-                    int (*run)(const Arguments& args)) {
+                    void (*declare)(CLI::App& command, Arguments& args), Run run) {
   auto args = std::make_shared<Arguments>();
   CLI::App* command = app.add_subcommand(name);
   declare(*command, *args);
@@ -119,7 +119,11 @@ std::vector<Command> add_render_commands(CLI::App& app);
 /// Adds record (episodes to .mp4 through wrappers::RecordVideo) to `app`.
 std::vector<Command> add_record_commands(CLI::App& app);
 
-/// Adds train and eval (PPO on LibTorch, examples/trainer/ppo).
-std::vector<Command> add_train_commands(CLI::App& app);
+struct Trainer;
+
+/// The `pixelgym` tool: parses the command line and runs the subcommand it chose, train and eval
+/// through `trainer` (train_commands.h, which also adds compare); returns the exit code. The main()
+/// of pixelgym and of pixelgym-train.
+int run_tool(int argc, char** argv, const Trainer& trainer);
 
 }  // namespace pixelgym::cli

@@ -1,93 +1,9 @@
 // pixelgym — the command-line front door: list, info, check, snapshot, rollout, bench, inspect,
-// view, record, train, eval, help.
-#include <exception>
-#include <iostream>
-#include <string>
-
+// view, record, train, eval, compare, help. It does not load LibTorch: train and eval, once their
+// command lines parsed, replace this process by pixelgym-train (trainer_main.cc).
 #include "examples/pixelgym/cli.h"
-
-namespace {
-
-using pixelgym::cli::Command;
-
-// An error message, then the usage of the subcommand it is about (CLI11's help() shows the chosen
-// subcommand's, or the whole tool's when none was chosen); exit code 2.
-int usage_error(const CLI::App& app, const std::string& message) {
-  std::cerr << "pixelgym: " << message << "\n\n" << app.help();
-  return pixelgym::cli::kExitUsage;
-}
-
-// The whole tool's help, even while a subcommand (`help`) is chosen.
-std::string tool_help(const CLI::App& app) {
-  return app.get_formatter()->make_help(&app, app.get_name(), CLI::AppFormatMode::Normal);
-}
-
-}  // namespace
+#include "examples/pixelgym/train_commands.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{
-      "pixelgym: pixel-based reinforcement-learning environments (Bullet + OSMesa)\n"
-      "behind the Gymnasium API.",
-      "pixelgym"};
-  app.require_subcommand(1, 1);
-  app.fallthrough(false);
-  app.set_version_flag("--version", std::string("pixelgym ") + PIXELGYM_VERSION,
-                       "Print the version and exit");
-  std::vector<Command> commands = pixelgym::cli::add_env_commands(app);
-  for (auto* add : {pixelgym::cli::add_engine_commands, pixelgym::cli::add_render_commands,
-                    pixelgym::cli::add_record_commands, pixelgym::cli::add_train_commands}) {
-    for (auto& command : add(app)) commands.push_back(std::move(command));
-  }
-
-  // `pixelgym help [SUBCOMMAND]`: the same text as --help.
-  std::string help_topic;
-  CLI::App* help = app.add_subcommand("help", "Show this help, or a subcommand's: help SUBCOMMAND");
-  help->add_option("subcommand", help_topic, "Subcommand to explain");
-  commands.push_back({help, [&app, &help_topic, &commands] {
-                        if (help_topic.empty()) {
-                          std::cout << tool_help(app);
-                          return 0;
-                        }
-                        for (const Command& command : commands) {
-                          if (command.app->get_name() == help_topic) {
-                            std::cout << command.app->help(app.get_name());
-                            return 0;
-                          }
-                        }
-                        std::cerr << "pixelgym: help: unknown subcommand \"" << help_topic
-                                  << "\"\n\n"
-                                  << tool_help(app);
-                        return pixelgym::cli::kExitUsage;
-                      }});
-
-  // CLI11 reports an unknown first word only as "a subcommand is required"; name it instead.
-  if (argc > 1 && argv[1][0] != '-') {
-    bool known = false;
-    std::string names;
-    for (const auto& command : commands) {
-      known = known || command.app->get_name() == argv[1];
-      names += (names.empty() ? "" : ", ") + command.app->get_name();
-    }
-    if (!known) {
-      return usage_error(
-          app, std::string("unknown subcommand \"") + argv[1] + "\" (subcommands: " + names + ")");
-    }
-  }
-
-  try {
-    app.parse(argc, argv);
-    for (const auto& command : commands) {
-      if (command.app->parsed()) return command.run();
-    }
-  } catch (const CLI::Success& success) {  // --help, --help-all, --version
-    return app.exit(success);
-  } catch (const CLI::ParseError& error) {
-    return usage_error(app, error.what());
-  } catch (const pixelgym::cli::UsageError& error) {
-    return usage_error(app, error.what());
-  } catch (const std::exception& error) {
-    std::cerr << "pixelgym: error: " << error.what() << "\n";
-    return pixelgym::cli::kExitFailure;
-  }
-  return 0;
+  return pixelgym::cli::run_tool(argc, argv, pixelgym::cli::exec_trainer(argv));
 }

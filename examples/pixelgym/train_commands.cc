@@ -1,212 +1,31 @@
-// pixelgym train / eval: the trainer's run (examples/trainer/run) with an algorithm: PPO
-// (examples/trainer/ppo) or DrQ-v2 (examples/trainer/drqv2).
-#include <algorithm>
+// pixelgym train, eval and compare: their command lines (train_commands.h), and compare, which
+// draws finished runs' curves; train and eval run in pixelgym-train (trainer.cc).
+#include "examples/pixelgym/train_commands.h"
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
-#include <optional>
-#include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
-#include "examples/pixelgym/cli.h"
-#include "examples/trainer/distributed/gloo_communicator.h"
-#include "examples/trainer/drqv2/drqv2_algorithm.h"
-#include "examples/trainer/ppo/ppo_algorithm.h"
 #include "examples/trainer/run/atomic_file.h"
 #include "examples/trainer/run/curve_plot.h"
-#include "examples/trainer/run/evaluation.h"
-#include "examples/trainer/run/process_tuning.h"
 #include "examples/trainer/run/progress_csv.h"
 #include "examples/trainer/run/training_run.h"
+#include "render/image_io.h"
 
 namespace pixelgym::cli {
 namespace {
 
 namespace fs = std::filesystem;
 
-// The algorithms `train --algo` offers, PPO first (the default).
-const ppo::PpoAlgorithmFactory kPpo;
-const drqv2::DrqV2AlgorithmFactory kDrqV2;
-const trainer::AlgorithmFactories kAlgorithms = {&kPpo, &kDrqV2};
-
-const trainer::AlgorithmFactory& algorithm_named(const std::string& name) {
-  for (const trainer::AlgorithmFactory* algorithm : kAlgorithms) {
-    if (algorithm->name() == name) return *algorithm;
-  }
-  throw UsageError("train --algo: unknown algorithm \"" + name + "\"");
-}
-
-// The algorithm of the run in `folder` (its config.json names it).
-const trainer::AlgorithmFactory& algorithm_of_run(const fs::path& folder) {
-  std::ifstream config_file(folder / "config.json");
-  if (!config_file) {
-    throw std::runtime_error("--resume " + folder.string() + ": no config.json there");
-  }
-  const nlohmann::json config = nlohmann::json::parse(config_file, nullptr, false);
-  return trainer::algorithm_of(config, folder / "config.json", kAlgorithms);
-}
-
 // --- train ---
-
-struct TrainArguments : EnvArguments {
-  std::string algo = "ppo";
-  bool algo_given = false;
-  std::string config_file;
-  std::int64_t steps = 0;  // 0: the config's total_env_steps
-  double minutes = 0.0;
-  std::string out;
-  std::string resume;
-  bool quiet = false;
-  std::uint64_t seed = 0;
-  bool seed_given = false;
-  int num_envs = 0;
-  int threads = 2;
-  int torch_threads = 0;
-  std::int64_t checkpoint_every = 10;
-  std::int64_t keep_checkpoints = 3;
-  std::int64_t eval_episodes = 5;
-  std::int64_t eval_every = 0;
-  std::int64_t eval_every_episodes = 5;
-  double eval_max_share = 0.1;
-  int nproc = 1;
-  double dist_timeout = 60.0;
-  const CLI::App* command = nullptr;  // the parsed subcommand: which flags were given
-};
-
-// This process's command line without --nproc N (or --nproc=N): what each local rank runs.
-std::vector<std::string> command_line_without_nproc() {
-  std::ifstream file("/proc/self/cmdline", std::ios::binary);
-  std::vector<std::string> arguments;
-  std::string argument;
-  while (std::getline(file, argument, '\0')) arguments.push_back(argument);
-  std::vector<std::string> kept;
-  for (std::size_t i = 0; i < arguments.size(); ++i) {
-    if (arguments[i] == "--nproc") {
-      ++i;  // and its value
-      continue;
-    }
-    if (arguments[i].rfind("--nproc=", 0) == 0) continue;
-    kept.push_back(arguments[i]);
-  }
-  return kept;
-}
-
-// The settings of a new run: the flags, over the --config file's settings of the algorithm.
-trainer::RunSettings new_run_settings(const TrainArguments& args,
-                                      const trainer::AlgorithmFactory& algorithm) {
-  trainer::RunSettings settings;
-  settings.env_id = args.id;
-  settings.sets = args.sets;
-  settings.wraps = args.wraps;
-  std::string config = "{}";
-  if (!args.config_file.empty()) {
-    std::ifstream in(args.config_file);
-    if (!in) throw UsageError("--config " + args.config_file + ": cannot read it");
-    std::stringstream text;
-    text << in.rdbuf();
-    config = text.str();
-  }
-  settings.algorithm_config = algorithm.parse_config(config);
-  if (args.seed_given) settings.algorithm_config["seed"] = args.seed;
-  if (args.num_envs > 0) settings.algorithm_config["num_envs"] = args.num_envs;
-  settings.num_threads = args.threads;
-  settings.torch_threads = args.torch_threads;
-  settings.checkpoint_every = args.checkpoint_every;
-  settings.keep_checkpoints = args.keep_checkpoints;
-  settings.eval_episodes = args.eval_episodes;
-  // Ten evaluations over the run unless --eval-every says otherwise.
-  const std::int64_t total = args.steps > 0 ? args.steps : settings.total_env_steps();
-  settings.eval_every = args.command->count("--eval-every") > 0
-                            ? args.eval_every
-                            : std::max<std::int64_t>(total / 10, 1);
-  settings.eval_every_episodes = args.eval_every_episodes;
-  settings.eval_max_share = args.eval_max_share;
-  return settings;
-}
-
-// The run settings given on the command line, which a resume checks against the run's.
-trainer::ResumeChecks resume_checks(const TrainArguments& args) {
-  const auto given = [&](const char* flag) { return args.command->count(flag) > 0; };
-  trainer::ResumeChecks checks;
-  if (args.seed_given) checks.seed = args.seed;
-  if (args.num_envs > 0) checks.num_envs = args.num_envs;
-  if (given("--threads")) checks.num_threads = args.threads;
-  if (given("--torch-threads")) checks.torch_threads = args.torch_threads;
-  if (given("--checkpoint-every")) checks.checkpoint_every = args.checkpoint_every;
-  if (given("--keep-checkpoints")) checks.keep_checkpoints = args.keep_checkpoints;
-  if (given("--eval-episodes")) checks.eval_episodes = args.eval_episodes;
-  if (given("--eval-every")) checks.eval_every = args.eval_every;
-  if (given("--eval-every-episodes")) checks.eval_every_episodes = args.eval_every_episodes;
-  return checks;
-}
-
-int run_train(const TrainArguments& args) {
-  if (args.resume.empty() && args.id.empty()) {
-    throw UsageError("train: give an env id, or --resume RUN_FOLDER");
-  }
-  if (!args.resume.empty() && (!args.id.empty() || !args.sets.empty() || !args.wraps.empty() ||
-                               !args.config_file.empty() || !args.out.empty() || args.algo_given)) {
-    throw UsageError(
-        "train --resume takes the env and settings from the run's config.json: give no id, "
-        "--set, --wrap, --algo, --config or --out with it");
-  }
-  const bool launcher = args.nproc > 1;
-  if (launcher && std::getenv("WORLD_SIZE") != nullptr) {
-    throw UsageError(
-        "train --nproc starts its own local ranks, but WORLD_SIZE is set (a launcher such as "
-        "torchrun or srun started this process as a rank already): give one or the other");
-  }
-  // A rank of a data-parallel run started by a launcher (torchrun, srun, train --nproc).
-  std::optional<distributed::DistributedSettings> ranks =
-      launcher ? std::nullopt
-               : distributed::DistributedSettings::from_environment(args.dist_timeout);
-  const bool joins = ranks && ranks->rank > 0;
-  // Rank 0 takes the algorithm from the command line or the run folder; the others from it.
-  const trainer::AlgorithmFactory& algorithm =
-      joins ? kPpo
-            : (args.resume.empty() ? algorithm_named(args.algo) : algorithm_of_run(args.resume));
-  if ((launcher || (ranks && ranks->world_size > 1)) && algorithm.name() != "ppo") {
-    throw UsageError("train --algo " + algorithm.name() +
-                     " runs in one process; data-parallel training (--nproc, WORLD_SIZE) is "
-                     "PPO's (--algo ppo)");
-  }
-  if (launcher) {
-    return distributed::run_local_ranks(args.nproc, command_line_without_nproc(), args.dist_timeout,
-                                        std::cerr);
-  }
-  trainer::tune_process_for_training();
-  std::unique_ptr<distributed::GlooCommunicator> communicator;
-  if (ranks && ranks->world_size > 1) {
-    communicator = std::make_unique<distributed::GlooCommunicator>(*ranks);
-  }
-  const trainer::TrainBudget budget{args.steps, args.minutes};
-  // Ranks other than 0 print errors only.
-  std::ostream discard(nullptr);
-  const trainer::RunOutput output{joins ? discard : std::cout, std::cerr,
-                                  trainer::ProgressLine::mode_for_stdout(args.quiet || joins),
-                                  trainer::ProgressLine::stdout_columns()};
-  if (joins) {
-    trainer::TrainingRun::join(kAlgorithms, parse_sets, *communicator, output).train();
-    return 0;
-  }
-  try {
-    trainer::TrainingRun run =
-        args.resume.empty()
-            ? trainer::TrainingRun::create(
-                  algorithm, parse_sets, new_run_settings(args, algorithm),
-                  args.out.empty() ? fs::path("runs") / args.id : fs::path(args.out), budget,
-                  output)
-            : trainer::TrainingRun::resume(algorithm, parse_sets, args.resume, budget,
-                                           resume_checks(args), output);
-    if (communicator) run.distribute(*communicator);
-    run.train();
-  } catch (const trainer::RunRequestError& error) {
-    throw UsageError(error.what());
-  }
-  return 0;
-}
 
 // What to train and for how long: --config, --steps, --minutes, --out, --resume, --quiet.
 void add_run_options(CLI::App& train, TrainArguments& args) {
@@ -337,41 +156,6 @@ void declare_train(CLI::App& train, TrainArguments& args) {
 
 // --- eval ---
 
-struct EvalArguments {
-  std::string run;
-  std::int64_t episodes = 10;
-  std::uint64_t seed = 0;
-  std::string video;
-  bool stochastic = false;
-};
-
-int run_eval(const EvalArguments& args) {
-  // RecordVideo names the clip after the path's stem and writes H.264 .mp4 (an .avi given here
-  // would come out as .mp4 under another name): refuse any other name before the work.
-  if (!args.video.empty() &&
-      (fs::path(args.video).extension() != ".mp4" || fs::path(args.video).stem().empty())) {
-    throw UsageError("eval --video: expected a FILE.mp4, got \"" + args.video + "\"");
-  }
-  // Before any episode runs: a path that cannot take the video is found now, not after them.
-  if (!args.video.empty()) check_video_file("eval --video", args.video);
-  trainer::tune_process_for_training();
-  trainer::EvaluationRequest request{args.episodes, args.seed, args.stochastic, std::nullopt};
-  if (!args.video.empty()) request.video = fs::path(args.video);
-  const trainer::CheckpointEvaluation result =
-      trainer::evaluate_checkpoint(kAlgorithms, parse_sets, args.run, request, std::cerr);
-  const trainer::PolicyEvaluation& evaluation = result.evaluation;
-  std::cout << result.checkpoint.string() << ": " << result.settings.env_id << ", " << args.episodes
-            << " episodes from seed " << args.seed
-            << (args.stochastic ? ", sampled actions" : ", deterministic actions") << "\n";
-  for (std::size_t e = 0; e < evaluation.returns.size(); ++e) {
-    std::cout << "episode " << e << ": return=" << evaluation.returns[e] << "\n";
-  }
-  std::cout << "return_mean=" << evaluation.mean << " return_std=" << evaluation.std
-            << " clipped_action_fraction=" << evaluation.clipped_fraction << "\n";
-  if (request.video) std::cout << "wrote " << request.video->string() << "\n";
-  return 0;
-}
-
 void declare_eval(CLI::App& eval, EvalArguments& args) {
   eval.description(
       "Evaluate a trained policy (a run folder's latest checkpoint, or a checkpoint "
@@ -481,9 +265,25 @@ void declare_compare(CLI::App& compare, CompareArguments& args) {
 
 }  // namespace
 
-std::vector<Command> add_train_commands(CLI::App& app) {
-  return {add_command(app, "train", declare_train, run_train),
-          add_command(app, "eval", declare_eval, run_eval),
+Trainer exec_trainer(char** argv) {
+  const auto replace_this_process = [argv]() -> int {
+    std::error_code error;
+    const fs::path self = fs::read_symlink("/proc/self/exe", error);
+    const fs::path program = (error ? fs::path(argv[0]) : self).parent_path() / "pixelgym-train";
+    std::cout.flush();
+    std::cerr.flush();
+    ::execv(program.c_str(), argv);
+    throw std::runtime_error("cannot start " + program.string() + ": " + std::strerror(errno) +
+                             " (pixelgym runs train and eval in pixelgym-train, the program "
+                             "beside it that links LibTorch)");
+  };
+  return {[replace_this_process](const TrainArguments&) { return replace_this_process(); },
+          [replace_this_process](const EvalArguments&) { return replace_this_process(); }};
+}
+
+std::vector<Command> add_train_commands(CLI::App& app, const Trainer& trainer) {
+  return {add_command(app, "train", declare_train, trainer.train),
+          add_command(app, "eval", declare_eval, trainer.eval),
           add_command(app, "compare", declare_compare, run_compare)};
 }
 

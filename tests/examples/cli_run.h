@@ -15,10 +15,9 @@ struct CliRun {
   std::string output;  // stdout and stderr
 };
 
-/// Runs `pixelgym ARGUMENTS` through the shell, with `environment` ("NAME=value ...") set for it.
-inline CliRun run_cli(const std::string& arguments, const std::string& environment = "") {
-  const std::string command =
-      environment + " " + std::string(PIXELGYM_CLI) + " " + arguments + " 2>&1";
+/// Runs `command_line` through the shell, its stderr with its stdout.
+inline CliRun run_program(const std::string& command_line) {
+  const std::string command = command_line + " 2>&1";
   std::FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) return {-1, "popen failed"};
   std::string output;
@@ -26,6 +25,11 @@ inline CliRun run_cli(const std::string& arguments, const std::string& environme
   while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) output += buffer.data();
   const int status = pclose(pipe);
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
+/// Runs `pixelgym ARGUMENTS` through the shell, with `environment` ("NAME=value ...") set for it.
+inline CliRun run_cli(const std::string& arguments, const std::string& environment = "") {
+  return run_program(environment + " " + std::string(PIXELGYM_CLI) + " " + arguments);
 }
 
 }  // namespace pixelgym::testing

@@ -72,6 +72,22 @@ struct ApiRollout {
 
 // --- list, info ---
 
+// The tool starts without LibTorch (loading it took 0.9 s of every start): only pixelgym-train,
+// which runs train and eval, links it. The dynamic loader lists what the tool needs.
+TEST(PixelgymCliTest, TheToolDoesNotLoadLibTorch) {
+  const CliRun loaded = run("--version", "LD_TRACE_LOADED_OBJECTS=1");
+  EXPECT_EQ(loaded.exit_code, 0) << loaded.output;
+  EXPECT_THAT(loaded.output, HasSubstr("libOSMesa"));
+  std::vector<std::string> torch;
+  std::istringstream lines(loaded.output);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.find("libtorch") != std::string::npos || line.find("libc10") != std::string::npos) {
+      torch.push_back(line);
+    }
+  }
+  EXPECT_THAT(torch, ::testing::IsEmpty());
+}
+
 TEST(PixelgymCliTest, ListShowsEveryRegisteredIdWithItsDescription) {
   const CliRun result = run("list");
   ASSERT_EQ(result.exit_code, 0) << result.output;

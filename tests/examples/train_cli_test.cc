@@ -653,5 +653,35 @@ TEST(TrainCliTest, DrqV2WritesARunThatEvalReadsAndResumesAsIfItHadNotStopped) {
   fs::remove_all(folder);
 }
 
+// pixelgym does not link LibTorch: train and eval run in pixelgym-train, the program beside it,
+// which takes the process over once the command line parsed. Without it the other subcommands
+// work, a train usage error is still found, and train says which program is missing.
+TEST(TrainCliTest, TrainAndEvalRunInPixelgymTrainBesideTheTool) {
+  const fs::path folder = fresh_folder("alone");
+  const fs::path alone = folder / "pixelgym";
+  fs::copy_file(PIXELGYM_CLI, alone);
+  const std::string tool = alone.string();
+  const CliRun listed = run_program(tool + " list");
+  EXPECT_EQ(listed.exit_code, 0) << listed.output;
+  EXPECT_NE(listed.output.find("CartPoleBalance-v0"), std::string::npos) << listed.output;
+  const CliRun usage = run_program(tool + " train CartPoleBalance-v0 --threads 0");
+  EXPECT_EQ(usage.exit_code, 2) << usage.output;
+  EXPECT_NE(usage.output.find("--threads: must be an integer from 1"), std::string::npos)
+      << usage.output;
+  const CliRun missing =
+      run_program(tool + " train CartPoleBalance-v0 --steps 16 --out " + (folder / "run").string());
+  EXPECT_EQ(missing.exit_code, 1) << missing.output;
+  EXPECT_NE(
+      missing.output.find("pixelgym: error: cannot start " + (folder / "pixelgym-train").string() +
+                          ": No such file or directory"),
+      std::string::npos)
+      << missing.output;
+  const CliRun eval = run_program(tool + " eval " + (folder / "run").string());
+  EXPECT_EQ(eval.exit_code, 1) << eval.output;
+  EXPECT_NE(eval.output.find("cannot start"), std::string::npos) << eval.output;
+  EXPECT_FALSE(fs::exists(folder / "run"));
+  fs::remove_all(folder);
+}
+
 }  // namespace
 }  // namespace pixelgym::testing

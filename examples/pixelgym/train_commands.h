@@ -1,0 +1,67 @@
+// pixelgym train and eval: their command lines, and what runs them. LibTorch is loaded only by
+// pixelgym-train, the program that runs them (trainer.cc); pixelgym parses their command lines and
+// then replaces itself by it, so that its other subcommands start without LibTorch (0.9 s of
+// every start otherwise).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "examples/pixelgym/cli.h"
+
+namespace pixelgym::cli {
+
+/// `pixelgym train`'s command line.
+struct TrainArguments : EnvArguments {
+  std::string algo = "ppo";
+  bool algo_given = false;
+  std::string config_file;
+  std::int64_t steps = 0;  // 0: the config's total_env_steps
+  double minutes = 0.0;
+  std::string out;
+  std::string resume;
+  bool quiet = false;
+  std::uint64_t seed = 0;
+  bool seed_given = false;
+  int num_envs = 0;
+  int threads = 2;
+  int torch_threads = 0;
+  std::int64_t checkpoint_every = 10;
+  std::int64_t keep_checkpoints = 3;
+  std::int64_t eval_episodes = 5;
+  std::int64_t eval_every = 0;
+  std::int64_t eval_every_episodes = 5;
+  double eval_max_share = 0.1;
+  int nproc = 1;
+  double dist_timeout = 60.0;
+  const CLI::App* command = nullptr;  // the parsed subcommand: which flags were given
+};
+
+/// `pixelgym eval`'s command line.
+struct EvalArguments {
+  std::string run;
+  std::int64_t episodes = 10;
+  std::uint64_t seed = 0;
+  std::string video;
+  bool stochastic = false;
+};
+
+/// What runs train and eval once their command lines parsed (each returns the exit code).
+struct Trainer {
+  std::function<int(const TrainArguments&)> train;
+  std::function<int(const EvalArguments&)> eval;
+};
+
+/// pixelgym-train's: trains and evaluates in this process, with LibTorch (trainer.cc).
+Trainer in_process_trainer();
+
+/// pixelgym's: replaces this process by pixelgym-train, the program in this executable's folder,
+/// with `argv` (the same command line; the same process id). Throws std::runtime_error naming
+/// the program and the OS's reason when it cannot be started.
+Trainer exec_trainer(char** argv);
+
+/// Adds train, eval and compare to `app`; train and eval run through `trainer`.
+std::vector<Command> add_train_commands(CLI::App& app, const Trainer& trainer);
+
+}  // namespace pixelgym::cli
