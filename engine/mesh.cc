@@ -139,9 +139,31 @@ std::shared_ptr<const Mesh> load_mesh(const std::string& path) {
   // URDF meshes are in their file's coordinates: keep a Collada file's Z_UP as authored instead of
   // letting assimp turn the scene to its own Y-up convention.
   importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
-  const aiScene* scene =
-      importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                                  aiProcess_GenSmoothNormals | aiProcess_SortByPType);
+  // Read, then post-process. The post-processing steps trust each mesh's primitive types, which a
+  // reader can get wrong on a malformed file: on a PLY with a garbled body (a face without
+  // vertices) Triangulate called abort(), ending the process. They are recomputed from the faces in
+  // between, and a face without vertices is refused.
+  const aiScene* scene = importer.ReadFile(path, 0);
+  if (scene != nullptr) {
+    for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+      aiMesh& read = *scene->mMeshes[m];
+      unsigned types = 0;
+      for (unsigned f = 0; f < read.mNumFaces; ++f) {
+        const unsigned corners = read.mFaces[f].mNumIndices;
+        if (corners == 0) {
+          throw std::runtime_error("mesh " + path + ": face " + std::to_string(f) + " of mesh " +
+                                   std::to_string(m) + " has no vertices");
+        }
+        types |= corners == 1   ? aiPrimitiveType_POINT
+                 : corners == 2 ? aiPrimitiveType_LINE
+                 : corners == 3 ? aiPrimitiveType_TRIANGLE
+                                : aiPrimitiveType_POLYGON;
+      }
+      if (types != 0) read.mPrimitiveTypes = types;  // a mesh without faces keeps its own
+    }
+    scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                         aiProcess_GenSmoothNormals | aiProcess_SortByPType);
+  }
   if (scene == nullptr || scene->mRootNode == nullptr) {
     throw std::runtime_error("mesh " + path + ": cannot be read: " + importer.GetErrorString());
   }

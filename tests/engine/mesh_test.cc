@@ -65,6 +65,13 @@ TEST(MeshTest, APlyHeaderAssimpWouldHangOnIsRefused) {
                         "NAME COUNT\""));
 }
 
+// A PLY whose ASCII body is garbled (found by fuzz/mesh_fuzz): assimp's reader built a face
+// without vertices, and its Triangulate step then called abort(), ending the process.
+TEST(MeshTest, AFaceWithoutVerticesIsRefusedBeforeAssimpPostProcessesIt) {
+  EXPECT_THAT(error_of(data("meshes/face_without_vertices.ply")),
+              HasSubstr("face_without_vertices.ply: face 0 of mesh 0 has no vertices"));
+}
+
 TEST(MeshCacheTest, ReadsEachFileOnce) {
   MeshCache cache;
   const auto a = cache.get(asset_path("arm/meshes/link3.obj"));

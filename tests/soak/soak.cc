@@ -133,7 +133,10 @@ int main(int argc, char** argv) {
   envs->reset(std::uint64_t{0});
 
   const std::int64_t warmup = std::max<std::int64_t>(10000, options.steps / 10);
+  // The resident size is printed at 10k, 100k and 1M env steps, after warm-up, at every tenth of
+  // the run and at its end.
   std::vector<std::int64_t> milestones = {10000, 100000, 1000000, warmup, options.steps};
+  for (int tenth = 1; tenth < 10; ++tenth) milestones.push_back(options.steps * tenth / 10);
   double rss_after_warmup = -1;
   std::int64_t episodes = 0;
   const auto start = std::chrono::steady_clock::now();
