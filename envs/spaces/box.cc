@@ -43,7 +43,9 @@ void fill_sample(const std::vector<double>& low, const std::vector<double>& high
           rng.integer(static_cast<std::int64_t>(low[i]), static_cast<std::int64_t>(high[i])));
     } else {
       double x;
-      if (has_low && has_high) {
+      if (low[i] == high[i]) {
+        x = low[i];  // one value, infinite ones included: Box(-inf, -inf) holds only -inf
+      } else if (has_low && has_high) {
         x = rng.uniform(low[i], high[i]);
       } else if (has_low) {
         x = low[i] + rng.exponential();

@@ -18,6 +18,9 @@ TEST(BoxTest, SamplesAreContainedAcrossSeedsForEveryBoundKind) {
       Box({0.0, -kInf}, {kInf, 2.0}, {2}),
       Box(-5.0, 5.0, {2, 2}, DType::kInt32),
       Box(-kInf, kInf, {3}, DType::kInt64),
+      // Bounds equal and infinite (found by fuzz/spaces_fuzz: Box(-inf, -inf) drew 0.37).
+      Box(-kInf, -kInf, {}),
+      Box({kInf, -kInf, 1.5}, {kInf, -kInf, 1.5}, {3}, DType::kFloat64),
   };
   for (const Box& box : boxes) {
     for (std::uint64_t seed = 0; seed < 50; ++seed) {
