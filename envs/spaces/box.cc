@@ -32,6 +32,15 @@ std::string format_bounds(const std::vector<double>& bounds) {
   return text + "]";
 }
 
+// A bound of an integer Box as an int64. int64's own limits, held as doubles, are -2^63 and 2^63,
+// and 2^63 is past int64: converting it was undefined (on x86 it gave INT64_MIN, so a Box over
+// int64's whole range always drew INT64_MIN; found by fuzz/spaces_fuzz under UBSan).
+std::int64_t integer_bound(double bound) {
+  constexpr double kTwoTo63 = 9223372036854775808.0;
+  if (bound >= kTwoTo63) return std::numeric_limits<std::int64_t>::max();
+  return static_cast<std::int64_t>(bound);  // the constructor keeps bounds >= -2^63
+}
+
 template <typename T>
 void fill_sample(const std::vector<double>& low, const std::vector<double>& high, Rng& rng,
                  T* out) {
@@ -39,8 +48,7 @@ void fill_sample(const std::vector<double>& low, const std::vector<double>& high
     const bool has_low = std::isfinite(low[i]);
     const bool has_high = std::isfinite(high[i]);
     if constexpr (std::is_integral_v<T>) {
-      out[i] = static_cast<T>(
-          rng.integer(static_cast<std::int64_t>(low[i]), static_cast<std::int64_t>(high[i])));
+      out[i] = static_cast<T>(rng.integer(integer_bound(low[i]), integer_bound(high[i])));
     } else {
       double x;
       if (low[i] == high[i]) {

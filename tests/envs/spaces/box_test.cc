@@ -32,6 +32,19 @@ TEST(BoxTest, SamplesAreContainedAcrossSeedsForEveryBoundKind) {
   }
 }
 
+// int64's upper limit as a double is 2^63, past int64: converting it was undefined (found by
+// fuzz/spaces_fuzz under UBSan), and on x86 every draw came out INT64_MIN.
+TEST(BoxTest, AnInt64BoxOverTheWholeRangeDrawsDifferentValues) {
+  const Box box(-kInf, kInf, {}, DType::kInt64);
+  Rng rng(3);
+  const std::int64_t first = box.sample(rng).array().data<std::int64_t>()[0];
+  bool differs = false;
+  for (int draw = 0; draw < 20 && !differs; ++draw) {
+    differs = box.sample(rng).array().data<std::int64_t>()[0] != first;
+  }
+  EXPECT_TRUE(differs) << "every draw was " << first;
+}
+
 TEST(BoxTest, SeededSpaceSamplesRepeat) {
   Box box(-1.0, 1.0, {4});
   box.seed(5);
