@@ -108,6 +108,27 @@ Array Array::from_external(void* data, DType dtype, Shape shape, std::shared_ptr
   return array;
 }
 
+std::int64_t Array::element_as_int64(std::int64_t flat_index) const {
+  if (flat_index < 0 || flat_index >= size_) {
+    throw std::out_of_range("Array: element " + std::to_string(flat_index) +
+                            " out of range for size " + std::to_string(size_));
+  }
+  const std::byte* p = data_ + flat_index * static_cast<std::int64_t>(dtype_size(dtype_));
+  switch (dtype_) {
+    case DType::kBool:
+      return *reinterpret_cast<const bool*>(p) ? 1 : 0;
+    case DType::kUInt8:
+      return *reinterpret_cast<const std::uint8_t*>(p);
+    case DType::kInt32:
+      return *reinterpret_cast<const std::int32_t*>(p);
+    case DType::kInt64:
+      return *reinterpret_cast<const std::int64_t*>(p);
+    default:
+      throw std::invalid_argument(std::string("Array::element_as_int64: dtype ") +
+                                  dtype_name(dtype_) + " is not an integer dtype");
+  }
+}
+
 double Array::element_as_double(std::int64_t flat_index) const {
   if (flat_index < 0 || flat_index >= size_) {
     throw std::out_of_range("Array: element " + std::to_string(flat_index) +

@@ -125,6 +125,9 @@ class Array {
   }
   /// Element `flat_index` (row-major) converted to double, whatever the dtype.
   double element_as_double(std::int64_t flat_index) const;
+  /// Element `flat_index` of a bool or integer array, exactly (a double rounds int64s past 2^53).
+  /// Throws std::invalid_argument for a floating dtype.
+  std::int64_t element_as_int64(std::int64_t flat_index) const;
 
   /// A deep copy with its own memory.
   Array clone() const;

@@ -53,7 +53,7 @@ std::string MultiDiscrete::mismatch(const Value& value) const {
   }
   for (std::int64_t i = 0; i < array.size(); ++i) {
     const auto k = static_cast<std::size_t>(i);
-    const auto x = static_cast<std::int64_t>(array.element_as_double(i));
+    const std::int64_t x = array.element_as_int64(i);  // exactly: not through a double
     if (x < start_[k] || x >= start_[k] + nvec_[k]) {
       return "element " + std::to_string(i) + " = " + std::to_string(x) + " is outside {" +
              std::to_string(start_[k]) + ", ..., " + std::to_string(start_[k] + nvec_[k] - 1) + "}";

@@ -55,6 +55,19 @@ TEST(DiscreteTest, RejectsARangePastInt64AndChecksTheEdgesWithoutOverflow) {
   EXPECT_FALSE(wide.contains(Array::scalar<std::int64_t>(0)));
 }
 
+// Values past 2^53 are judged exactly, not through a double (found by fuzz/spaces_fuzz).
+TEST(DiscreteTest, LargeStartsAreJudgedExactly) {
+  const Discrete space(97, 7006863666131853568);
+  Rng rng(0);
+  for (int draw = 0; draw < 50; ++draw) {
+    const Value sample = space.sample(rng);
+    ASSERT_TRUE(space.contains(sample)) << space.mismatch(sample);
+  }
+  EXPECT_FALSE(space.contains(Array::scalar<std::int64_t>(7006863666131853567)));
+  EXPECT_TRUE(space.contains(Array::scalar<std::int64_t>(7006863666131853568 + 96)));
+  EXPECT_FALSE(space.contains(Array::scalar<std::int64_t>(7006863666131853568 + 97)));
+}
+
 TEST(DiscreteTest, ToStringEqualsShape) {
   EXPECT_EQ(Discrete(4).to_string(), "Discrete(4)");
   EXPECT_EQ(Discrete(4, 1).to_string(), "Discrete(4, start=1)");
