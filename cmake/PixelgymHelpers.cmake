@@ -40,9 +40,11 @@ endfunction()
 # build leaves it out (issue 31: it keeps CI under an hour; docs/reliability.md lists them).
 #
 # In the AddressSanitizer build tests compile at -O0 (the libraries they test stay at -O1): a
-# third faster to build, and what they run is mostly the libraries.
+# third faster to build, and what they run is mostly the libraries. COMPUTES marks a test whose
+# own code does heavy numeric work (the acrobot's model-predictive controller, all Eigen): it keeps
+# -O1, since at -O0 it ran 213 times slower than in Release (1,033 s, the longest test in CI).
 function(pixelgym_add_test source)
-  cmake_parse_arguments(ARG "COUNTS_ALLOCATIONS;TENSOR_MATH" "" "LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "COUNTS_ALLOCATIONS;TENSOR_MATH;COMPUTES" "" "LIBS;LABELS" ${ARGN})
   if(ARG_COUNTS_ALLOCATIONS AND NOT PIXELGYM_SANITIZE STREQUAL "")
     return()
   endif()
@@ -58,7 +60,7 @@ function(pixelgym_add_test source)
     PIXELGYM_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     PIXELGYM_TEST_OUTPUT_DIR="${PROJECT_BINARY_DIR}/test_output")
   pixelgym_set_warnings(${target})
-  if(PIXELGYM_SANITIZE STREQUAL "address")
+  if(PIXELGYM_SANITIZE STREQUAL "address" AND NOT ARG_COMPUTES)
     target_compile_options(${target} PRIVATE -O0)
   endif()
   set(properties "")
