@@ -108,12 +108,23 @@ Array Array::from_external(void* data, DType dtype, Shape shape, std::shared_ptr
   return array;
 }
 
-std::int64_t Array::element_as_int64(std::int64_t flat_index) const {
-  if (flat_index < 0 || flat_index >= size_) {
+namespace {
+
+// The address of element `flat_index` of `size` elements of `dtype` from `data`; throws
+// std::out_of_range naming the index and the size when it is outside them.
+const std::byte* element_at(const std::byte* data, std::int64_t size, DType dtype,
+                            std::int64_t flat_index) {
+  if (flat_index < 0 || flat_index >= size) {
     throw std::out_of_range("Array: element " + std::to_string(flat_index) +
-                            " out of range for size " + std::to_string(size_));
+                            " out of range for size " + std::to_string(size));
   }
-  const std::byte* p = data_ + flat_index * static_cast<std::int64_t>(dtype_size(dtype_));
+  return data + flat_index * static_cast<std::int64_t>(dtype_size(dtype));
+}
+
+}  // namespace
+
+std::int64_t Array::element_as_int64(std::int64_t flat_index) const {
+  const std::byte* p = element_at(data_, size_, dtype_, flat_index);
   switch (dtype_) {
     case DType::kBool:
       return *reinterpret_cast<const bool*>(p) ? 1 : 0;
@@ -130,11 +141,7 @@ std::int64_t Array::element_as_int64(std::int64_t flat_index) const {
 }
 
 double Array::element_as_double(std::int64_t flat_index) const {
-  if (flat_index < 0 || flat_index >= size_) {
-    throw std::out_of_range("Array: element " + std::to_string(flat_index) +
-                            " out of range for size " + std::to_string(size_));
-  }
-  const std::byte* p = data_ + flat_index * static_cast<std::int64_t>(dtype_size(dtype_));
+  const std::byte* p = element_at(data_, size_, dtype_, flat_index);
   switch (dtype_) {
     case DType::kBool:
       return *reinterpret_cast<const bool*>(p) ? 1.0 : 0.0;
