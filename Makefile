@@ -8,6 +8,10 @@
 #                    it after test-asan)
 #   make fuzz        builds the fuzz targets with libFuzzer (clang) in build-fuzz/ and fuzzes one:
 #                    FUZZ_TARGET=urdf FUZZ_SECONDS=600 (docs/reliability.md)
+#   make install     installs the Release build (cmake --install build; PREFIX=/usr/local unless
+#                    given): libraries, headers, CMake package, tool, assets, Python package
+#   make deb         builds the Debian package in build-deb/ (prefix /usr, tests off):
+#                    build-deb/pixelgym_VERSION_ARCH.deb, for `apt install ./build-deb/pixelgym_*.deb`
 #   make format-check   the project's C++ files against .clang-format (clang-format 14); exits 1
 #                       naming the files that differ. `make format` rewrites them.
 BUILD_DIR ?= build
@@ -15,7 +19,7 @@ BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 PIXELGYM := $(BUILD_DIR)/examples/pixelgym
 
-.PHONY: all deps configure build demo test test-asan test-tsan fuzz format-check format goldens bench clean
+.PHONY: all deps configure build demo test test-asan test-tsan fuzz install deb format-check format goldens bench clean
 
 all: build
 
@@ -93,6 +97,17 @@ fuzz: deps
 # CI runs `make test`, which runs this same check as the ctest test FormatCheck
 # (tests/examples/CMakeLists.txt): it then shows in ctest's summary beside the other tests, and a
 # formatting slip does not stop the real tests from running and reporting.
+PREFIX ?= /usr/local
+install: build
+	cmake --install $(BUILD_DIR) --prefix $(PREFIX)
+
+DEB_BUILD_DIR ?= build-deb
+deb: deps
+	cmake -S . -B $(DEB_BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DCMAKE_INSTALL_PREFIX=/usr \
+	  -DPIXELGYM_BUILD_TESTS=OFF -DPIXELGYM_BUILD_BENCH=OFF
+	cmake --build $(DEB_BUILD_DIR) --parallel $(JOBS)
+	cd $(DEB_BUILD_DIR) && cpack -G DEB
+
 format-check: deps
 	scripts/format-check.sh
 

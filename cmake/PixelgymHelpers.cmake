@@ -11,16 +11,27 @@ function(pixelgym_set_warnings target)
   endif()
 endfunction()
 
-# pixelgym_add_library(NAME SOURCES ... DEPS ...): library pixelgym_NAME with alias
-# pixelgym::NAME; headers are included as "NAME/file.h" from the project root.
+# pixelgym_add_library(NAME SOURCES ... DEPS ...): library pixelgym_NAME (shared unless
+# PIXELGYM_SHARED_LIBS is off) with alias pixelgym::NAME, exported as pixelgym::NAME by
+# `cmake --install` (cmake/PixelgymInstall.cmake); headers are included as "NAME/file.h" from the
+# project root, or from include/pixelgym/ once installed.
 function(pixelgym_add_library name)
   cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
-  add_library(pixelgym_${name} ${ARG_SOURCES})
+  if(PIXELGYM_SHARED_LIBS)
+    add_library(pixelgym_${name} SHARED ${ARG_SOURCES})
+  else()
+    add_library(pixelgym_${name} STATIC ${ARG_SOURCES})
+  endif()
   add_library(pixelgym::${name} ALIAS pixelgym_${name})
   target_compile_features(pixelgym_${name} PUBLIC cxx_std_17)
-  target_include_directories(pixelgym_${name} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>)
+  target_include_directories(pixelgym_${name} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>
+                             $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/pixelgym>)
   target_link_libraries(pixelgym_${name} PUBLIC ${ARG_DEPS})
-  set_target_properties(pixelgym_${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  # Installed, the libraries find each other in their own folder.
+  set_target_properties(pixelgym_${name} PROPERTIES POSITION_INDEPENDENT_CODE ON EXPORT_NAME ${name}
+                        VERSION ${PROJECT_VERSION} SOVERSION ${PROJECT_VERSION_MAJOR}.${PROJECT_VERSION_MINOR}
+                        INSTALL_RPATH "$ORIGIN")
+  set_property(GLOBAL APPEND PROPERTY PIXELGYM_LIBRARIES pixelgym_${name})
   pixelgym_set_warnings(pixelgym_${name})
 endfunction()
 

@@ -1,6 +1,7 @@
 #include "engine/robot_model.h"
 
 #include <console_bridge/console.h>
+#include <dlfcn.h>
 #include <tinyxml.h>
 #include <urdf_parser/urdf_parser.h>
 
@@ -430,6 +431,23 @@ double RobotModel::total_mass_kg() const {
   return total;
 }
 
+std::string assets_folder() {
+  // Installed, the assets sit at PIXELGYM_LIB_TO_ASSETS from the folder of the library holding
+  // this code (share/pixelgym/assets beside lib/); in the build tree, that folder does not exist
+  // and the source tree's assets/ serve.
+  Dl_info info{};
+  if (::dladdr(reinterpret_cast<void*>(&assets_folder), &info) != 0 && info.dli_fname != nullptr) {
+    std::error_code error;
+    const fs::path library = fs::canonical(info.dli_fname, error);
+    if (!error) {
+      const fs::path installed =
+          (library.parent_path() / PIXELGYM_LIB_TO_ASSETS).lexically_normal();
+      if (fs::is_directory(installed, error)) return installed.string();
+    }
+  }
+  return PIXELGYM_ASSETS_DIR;
+}
+
 std::vector<std::string> asset_search_path() {
   std::vector<std::string> folders;
   if (const char* variable = std::getenv("PIXELGYM_ASSET_PATH")) {
@@ -439,7 +457,7 @@ std::vector<std::string> asset_search_path() {
       if (!entry.empty()) folders.push_back(entry);
     }
   }
-  folders.emplace_back(PIXELGYM_ASSETS_DIR);
+  folders.push_back(assets_folder());
   return folders;
 }
 
@@ -449,7 +467,7 @@ std::string asset_path(const std::string& relative) {
     if (fs::exists(candidate)) return candidate.lexically_normal().string();
   }
   throw UrdfError("asset \"" + relative + "\" not found in PIXELGYM_ASSET_PATH or " +
-                  PIXELGYM_ASSETS_DIR);
+                  assets_folder());
 }
 
 std::string resolve_uri(const std::string& uri, const std::string& urdf_path) {

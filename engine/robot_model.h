@@ -133,8 +133,13 @@ class RobotModel {
   std::vector<int> movable_joints_;
 };
 
+/// pixelgym's own assets folder: installed (`cmake --install`, the Debian package), the
+/// share/pixelgym/assets of the prefix the engine library was installed to, found from the
+/// library's own location; in the build tree, the source tree's assets/.
+std::string assets_folder();
+
 /// Folders searched for `package://` URIs and for assets named by relative paths: the entries of
-/// the PIXELGYM_ASSET_PATH environment variable (colon-separated), then pixelgym's own assets/.
+/// the PIXELGYM_ASSET_PATH environment variable (colon-separated), then assets_folder().
 std::vector<std::string> asset_search_path();
 
 /// The absolute path of `uri` as used inside the URDF at `urdf_path`: `file://` and absolute

@@ -8,6 +8,8 @@ set -euo pipefail
 PACKAGES=(
   # toolchain
   cmake g++ make pkg-config ccache
+  # make deb: dpkg-shlibdeps, which finds the Debian packages the installed programs load
+  dpkg-dev
   # make format-check (clang-format 14 on Debian 12)
   clang-format
   # engine: physics, URDF parsing, mesh import, linear algebra

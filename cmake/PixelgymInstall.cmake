@@ -1,0 +1,49 @@
+# `cmake --install BUILD [--prefix PREFIX]`: pixelgym's shared libraries, their headers (under
+# include/pixelgym/, included as "envs/registry.h" as in the source tree), the CMake package
+# (find_package(pixelgym) gives the pixelgym:: targets), the assets (share/pixelgym/assets, which
+# the engine finds from its own library's folder), and, from their own folders, the tool
+# (examples/) and the Python package (python/). `make deb` packs the same files into a Debian
+# package with CPack.
+include(CMakePackageConfigHelpers)
+
+if(NOT PIXELGYM_SHARED_LIBS)
+  message(STATUS "pixelgym: PIXELGYM_SHARED_LIBS is off, so cmake --install installs no library")
+  return()
+endif()
+
+get_property(pixelgym_libraries GLOBAL PROPERTY PIXELGYM_LIBRARIES)
+set_target_properties(pixelgym_testing_gtest PROPERTIES EXPORT_NAME testing_gtest)
+install(TARGETS ${pixelgym_libraries} pixelgym_testing_gtest EXPORT pixelgymTargets
+        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/pixelgym)
+install(DIRECTORY engine envs render testing wrappers
+        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/pixelgym FILES_MATCHING PATTERN "*.h")
+install(DIRECTORY assets/ DESTINATION ${PIXELGYM_INSTALL_ASSETS_DIR} PATTERN tools EXCLUDE)
+
+set(pixelgym_cmake_dir ${CMAKE_INSTALL_LIBDIR}/cmake/pixelgym)
+install(EXPORT pixelgymTargets NAMESPACE pixelgym:: DESTINATION ${pixelgym_cmake_dir})
+configure_package_config_file(cmake/pixelgymConfig.cmake.in
+                              ${PROJECT_BINARY_DIR}/pixelgymConfig.cmake
+                              INSTALL_DESTINATION ${pixelgym_cmake_dir})
+# 0.x: a minor version may change the API, so only the same minor version is compatible.
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/pixelgymConfigVersion.cmake
+                                 COMPATIBILITY SameMinorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/pixelgymConfig.cmake
+              ${PROJECT_BINARY_DIR}/pixelgymConfigVersion.cmake
+        DESTINATION ${pixelgym_cmake_dir})
+
+# The Debian package (`make deb`, from a build configured with CMAKE_INSTALL_PREFIX=/usr):
+# dpkg-shlibdeps reads the installed programs and libraries and makes the package depend on the
+# Debian packages that hold the libraries they load (Bullet, Mesa's OSMesa, OpenCV, LibTorch ...).
+set(CPACK_GENERATOR DEB)
+set(CPACK_PACKAGE_NAME pixelgym)
+set(CPACK_PACKAGE_VENDOR pixelgym)
+set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "${PROJECT_DESCRIPTION}")
+set(CPACK_PACKAGE_CONTACT "pixelgym maintainers <pixelgym@users.noreply.github.com>")
+set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
+set(CPACK_DEBIAN_PACKAGE_SECTION science)
+set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
+# Headers include Eigen's; find_package(pixelgym) finds it and Threads.
+set(CPACK_DEBIAN_PACKAGE_DEPENDS "libeigen3-dev (>= 3.4), python3-numpy")
+set(CPACK_PACKAGING_INSTALL_PREFIX ${CMAKE_INSTALL_PREFIX})
+include(CPack)

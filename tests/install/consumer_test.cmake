@@ -1,0 +1,46 @@
+# cmake -DBUILD_DIR=... -DCONSUMER_DIR=... -DWORK_DIR=... -P consumer_test.cmake
+# Installs BUILD_DIR into WORK_DIR/prefix, builds CONSUMER_DIR against it with find_package, runs
+# the consumer and the installed `pixelgym list`, and fails with the step's output when a step
+# fails or prints something other than expected. PIXELGYM_ASSET_PATH is unset throughout: the
+# installed code must find its assets from where it was installed.
+set(prefix ${WORK_DIR}/prefix)
+file(REMOVE_RECURSE ${WORK_DIR})
+unset(ENV{PIXELGYM_ASSET_PATH})
+
+function(step name)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE result OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT result EQUAL 0)
+    message(FATAL_ERROR "${name} failed (${result}):\n${ARGN}\n${out}\n${err}")
+  endif()
+  set(step_output "${out}" PARENT_SCOPE)
+endfunction()
+
+step("cmake --install" ${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
+foreach(installed include/pixelgym/envs/registry.h share/pixelgym/assets/cartpole bin/pixelgym
+                  bin/pixelgym-train)
+  if(NOT EXISTS ${prefix}/${installed})
+    message(FATAL_ERROR "cmake --install did not install ${installed} under ${prefix}")
+  endif()
+endforeach()
+file(GLOB_RECURSE config ${prefix}/pixelgymConfig.cmake)
+if(NOT config)
+  message(FATAL_ERROR "cmake --install did not install pixelgymConfig.cmake under ${prefix}")
+endif()
+
+step("configuring the consumer" ${CMAKE_COMMAND} -S ${CONSUMER_DIR} -B ${WORK_DIR}/build
+     -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${prefix})
+step("building the consumer" ${CMAKE_COMMAND} --build ${WORK_DIR}/build)
+step("running the consumer" ${WORK_DIR}/build/consumer)
+message(STATUS "consumer:\n${step_output}")
+if(NOT step_output MATCHES "assets: ${prefix}/share/pixelgym/assets\n")
+  message(FATAL_ERROR "the installed engine did not use the installed assets under ${prefix}")
+endif()
+if(NOT step_output MATCHES "consumer ran to the end\n$")
+  message(FATAL_ERROR "the consumer did not run to its end")
+endif()
+
+step("the installed pixelgym list" ${prefix}/bin/pixelgym list)
+if(NOT step_output MATCHES "CartPoleSwingup-v0")
+  message(FATAL_ERROR "the installed `pixelgym list` did not list CartPoleSwingup-v0:\n${step_output}")
+endif()
+message(STATUS "the installed pixelgym list: ${step_output}")
