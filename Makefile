@@ -52,11 +52,14 @@ test: build
 # corpora's replays (Fuzz.*) among them, in a Debug build at -O1 (asserts on; warnings are not
 # errors here: GCC's are false alarms under the sanitizers' instrumentation). lsan.supp names the
 # third-party leaks suppressed, each with its reason. The Python binding's tests run with ASan's
-# runtime preloaded into the interpreter (tests/python/CMakeLists.txt says how and why).
+# runtime preloaded into the interpreter (tests/python/CMakeLists.txt says how and why). The
+# sanitizer and fuzz builds link pixelgym's libraries statically, as they were checked (the
+# installable shared libraries are the Release build's: the consumer test runs there).
 ASAN_BUILD_DIR ?= build-asan
 test-asan: deps
 	cmake -S . -B $(ASAN_BUILD_DIR) -DCMAKE_BUILD_TYPE=Debug -DPIXELGYM_SANITIZE=address \
-	  -DPIXELGYM_BUILD_BENCH=OFF -DPIXELGYM_WERROR=OFF -DPIXELGYM_BUILD_PYTHON=ON
+	  -DPIXELGYM_BUILD_BENCH=OFF -DPIXELGYM_WERROR=OFF -DPIXELGYM_BUILD_PYTHON=ON \
+	  -DPIXELGYM_SHARED_LIBS=OFF
 	cmake --build $(ASAN_BUILD_DIR) --parallel $(JOBS)
 	ASAN_OPTIONS="detect_stack_use_after_return=0 strict_init_order=1 $(ASAN_OPTIONS)" \
 	UBSAN_OPTIONS="print_stacktrace=1 halt_on_error=1 $(UBSAN_OPTIONS)" \
@@ -70,7 +73,7 @@ test-asan: deps
 TSAN_BUILD_DIR ?= build-tsan
 test-tsan: deps
 	cmake -S . -B $(TSAN_BUILD_DIR) -DCMAKE_BUILD_TYPE=Debug -DPIXELGYM_SANITIZE=thread \
-	  -DPIXELGYM_BUILD_BENCH=OFF -DPIXELGYM_WERROR=OFF
+	  -DPIXELGYM_BUILD_BENCH=OFF -DPIXELGYM_WERROR=OFF -DPIXELGYM_SHARED_LIBS=OFF
 	cmake --build $(TSAN_BUILD_DIR) --parallel $(JOBS) --target threads_tests
 	TSAN_OPTIONS="suppressions=$(CURDIR)/tsan.supp halt_on_error=1 detect_deadlocks=0 $(TSAN_OPTIONS)" \
 	  ctest --test-dir $(TSAN_BUILD_DIR) -L threads --output-on-failure --parallel $(JOBS)
@@ -85,7 +88,8 @@ FUZZ_SECONDS ?= 600
 FUZZ_TIMEOUT ?= 10
 fuzz: deps
 	cmake -S . -B $(FUZZ_BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=clang++ \
-	  -DPIXELGYM_FUZZ=ON -DPIXELGYM_BUILD_BENCH=OFF -DPIXELGYM_BUILD_PYTHON=OFF
+	  -DPIXELGYM_FUZZ=ON -DPIXELGYM_BUILD_BENCH=OFF -DPIXELGYM_BUILD_PYTHON=OFF \
+	  -DPIXELGYM_SHARED_LIBS=OFF
 	cmake --build $(FUZZ_BUILD_DIR) --parallel $(JOBS) --target $(FUZZ_TARGET)_fuzz
 	mkdir -p $(FUZZ_BUILD_DIR)/findings/$(FUZZ_TARGET)
 	LSAN_OPTIONS="suppressions=$(CURDIR)/lsan.supp print_suppressions=0 $(LSAN_OPTIONS)" \

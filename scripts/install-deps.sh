@@ -20,7 +20,7 @@ PACKAGES=(
   libopencv-dev
   # examples: the PPO trainer; OpenBLAS (pthreads) takes over libblas.so.3 from the reference
   # BLAS Debian's LibTorch links by default: several times faster convolutions and linear layers
-  # on a CPU (see the README, Training)
+  # on a CPU (see docs/training.md)
   libtorch-dev libopenblas0-pthread
   # the distributed trainer: Gloo's headers for c10d's ProcessGroupGloo (in libtorch_cpu)
   libgloo-dev

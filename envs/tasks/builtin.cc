@@ -1,5 +1,7 @@
 #include "envs/tasks/builtin.h"
 
+#include <optional>
+
 #include "envs/tasks/acrobot.h"
 #include "envs/tasks/arm_push.h"
 #include "envs/tasks/arm_reach.h"
@@ -7,6 +9,7 @@
 #include "envs/tasks/grid_world.h"
 #include "envs/tasks/pendulum.h"
 #include "envs/tasks/reacher.h"
+#include "envs/tasks/urdf_reach.h"
 #include "envs/vector/make_vec.h"
 
 namespace pixelgym {
@@ -20,6 +23,7 @@ void register_builtin_envs(Registry& registry) {
   for (EnvSpec& spec : ReacherTask::specs()) registry.register_env(std::move(spec));
   registry.register_env(ArmReachTask::spec_v0());
   registry.register_env(ArmPushTask::spec_v0());
+  registry.register_env(UrdfReachTask::spec_v0());
 }
 
 // The process-wide registry and its free functions (declared in envs/registry.h and
@@ -27,10 +31,18 @@ void register_builtin_envs(Registry& registry) {
 // (pixelgym::envs) links no task.
 
 Registry& default_registry() {
+  // Filled whole or not at all: when a registration throws, the next call starts afresh instead
+  // of finding the envs registered before it ("already registered").
   static Registry* registry = [] {
-    static Registry instance;
-    register_builtin_envs(instance);
-    return &instance;
+    static std::optional<Registry> instance;
+    instance.emplace();
+    try {
+      register_builtin_envs(*instance);
+    } catch (...) {
+      instance.reset();
+      throw;
+    }
+    return &*instance;
   }();
   return *registry;
 }

@@ -284,8 +284,12 @@ EnvSpec pixel_task_spec(const std::string& id, const std::string& description,
     const std::unique_ptr<Task> task = make_task(kwargs);
     return PixelEnv::describe(*task, TaskConfig::from_params(kwargs, task->camera_names(), id));
   };
-  // The default time limit: the one describe gives for default kwargs.
-  spec.max_episode_steps = spec.describe(resolve_params(spec.params, {}, id)).max_episode_steps;
+  // The default time limit: the one describe gives for default kwargs, from the task's episode
+  // length alone, so that registering reads no file (UrdfReach-v0's task reads its URDF only
+  // when asked for its spaces or world).
+  const Params defaults = resolve_params(spec.params, {}, id);
+  const std::int64_t repeat = defaults.at("action_repeat").as_int();
+  spec.max_episode_steps = (make_task(defaults)->episode_length() + repeat - 1) / repeat;
   return spec;
 }
 
