@@ -275,16 +275,5 @@ int main(int argc, char** argv) {
                 options.rss_growth_mib);
     return 1;
   }
-  std::filesystem::remove_all(options.video_folder);
-  if (kUnderAddressSanitizer) {
-    std::printf(
-        "resident size not judged under AddressSanitizer (its quarantine keeps freed memory)\n");
-    return 0;
-  }
-  if (grown > options.rss_growth_mib) {
-    std::printf("FAILED: resident memory grew %.1f MiB after warm-up, more than %.1f\n", grown,
-                options.rss_growth_mib);
-    return 1;
-  }
   return 0;
 }
