@@ -12,6 +12,9 @@
 #                    given): libraries, headers, CMake package, tool, assets, Python package
 #   make deb         builds the Debian package in build-deb/ (prefix /usr, tests off):
 #                    build-deb/pixelgym_VERSION_ARCH.deb, for `apt install ./build-deb/pixelgym_*.deb`
+#   make bench-report   builds, then runs the benchmarks beside the reference programs of
+#                       ../shared/peers in interleaved rounds (REPEATS=5, about 20 minutes here) and
+#                       writes bench/RESULTS.md and README.md's headline figures (bench/README.md)
 #   make format-check   the project's C++ files against .clang-format (clang-format 14); exits 1
 #                       naming the files that differ. `make format` rewrites them.
 BUILD_DIR ?= build
@@ -19,7 +22,7 @@ BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 PIXELGYM := $(BUILD_DIR)/examples/pixelgym
 
-.PHONY: all deps configure build demo test test-asan test-tsan fuzz install deb format-check format goldens bench clean
+.PHONY: all deps configure build demo test test-asan test-tsan fuzz install deb format-check format goldens bench bench-report clean
 
 all: build
 
@@ -125,6 +128,10 @@ goldens: build
 bench: build
 	$(BUILD_DIR)/bench/envs_bench
 	$(BUILD_DIR)/bench/engine_bench
+
+REPEATS ?= 5
+bench-report: build
+	/usr/bin/python3 bench/report.py --build $(BUILD_DIR) --repeats $(REPEATS)
 
 clean:
 	rm -rf $(BUILD_DIR)
