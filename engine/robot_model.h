@@ -21,6 +21,7 @@ class UrdfError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// Which shape a Geometry is: a primitive, or a triangle mesh read from a file.
 enum class GeometryType { kBox, kSphere, kCylinder, kCapsule, kMesh };
 
 /// "box", "sphere", "cylinder", "capsule", "mesh".
@@ -28,6 +29,7 @@ const char* geometry_type_name(GeometryType type);
 
 /// A primitive or a mesh, in metres. Cylinders and capsules lie along their local z axis.
 struct Geometry {
+  /// Which of the fields below apply.
   GeometryType type = GeometryType::kBox;
   /// Box: full side lengths.
   Eigen::Vector3d box_size_m{1.0, 1.0, 1.0};
@@ -35,56 +37,76 @@ struct Geometry {
   double radius_m = 0.0;
   /// Cylinder and capsule: length of the cylindrical part (a capsule adds a hemisphere each end).
   double length_m = 0.0;
-  /// Mesh: shared vertex data in the file's units, and the URDF's scale.
+  /// Mesh: shared vertex data in the file's units.
   std::shared_ptr<const Mesh> mesh;
+  /// Mesh: the URDF's per-axis scale from the file's units to metres.
   Eigen::Vector3d mesh_scale{1.0, 1.0, 1.0};
 };
 
 /// Surface appearance from the URDF's <material>.
 struct Material {
+  /// The URDF's material name; may be empty.
   std::string name;
+  /// Colour, RGBA in [0, 1]; grey when `has_rgba` is false.
   Eigen::Vector4d rgba{0.75, 0.75, 0.75, 1.0};
-  /// False when the URDF gave no colour (mesh parts then keep their own).
+  /// False when the URDF gave no colour (mesh parts then keep their own). A black colour counts
+  /// as none: urdfdom leaves an unset colour black and the two cannot be told apart.
   bool has_rgba = false;
   /// Absolute path of the texture image, or empty.
   std::string texture_path;
 };
 
+/// One <visual> of a link: what the renderer draws.
 struct VisualElement {
+  /// The geometry's pose in the link's URDF frame (the element's <origin>).
   Eigen::Isometry3d X_link_geometry = Eigen::Isometry3d::Identity();
   Geometry geometry;
   Material material;
 };
 
+/// One <collision> of a link: what Bullet collides.
 struct CollisionElement {
+  /// The geometry's pose in the link's URDF frame (the element's <origin>).
   Eigen::Isometry3d X_link_geometry = Eigen::Isometry3d::Identity();
   Geometry geometry;
 };
 
 /// Mass properties; the inertia is about the centre of mass, in the frame X_link_inertial.
+/// A link without <inertial> keeps the zeros.
 struct Inertial {
   double mass_kg = 0.0;
+  /// The centre of mass frame in the link's URDF frame (the <inertial>'s <origin>).
   Eigen::Isometry3d X_link_inertial = Eigen::Isometry3d::Identity();
+  /// The symmetric inertia tensor about the centre of mass, in kg m^2.
   Eigen::Matrix3d inertia_kg_m2 = Eigen::Matrix3d::Zero();
 };
 
+/// One <link> of a URDF.
 struct LinkModel {
+  /// The URDF's link name.
   std::string name;
   Inertial inertial;
+  /// Its <visual> elements, in file order (may be empty).
   std::vector<VisualElement> visuals;
+  /// Its <collision> elements, in file order (may be empty: the link then collides with nothing).
   std::vector<CollisionElement> collisions;
   /// Index of the joint whose child this link is; -1 for the root.
   int parent_joint = -1;
 };
 
+/// How a joint moves: revolute turns about its axis within limits, continuous turns without
+/// limits, prismatic slides along its axis within limits, fixed does not move.
 enum class JointType { kRevolute, kContinuous, kPrismatic, kFixed };
 
 /// "revolute", "continuous", "prismatic", "fixed".
 const char* joint_type_name(JointType type);
 
+/// One <joint> of a URDF.
 struct JointModel {
+  /// The URDF's joint name.
   std::string name;
   JointType type = JointType::kFixed;
+  /// Indices into RobotModel::links() of the link it hangs from and of the link it moves.
   int parent_link = 0;
   int child_link = 0;
   /// The joint frame in the parent link's frame; the child link's frame is the joint frame moved
@@ -92,17 +114,22 @@ struct JointModel {
   Eigen::Isometry3d X_parent_joint = Eigen::Isometry3d::Identity();
   /// Unit axis in the joint frame.
   Eigen::Vector3d axis{1.0, 0.0, 0.0};
-  /// Position limits (rad or m); `has_limits` is false for continuous and fixed joints.
+  /// Whether `lower` and `upper` hold position limits; false for continuous and fixed joints.
   bool has_limits = false;
+  /// Position limits (rad or m), lower <= upper; 0 when `has_limits` is false.
   double lower = 0.0;
   double upper = 0.0;
   /// Largest torque (N m) or force (N) the joint's actuator gives; 0 when the URDF sets none.
   double effort_limit = 0.0;
+  /// Largest speed (rad/s or m/s) from the URDF's <limit>; 0 when it sets none. The World does
+  /// not enforce it; tasks may scale their actions by it.
   double velocity_limit = 0.0;
-  /// Viscous damping (N m s / rad or N s / m) and dry friction (N m or N).
+  /// Viscous damping (N m s / rad or N s / m) from <dynamics>; 0 when the URDF sets none.
   double damping = 0.0;
+  /// Dry friction (N m or N) from <dynamics>; 0 when the URDF sets none.
   double friction = 0.0;
 
+  /// True for every type but kFixed: the joint is one of the robot's degrees of freedom.
   bool movable() const { return type != JointType::kFixed; }
 };
 
@@ -110,19 +137,27 @@ struct JointModel {
 /// parent comes before its children; joints()[i] has child link i + 1.
 class RobotModel {
  public:
+  /// Takes links and joints already in that order (as parse_urdf builds them) and checks nothing;
+  /// movable_joints() is computed from `joints`.
   RobotModel(std::string name, std::string path, std::vector<LinkModel> links,
              std::vector<JointModel> joints);
 
+  /// The URDF's robot name.
   const std::string& name() const { return name_; }
   /// The URDF file it came from.
   const std::string& path() const { return path_; }
+  /// Every link, root first (see the class comment).
   const std::vector<LinkModel>& links() const { return links_; }
+  /// Every joint, fixed ones included; joints()[i] moves links()[i + 1].
   const std::vector<JointModel>& joints() const { return joints_; }
   /// Indices into joints() of the non-fixed joints, in tree order (the robot's degrees of freedom).
   const std::vector<int>& movable_joints() const { return movable_joints_; }
-  /// Throws std::out_of_range naming the robot and the name.
+  /// The index into links() of the link named `name`. Throws std::out_of_range naming the robot
+  /// and the name.
   int link_index(const std::string& name) const;
+  /// The index into joints() of the joint named `name`. Throws std::out_of_range as link_index.
   int joint_index(const std::string& name) const;
+  /// The sum of every link's mass, in kg.
   double total_mass_kg() const;
 
  private:
@@ -171,8 +206,11 @@ std::shared_ptr<const RobotModel> parse_urdf(const std::string& path, MeshCache&
 /// Parses each URDF once and shares the result (and its meshes) with every caller. Thread-safe.
 class ModelCache {
  public:
-  /// The model of the URDF at `path` (absolute, normalized), parsed on first use.
+  /// The model of the URDF at `path` (absolute, normalized), parsed on first use. Throws
+  /// UrdfError as parse_urdf; a file that failed is not remembered. Parses under the cache's
+  /// lock: concurrent first uses take turns.
   std::shared_ptr<const RobotModel> load_urdf(const std::string& path);
+  /// The mesh cache this cache's URDFs read their meshes through.
   MeshCache& meshes() { return meshes_; }
   /// How many URDF files this cache has parsed.
   int urdfs_parsed() const;
@@ -184,10 +222,12 @@ class ModelCache {
   int urdfs_parsed_ = 0;
 };
 
-/// The process-wide cache envs load their robots through.
+/// The process-wide cache envs load their robots through; it lives until the process ends.
 ModelCache& default_model_cache();
 
-/// `path` inside pixelgym's assets/ folder (resolved through asset_search_path()).
+/// `relative` in the first folder of asset_search_path() that has it (PIXELGYM_ASSET_PATH's,
+/// then pixelgym's assets/), lexically normalized. Throws UrdfError naming `relative` when no
+/// folder has it.
 std::string asset_path(const std::string& relative);
 
 }  // namespace pixelgym::engine

@@ -16,11 +16,13 @@ namespace pixelgym::engine {
 struct WorldConfig {
   /// One physics step, in seconds (PyBullet's default, 1/240 s).
   double timestep_s = 1.0 / 240.0;
+  /// Gravity in world coordinates, m/s^2.
   Eigen::Vector3d gravity_m_s2{0.0, 0.0, -9.81};
   /// Constraint solver iterations per step.
   int solver_iterations = 50;
   /// An infinite static plane z = 0.
   bool ground_plane = true;
+  /// The ground plane's friction coefficient (Bullet combines it with the other side's).
   double ground_friction = 1.0;
 
   /// Throws std::invalid_argument for a non-positive or non-finite timestep, non-finite gravity
@@ -51,28 +53,36 @@ struct RobotOptions {
 
 /// A free rigid body: a cube to push, a table, a target marker.
 struct BodyOptions {
+  /// Names the body in contacts and visual shapes (not checked for uniqueness).
   std::string name;
+  /// Its shape, for collisions and drawing alike.
   Geometry geometry;
+  /// How it is drawn.
   Material material;
   /// 0 makes the body static.
   double mass_kg = 1.0;
+  /// Where the body's frame starts; reset() puts it back here.
   Eigen::Isometry3d X_world_body = Eigen::Isometry3d::Identity();
   /// False for markers: drawn, never touched.
   bool collides = true;
+  /// Its friction coefficient (Bullet combines it with the other side's).
   double friction = 0.8;
 };
 
 /// One contact point between two named things ("cartpole/pole", "cube", "ground").
 struct Contact {
+  /// The two things touching: "robot/link" (the URDF's robot and link names), a body's name, or
+  /// "ground".
   std::string a;
   std::string b;
+  /// The contact point on b's surface, in world coordinates, m.
   Eigen::Vector3d position_world_m = Eigen::Vector3d::Zero();
-  /// From b towards a.
+  /// Unit normal from b towards a, in world coordinates.
   Eigen::Vector3d normal_world = Eigen::Vector3d::Zero();
+  /// The normal impulse of the last step divided by the timestep, N.
   double normal_force_n = 0.0;
 };
 
-/// Names a robot of one World: what `World::add_robot` returned. Only meaningful for that world.
 /// Thrown by World::step when the simulation went non-finite (a robot's base or joint, or a
 /// body), naming what and the simulation step.
 class NonFiniteState : public std::runtime_error {
@@ -87,7 +97,9 @@ class NonFiniteCommand : public std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
+/// Names a robot of one World: what `World::add_robot` returned. Only meaningful for that world.
 struct RobotId {
+  /// The robot's position in the order of add_robot calls, from 0; -1 (the default) names none.
   int index = -1;
 };
 inline bool operator==(RobotId a, RobotId b) { return a.index == b.index; }
@@ -95,6 +107,7 @@ inline bool operator!=(RobotId a, RobotId b) { return a.index != b.index; }
 
 /// Names a free body of one World: what `World::add_body` returned. Only meaningful for that world.
 struct BodyId {
+  /// The body's position in the order of add_body calls, from 0; -1 (the default) names none.
   int index = -1;
 };
 inline bool operator==(BodyId a, BodyId b) { return a.index == b.index; }
@@ -102,6 +115,7 @@ inline bool operator!=(BodyId a, BodyId b) { return a.index != b.index; }
 
 /// Something the renderer draws. Its pose comes from `visual_poses()`, in the same order.
 struct VisualShape {
+  /// The shape; `visual_poses()` gives its world pose.
   Geometry geometry;
   Material material;
   /// "robot/link" or the body name.
@@ -130,12 +144,13 @@ struct VisualShape {
 ///
 /// Determinism: the same additions and commands give bit-identical states. `reset()` rebuilds
 /// every Bullet object (solver caches and contact manifolds included), so a reset world matches a
-/// newly built one bit for bit. A step that leaves any state non-finite throws
-/// std::runtime_error naming the robot or body.
+/// newly built one bit for bit. A step that leaves any state non-finite throws NonFiniteState (a
+/// std::runtime_error) naming the robot or body.
 class World {
  public:
   /// Throws std::invalid_argument for an invalid config.
   explicit World(WorldConfig config = {});
+  /// Destroys every Bullet object it owns; the models and meshes stay with whoever shares them.
   ~World();
   World(const World&) = delete;
   World& operator=(const World&) = delete;
@@ -147,18 +162,26 @@ class World {
   /// hull. Throws std::invalid_argument for a negative mass or a mesh geometry without a mesh.
   BodyId add_body(BodyOptions options);
 
-  /// Advances `steps` physics steps of config().timestep_s with the current controls.
+  /// Advances `steps` physics steps of config().timestep_s with the current controls. Throws
+  /// std::invalid_argument for steps < 0, and NonFiniteState after the step that left a state
+  /// non-finite (the world stays in that state until reset()).
   void step(int steps = 1);
   /// Returns to the state right after the robots and bodies were added: every Bullet object is
-  /// rebuilt, controls are cleared, time restarts at 0.
+  /// rebuilt, controls are cleared (every degree of freedom back to kTorque with command 0), time
+  /// restarts at 0.
   void reset();
 
+  /// The config it was built with.
   const WorldConfig& config() const { return config_; }
+  /// Simulated time since the last reset (or construction): step_count() * timestep_s, seconds.
   double time_s() const;
+  /// Physics steps taken since the last reset (or construction).
   std::int64_t step_count() const { return step_count_; }
 
   // --- robots -------------------------------------------------------------------------------
+  /// Robots added so far.
   int num_robots() const;
+  /// The model `robot` was built from.
   const RobotModel& robot_model(RobotId robot) const;
   /// Degrees of freedom: the robot's movable joints in RobotModel::movable_joints() order.
   int num_dofs(RobotId robot) const;
@@ -171,8 +194,9 @@ class World {
   double joint_position(RobotId robot, int dof) const;
   /// The velocity of degree of freedom `dof`; std::out_of_range for a dof the robot lacks.
   double joint_velocity(RobotId robot, int dof) const;
-  /// Convenience forms that return a new vector (they allocate).
+  /// Convenience form of joint_positions that returns a new vector (it allocates).
   Eigen::VectorXd joint_positions(RobotId robot) const;
+  /// Convenience form of joint_velocities that returns a new vector (it allocates).
   Eigen::VectorXd joint_velocities(RobotId robot) const;
   /// Sets positions and velocities of every degree of freedom. Throws std::invalid_argument on a
   /// size mismatch or a non-finite value.
@@ -181,12 +205,16 @@ class World {
 
   /// Switches degree of freedom `dof` to `mode`. For kVelocity and kPosition, `max_force` bounds
   /// the motor (0: the URDF effort limit, or unbounded when it has none); `position_gain` and
-  /// `velocity_gain` are Bullet's motor gains (as PyBullet's positionGain / velocityGain).
+  /// `velocity_gain` are Bullet's motor gains (as PyBullet's positionGain / velocityGain). The
+  /// dof's command goes back to 0. Throws std::out_of_range for a dof the robot lacks and
+  /// std::invalid_argument for a negative (or NaN) max_force or gain.
   void set_control_mode(RobotId robot, int dof, ControlMode mode, double max_force = 0.0,
                         double position_gain = 0.3, double velocity_gain = 1.0);
   /// Sets every degree of freedom to `mode` with the same settings.
   void set_control_mode(RobotId robot, ControlMode mode, double max_force = 0.0,
                         double position_gain = 0.3, double velocity_gain = 1.0);
+  /// The mode of degree of freedom `dof` (kTorque until set); std::out_of_range for a dof the
+  /// robot lacks.
   ControlMode control_mode(RobotId robot, int dof) const;
   /// The command of each degree of freedom: a torque (kTorque), a velocity (kVelocity) or a
   /// position (kPosition), per its mode. Held until changed. Throws std::invalid_argument on a size
@@ -194,9 +222,11 @@ class World {
   void set_joint_commands(RobotId robot, const Eigen::Ref<const Eigen::VectorXd>& commands);
 
   /// World pose of the URDF frame of link `link` (an index into RobotModel::links()).
+  /// std::out_of_range for a link the robot lacks, as for every `link` argument below.
   Eigen::Isometry3d link_pose(RobotId robot, int link) const;
   /// World linear velocity of the origin of link `link`'s URDF frame, in m/s.
   Eigen::Vector3d link_linear_velocity(RobotId robot, int link) const;
+  /// World pose of the root link's URDF frame: link_pose(robot, 0).
   Eigen::Isometry3d base_pose(RobotId robot) const;
   /// Moves a floating-base robot's root link frame to `X_world_base` and stops its base. Throws
   /// std::invalid_argument for a fixed-base robot or a non-finite pose.
@@ -205,9 +235,13 @@ class World {
   int segmentation_id(RobotId robot, int link) const;
 
   // --- free bodies --------------------------------------------------------------------------
+  /// Bodies added so far.
   int num_bodies() const;
+  /// The options `body` was added with.
   const BodyOptions& body_options(BodyId body) const;
+  /// World pose of the body's frame.
   Eigen::Isometry3d body_pose(BodyId body) const;
+  /// World linear velocity of the origin of the body's frame, in m/s.
   Eigen::Vector3d body_linear_velocity(BodyId body) const;
   /// Moves a body and stops it. Throws std::invalid_argument for a non-finite pose.
   void set_body_pose(BodyId body, const Eigen::Isometry3d& X_world_body);
@@ -215,11 +249,13 @@ class World {
   int segmentation_id(BodyId body) const;
 
   // --- contacts and visuals -----------------------------------------------------------------
-  /// Contact points of the last step (with positive normal force or penetration).
+  /// Contact points of the last step (with positive normal force or penetration). Allocates the
+  /// returned vector.
   std::vector<Contact> contacts() const;
   /// Every visual element of every robot and body, in a fixed order.
   const std::vector<VisualShape>& visual_shapes() const { return visual_shapes_; }
-  /// The current world pose of each visual shape, in visual_shapes() order.
+  /// Writes the current world pose of each visual shape, in visual_shapes() order, into `poses`
+  /// (resized to visual_shapes().size(); no allocation once it has that size).
   void visual_poses(std::vector<Eigen::Isometry3d>& poses) const;
 
  private:

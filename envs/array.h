@@ -11,7 +11,8 @@
 
 namespace pixelgym {
 
-/// Element types an Array can hold. `kBool` is stored as one byte per element (0 or 1).
+/// Element types an Array can hold, named as numpy's (kUInt8 is uint8, kFloat32 float32, ...).
+/// `kBool` is stored as one byte per element (0 or 1).
 enum class DType : std::uint8_t { kBool, kUInt8, kInt32, kInt64, kFloat32, kFloat64 };
 
 /// Bytes per element of `dtype`.
@@ -25,7 +26,9 @@ bool is_floating(DType dtype);
 
 /// The values a dtype can hold, as doubles (int64's ends rounded to the nearest double).
 struct DTypeRange {
+  /// The smallest value, inclusive.
   double low;
+  /// The largest value, inclusive.
   double high;
 };
 /// The range of an integer dtype (kUInt8, kInt32, kInt64); kBool gives [0, 1]. Throws
@@ -74,7 +77,10 @@ class Array {
   /// A zero-filled array. Throws std::invalid_argument for a negative extent.
   Array(DType dtype, Shape shape);
 
-  /// Wraps memory owned elsewhere without copying; `owner` is kept alive while any view exists.
+  /// Wraps memory owned elsewhere without copying; `owner` is kept alive while any view exists
+  /// (null: the caller keeps `data` alive, and shares_memory() is then always false). `data` must
+  /// hold shape_size(shape) contiguous elements of `dtype`. Throws std::invalid_argument for null
+  /// `data` or a negative extent.
   static Array from_external(void* data, DType dtype, Shape shape, std::shared_ptr<void> owner);
 
   /// A 0-dimensional array holding `value`.
@@ -95,11 +101,15 @@ class Array {
     return array;
   }
 
+  /// The element type.
   DType dtype() const { return dtype_; }
+  /// The extent of each dimension, outermost first; empty for a 0-dimensional array.
   const Shape& shape() const { return shape_; }
+  /// Number of dimensions: shape().size().
   int ndim() const { return static_cast<int>(shape_.size()); }
   /// Number of elements.
   std::int64_t size() const { return size_; }
+  /// Bytes of the elements: size() * dtype_size(dtype()).
   std::size_t nbytes() const { return static_cast<std::size_t>(size_) * dtype_size(dtype_); }
 
   /// Typed pointer to the first element. Throws std::invalid_argument when T is not the dtype.
@@ -108,11 +118,13 @@ class Array {
     check_dtype(dtype_of<T>());
     return reinterpret_cast<T*>(data_);
   }
+  /// Typed pointer to the first element, read-only. Throws as the non-const form.
   template <typename T>
   const T* data() const {
     check_dtype(dtype_of<T>());
     return reinterpret_cast<const T*>(data_);
   }
+  /// Untyped pointer to the first element, whatever the dtype (nbytes() bytes follow it).
   void* raw_data() { return data_; }
   const void* raw_data() const { return data_; }
 
@@ -123,16 +135,17 @@ class Array {
     check_single();
     return *data<T>();
   }
-  /// Element `flat_index` (row-major) converted to double, whatever the dtype.
+  /// Element `flat_index` (row-major) converted to double, whatever the dtype. Throws
+  /// std::out_of_range unless 0 <= flat_index < size().
   double element_as_double(std::int64_t flat_index) const;
   /// Element `flat_index` of a bool or integer array, exactly (a double rounds int64s past 2^53).
-  /// Throws std::invalid_argument for a floating dtype.
+  /// Throws std::invalid_argument for a floating dtype, std::out_of_range as element_as_double.
   std::int64_t element_as_int64(std::int64_t flat_index) const;
 
   /// A deep copy with its own memory.
   Array clone() const;
   /// The sub-array at position `i` of the leading dimension, sharing memory (numpy's `a[i]`).
-  /// Throws std::out_of_range.
+  /// Throws std::out_of_range for a 0-dimensional array or i outside [0, shape()[0]).
   Array index(std::int64_t i) const;
   /// Rows [begin, end) of the leading dimension, sharing memory (numpy's `a[begin:end]`): a slot
   /// range of a batch, a window of a frame ring. Throws std::out_of_range unless
@@ -148,7 +161,8 @@ class Array {
   /// owner given): for accounting the memory that arrays hold, and for recognizing whose memory
   /// a view is (std::get_deleter on an owner made with a deleter of its own).
   const std::shared_ptr<void>& storage() const { return storage_; }
-  /// True when both arrays view the same allocation (numpy's `shares_memory` for our layouts).
+  /// True when both arrays view the same allocation (numpy's `shares_memory` for our layouts);
+  /// false when either has no storage (from_external with a null owner).
   bool shares_memory(const Array& other) const;
   /// Same dtype, same shape and identical bytes.
   bool equals(const Array& other) const;

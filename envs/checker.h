@@ -11,7 +11,9 @@ namespace pixelgym {
 
 /// The outcome of one named check.
 struct CheckResult {
+  /// The check's name, as listed at check_env ("reset_seed", "step", ...).
   std::string name;
+  /// Whether the check held.
   bool passed = false;
   /// Why it failed; empty when it passed.
   std::string reason;
@@ -20,7 +22,9 @@ struct CheckResult {
 /// Every check that `check_env` ran, in order.
 struct CheckReport {
   std::vector<CheckResult> results;
+  /// True when every check passed.
   bool passed() const;
+  /// The checks that failed, in order (a copy).
   std::vector<CheckResult> failures() const;
 };
 

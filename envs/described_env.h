@@ -17,6 +17,8 @@ namespace pixelgym {
 /// env, without a world or a GL context. reset, step and render throw std::logic_error.
 class DescribedEnv final : public Env {
  public:
+  /// Keeps `description`, whose observation_space and action_space must not be null (not
+  /// checked).
   explicit DescribedEnv(EnvDescription description);
 
   const Space& observation_space() const override { return *description_.observation_space; }

@@ -27,6 +27,7 @@ using Options = Params;
 
 /// What an env can render, and how fast its frames are meant to play.
 struct Metadata {
+  /// The render modes `render()` supports; pixelgym's envs support "rgb_array" only.
   std::vector<std::string> render_modes{"rgb_array"};
   /// Frames per second of `render()` output played back in real time; > 0.
   double render_fps = 0.0;
@@ -38,21 +39,26 @@ struct Metadata {
 
 /// What `reset` returns, and where `reset_into` writes.
 struct ResetResult {
+  /// The episode's first observation, laid out as observation_space().
   Value obs;
+  /// What the env reports beside it; often empty.
   Info info;
 };
 
 /// What `step` returns, and where `step_into` writes. `terminated`: the task's own end (goal
 /// reached, pole fell); `truncated`: cut off from outside the task (a time limit).
 struct StepResult {
+  /// The observation after the step, laid out as observation_space().
   Value obs;
+  /// The step's reward (a pixel task with action_repeat sums its control steps' rewards).
   double reward = 0.0;
   bool terminated = false;
   bool truncated = false;
+  /// What the env reports beside it; often empty.
   Info info;
 };
 
-/// Which call an observation buffer is for (see Env::observation_buffer).
+/// Which call an observation buffer is for (see Env::observation_buffer): `reset` or `step`.
 enum class BufferFor : std::uint8_t { kReset, kStep };
 
 /// The environment protocol, named as in Gymnasium.
@@ -104,6 +110,7 @@ class Env {
   /// is not laid out as `observation_space()`.
   void reset_into(ResetResult& out, std::optional<std::uint64_t> seed = std::nullopt,
                   const Options& options = {});
+  /// The buffer path of `step`, as reset_into is of `reset`.
   void step_into(const Value& action, StepResult& out);
   /// The current frame as an (H, W, 3) uint8 array (render mode "rgb_array"). Throws
   /// ResetNeeded before the first `reset` or after `close`.
@@ -111,8 +118,11 @@ class Env {
   /// Releases the env's resources. Calling it again does nothing.
   void close();
 
+  /// The space every observation is in; the same object for the env's life.
   virtual const Space& observation_space() const = 0;
+  /// The space `step` checks actions against; the same object for the env's life.
   virtual const Space& action_space() const = 0;
+  /// What the env renders, and at what rate.
   virtual const Metadata& metadata() const = 0;
 
   /// The innermost env beneath any wrappers.
@@ -144,8 +154,10 @@ class Env {
   /// Advances one step with an action already known to be in `action_space()`, writing into
   /// `out` as do_reset does (`out.reward` is 0, the flags false and `out.info` empty on entry).
   virtual void do_step(const Value& action, StepResult& out) = 0;
+  /// The current frame for `render()`, called only between reset and close: a new (H, W, 3)
+  /// uint8 array.
   virtual Array do_render() = 0;
-  /// Called at most once.
+  /// Releases what the env holds; called at most once, by the first `close()`.
   virtual void do_close() {}
 
  private:

@@ -13,13 +13,14 @@ namespace pixelgym {
 //   index or slice, a Dict-space insert position, a Task's state name, a World robot or body
 //   id). Python: KeyError for keys, IndexError for positions.
 // - std::invalid_argument: a bad value from the caller (an action not in the action space, an
-//   unknown env id or kwarg, a kwarg of the wrong type, a buffer of the wrong layout, a
-//   malformed URDF, a bad config). Python: ValueError.
+//   unknown env id or kwarg, a kwarg of the wrong type, a buffer of the wrong layout, a bad
+//   config). Python: ValueError.
 // - ResetNeeded: calls out of order (step or render before reset, step after the episode
 //   ended, anything but close after close). Python: gymnasium.error.ResetNeeded, or
 //   RuntimeError without gymnasium.
 // - std::runtime_error: the environment failing, not the caller (a file that cannot be read or
-//   written, a GL context that cannot be made). Python: RuntimeError.
+//   written, a GL context that cannot be made; a URDF or mesh that cannot be used, as
+//   engine::UrdfError). Python: RuntimeError.
 // - PhysicsDivergence (a std::runtime_error): a simulation that went non-finite. Python:
 //   RuntimeError.
 //

@@ -27,6 +27,7 @@ class Param {
   Param(const char* value) : value_(std::string(value)) {}  // NOLINT
   Param(std::string value) : value_(std::move(value)) {}    // NOLINT
 
+  /// Which of the four types it holds (every integer type is kInt, stored as int64).
   ParamType type() const { return static_cast<ParamType>(value_.index()); }
   /// Each accessor throws std::invalid_argument when the type differs; `as_float` also accepts
   /// an int (as Python would).
@@ -34,9 +35,10 @@ class Param {
   std::int64_t as_int() const;
   double as_float() const;
   const std::string& as_string() const;
-  /// "true", "64", "0.5", "\"side\"".
+  /// "true", "64", "0.5", "\"side\"" (floats with 6 significant digits).
   std::string to_string() const;
 
+  /// Same type and same value: the int 1 and the float 1.0 differ.
   friend bool operator==(const Param& a, const Param& b) { return a.value_ == b.value_; }
 
  private:
@@ -50,12 +52,15 @@ using Params = std::map<std::string, Param>;
 struct ParamSpec {
   std::string name;
   Param default_value;
+  /// One line for `pixelgym info` and the like.
   std::string doc;
+  /// The setting's type: its default's.
   ParamType type() const { return default_value.type(); }
 };
 
-/// Parses command-line text as `type`: bools accept true/false/1/0/yes/no/on/off, ints decimal,
-/// floats anything strtod reads fully. Throws std::invalid_argument naming the text and type.
+/// Parses command-line text as `type`: bools accept true/false/1/0/yes/no/on/off (any case), ints
+/// decimal within int64, floats anything strtod reads fully, strings as they are. Throws
+/// std::invalid_argument naming the text and type.
 Param parse_param(ParamType type, const std::string& text);
 
 /// `given` checked against `specs`, with defaults filled in. Throws std::invalid_argument,
@@ -64,7 +69,7 @@ Param parse_param(ParamType type, const std::string& text);
 Params resolve_params(const std::vector<ParamSpec>& specs, const Params& given,
                       const std::string& context);
 
-/// "render_width (int, default 256)" for each spec, comma-separated.
+/// "render_width (int, default 256)" for each spec, comma-separated; "none" for no specs.
 std::string describe_params(const std::vector<ParamSpec>& specs);
 
 }  // namespace pixelgym

@@ -18,12 +18,14 @@ namespace pixelgym {
 /// What an env made with some kwargs offers, known without making it: no Bullet world and no GL
 /// context are built to answer (`pixelgym info` prints it).
 struct EnvDescription {
+  /// The spaces of the env as `make` returns it (TimeLimit changes neither).
   SpacePtr observation_space;
   SpacePtr action_space;
   /// The step at which `make` truncates (TimeLimit), in env steps; std::nullopt for no limit.
   std::optional<std::int64_t> max_episode_steps;
   /// The camera names a pixel task accepts as its "camera" kwarg, default first; empty otherwise.
   std::vector<std::string> cameras;
+  /// The env's metadata (render modes, render_fps, render_shape).
   Metadata metadata;
 };
 
@@ -60,14 +62,16 @@ struct EnvSpec {
 class Registry {
  public:
   /// Adds `spec`. Throws std::invalid_argument for an id not of the form Name-vN, an id already
-  /// registered, a missing factory, or a param named "max_episode_steps" (reserved for make).
+  /// registered, a missing factory, a param named "max_episode_steps" (reserved for make), or a
+  /// max_episode_steps that is set and not positive.
   void register_env(EnvSpec spec);
 
   /// Builds env `id` with `kwargs`, wrapped in TimeLimit when the spec (or the reserved kwarg
-  /// "max_episode_steps") sets a limit. Throws std::invalid_argument for an unknown id (naming
-  /// the closest registered ids, or all of them when none is close), an unknown kwarg (listing the
-  /// valid ones with types and defaults) or a kwarg of the wrong type. `options` are passed to the
-  /// factory (see MakeOptions).
+  /// "max_episode_steps", 0 for no limit) sets a limit. Throws std::invalid_argument for an
+  /// unknown id (naming the closest registered ids, or all of them when none is close), an
+  /// unknown kwarg (listing the valid ones with types and defaults), a kwarg of the wrong type or
+  /// a negative max_episode_steps; std::runtime_error when the factory returns null; and what the
+  /// factory throws. `options` are passed to the factory (see MakeOptions).
   std::unique_ptr<Env> make(const std::string& id, const Params& kwargs = {},
                             const MakeOptions& options = {}) const;
 

@@ -25,9 +25,10 @@ class Rng {
   std::uint64_t next_u64();
   /// Uniform in [0, 1), 53 bits of resolution.
   double uniform();
-  /// Uniform in [low, high).
+  /// Uniform in [low, high): low + (high - low) * uniform(), so rounding can give `high` itself.
   double uniform(double low, double high);
-  /// Uniform integer in [low, high], both inclusive, without modulo bias.
+  /// Uniform integer in [low, high], both inclusive, without modulo bias. Throws
+  /// std::invalid_argument when low > high.
   std::int64_t integer(std::int64_t low, std::int64_t high);
   /// Standard normal (Marsaglia's polar method; no cached second value, so the state alone
   /// determines the sequence).
@@ -35,7 +36,9 @@ class Rng {
   /// Exponential with rate 1.
   double exponential();
 
+  /// The 256-bit state, which alone determines every number to come.
   const std::array<std::uint64_t, 4>& state() const { return state_; }
+  /// Same state: both give the same numbers from here on.
   friend bool operator==(const Rng& a, const Rng& b) { return a.state_ == b.state_; }
   friend bool operator!=(const Rng& a, const Rng& b) { return !(a == b); }
 

@@ -15,6 +15,7 @@ class TimeLimit final : public Wrapper {
   /// Throws std::invalid_argument unless max_episode_steps > 0.
   TimeLimit(std::unique_ptr<Env> env, std::int64_t max_episode_steps);
 
+  /// The episode length, in steps, at which it truncates.
   std::int64_t max_episode_steps() const { return max_episode_steps_; }
   /// Steps taken in the current episode.
   std::int64_t elapsed_steps() const { return elapsed_steps_; }

@@ -17,6 +17,7 @@ class Value;
 class ValueDict {
  public:
   ValueDict() = default;
+  /// The entries inserted in order (a repeated key keeps its first position and its last value).
   ValueDict(std::initializer_list<std::pair<std::string, Value>> entries);
 
   /// Adds `key`, or replaces its value when present (keeping its position).
@@ -25,14 +26,20 @@ class ValueDict {
   void erase(const std::string& key);
   /// Removes every entry (keeping the memory for the next ones).
   void clear();
+  /// Whether `key` is present.
   bool contains(const std::string& key) const;
-  /// Throws std::out_of_range naming the key and the keys present.
+  /// The value of `key`. Throws std::out_of_range naming the key and the keys present.
   const Value& at(const std::string& key) const;
   Value& at(const std::string& key);
+  /// Number of entries.
   std::size_t size() const { return keys_.size(); }
   bool empty() const { return keys_.empty(); }
+  /// The keys in insertion order.
   const std::vector<std::string>& keys() const { return keys_; }
+  /// The values, in the order of keys(): values()[i] belongs to keys()[i].
   const std::vector<Value>& values() const { return values_; }
+  /// The same, writable (replace values in place; adding or removing entries here would break
+  /// the pairing with keys()).
   std::vector<Value>& values() { return values_; }
 
  private:
@@ -46,12 +53,15 @@ class ValueDict {
 class ValueTuple {
  public:
   ValueTuple() = default;
+  /// The items in order.
   ValueTuple(std::initializer_list<Value> items);
   explicit ValueTuple(std::vector<Value> items);
 
+  /// Number of items.
   std::size_t size() const { return items_.size(); }
-  /// Throws std::out_of_range.
+  /// Item `i`. Throws std::out_of_range unless i < size().
   const Value& at(std::size_t i) const;
+  /// Every item, in order.
   const std::vector<Value>& items() const { return items_; }
 
  private:
@@ -62,11 +72,14 @@ class ValueTuple {
 /// memory).
 class Value {
  public:
-  Value();                  // an empty Array
+  /// An empty Array (float32, shape (0,)).
+  Value();
+  /// Holds `array` (sharing its memory), `dict` or `tuple`; implicit, so that each converts.
   Value(Array array);       // NOLINT(google-explicit-constructor): arrays are values
   Value(ValueDict dict);    // NOLINT(google-explicit-constructor)
   Value(ValueTuple tuple);  // NOLINT(google-explicit-constructor)
 
+  /// Which alternative it holds.
   bool is_array() const { return std::holds_alternative<Array>(data_); }
   bool is_dict() const { return std::holds_alternative<ValueDict>(data_); }
   bool is_tuple() const { return std::holds_alternative<ValueTuple>(data_); }

@@ -53,6 +53,7 @@ class Wrapper : public Env {
   Array do_render() override;
   void do_close() override;
 
+  /// The wrapped env, owned; never null.
   std::unique_ptr<Env> env_;
 };
 
@@ -62,7 +63,9 @@ class Wrapper : public Env {
 /// caller gets its own buffer back whatever happens. Allocates nothing.
 class SwapBack {
  public:
+  /// Swaps `a` and `b`, which must outlive the SwapBack.
   SwapBack(Value& a, Value& b) : a_(a), b_(b) { a_.swap(b_); }
+  /// Swaps them back.
   ~SwapBack() { a_.swap(b_); }
   SwapBack(const SwapBack&) = delete;
   SwapBack& operator=(const SwapBack&) = delete;
@@ -81,6 +84,7 @@ class SwapBack {
 class ObservationWrapper : public Wrapper {
  public:
   using Wrapper::Wrapper;
+  /// The space given to set_observation_space(), else the inner env's.
   const Space& observation_space() const override;
   /// `observation_space().zeros()`: observations are transformed, never the inner env's memory.
   Value observation_buffer(BufferFor call) override;
@@ -89,6 +93,7 @@ class ObservationWrapper : public Wrapper {
   /// Writes the transform of `obs` (laid out as the inner env's observation space) into the
   /// arrays of `out` (laid out as observation_space()).
   virtual void observation(const Value& obs, Value& out) = 0;
+  /// Sets the observation space this wrapper reports. Throws std::invalid_argument for null.
   void set_observation_space(SpacePtr space);
   void do_reset(std::optional<std::uint64_t> seed, const Options& options,
                 ResetResult& out) override;
@@ -104,12 +109,15 @@ class ObservationWrapper : public Wrapper {
 class ActionWrapper : public Wrapper {
  public:
   using Wrapper::Wrapper;
+  /// The space given to set_action_space(), else the inner env's.
   const Space& action_space() const override;
 
  protected:
   /// Writes the inner env's action for `action` into the arrays of `out` (laid out as the inner
   /// env's action space, owned by this wrapper).
   virtual void action(const Value& action, Value& out) = 0;
+  /// Sets the action space this wrapper reports (and Env::step checks actions against). Throws
+  /// std::invalid_argument for null.
   void set_action_space(SpacePtr space);
   void do_step(const Value& action, StepResult& out) override;
 
@@ -124,6 +132,7 @@ class RewardWrapper : public Wrapper {
   using Wrapper::Wrapper;
 
  protected:
+  /// The reward the caller sees for the inner env's `reward`.
   virtual double reward(double reward) = 0;
   void do_step(const Value& action, StepResult& out) override;
 };

@@ -53,7 +53,10 @@ class Context {
   /// already current here when the scope began (then it stays bound).
   class Scope {
    public:
+    /// Makes `context` current on the calling thread; `context` must outlive the scope.
     explicit Scope(Context& context);
+    /// Releases the context unless it was current when the scope began, and restores the GL
+    /// function table in use before.
     ~Scope();
     Scope(const Scope&) = delete;
     Scope& operator=(const Scope&) = delete;
@@ -65,15 +68,17 @@ class Context {
   };
   /// True when this context is current on the calling thread.
   bool is_current() const;
+  /// The implementation it was created with.
   GlBackend backend() const { return backend_; }
   /// The copy of Mesa the context is from (see MesaCopy): the one it was created for, or 0 when
   /// that one could not be loaded.
   int mesa_copy() const;
   /// GL_RENDERER and GL_VERSION, e.g. "llvmpipe (LLVM 15.0.6, 256 bits), 4.5 (Core Profile)
-  /// Mesa 22.3.6".
+  /// Mesa 22.3.6". Binds the context for the call (as Scope).
   std::string description();
   /// GL_MAX_SAMPLES: the most samples per pixel a multisampled render target (and so
-  /// Camera::msaa_samples) may have in this context; 4 on llvmpipe.
+  /// Camera::msaa_samples) may have in this context; 4 on llvmpipe. Binds the context for the
+  /// call (as Scope).
   int max_samples();
 
  private:

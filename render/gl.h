@@ -16,7 +16,7 @@
 #include <GL/glext.h>
 #include <GL/osmesa.h>
 
-// X(Name) for every glName the renderer calls.
+/// X(Name) for every glName the renderer calls.
 #define PIXELGYM_GL_FUNCTIONS(X)    \
   X(ActiveTexture)                  \
   X(AttachShader)                   \
@@ -97,10 +97,13 @@ struct GlFunctions {
 /// The table of the copy whose context was last made current on this thread (Context sets it).
 extern thread_local const GlFunctions* current_gl_functions;
 
+/// The calling thread's table: a context must have been made current on this thread first (the
+/// pointer is null before).
 inline const GlFunctions& current_gl() { return *current_gl_functions; }
 
 }  // namespace pixelgym::render
 
+/// The entry point glName of the current thread's table; each glName below expands to it.
 #define PIXELGYM_GL(name) (::pixelgym::render::current_gl().name)
 #define glActiveTexture PIXELGYM_GL(ActiveTexture)
 #define glAttachShader PIXELGYM_GL(AttachShader)

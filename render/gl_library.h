@@ -7,15 +7,19 @@ namespace pixelgym::render {
 
 /// The OSMesa functions of one copy, and its GL table.
 struct GlLibrary {
+  /// Which copy this is (see MesaCopy).
   int copy = 0;
+  /// That copy's OSMesaCreateContextAttribs, OSMesaMakeCurrent, OSMesaGetCurrentContext and
+  /// OSMesaDestroyContext.
   OSMesaContext (*create_context_attribs)(const int*, OSMesaContext) = nullptr;
   GLboolean (*make_current)(OSMesaContext, void*, GLenum, GLsizei, GLsizei) = nullptr;
   OSMesaContext (*get_current_context)() = nullptr;
   void (*destroy_context)(OSMesaContext) = nullptr;
-  // A private copy's own C library sets a thread's ctype tables (isalpha and friends, which LLVM
-  // uses when it compiles shaders) only on the thread that loaded it; other threads crash there
-  // until this, glibc's __ctype_init of that copy, has run on them. Null for copy 0.
+  /// A private copy's own C library sets a thread's ctype tables (isalpha and friends, which LLVM
+  /// uses when it compiles shaders) only on the thread that loaded it; other threads crash there
+  /// until this, glibc's __ctype_init of that copy, has run on them. Null for copy 0.
   void (*init_thread)() = nullptr;
+  /// The copy's GL entry points.
   GlFunctions gl;
 };
 

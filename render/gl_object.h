@@ -15,11 +15,15 @@ namespace pixelgym::render {
 template <void (*Delete)(GLuint)>
 class GlObject {
  public:
+  /// Owns nothing.
   GlObject() = default;
   /// Takes ownership of `name` (0 for none).
   explicit GlObject(GLuint name) : name_(name) {}
+  /// Deletes the object, if any (its context must be current).
   ~GlObject() { reset(); }
+  /// Takes `other`'s name, leaving it empty.
   GlObject(GlObject&& other) noexcept : name_(std::exchange(other.name_, 0)) {}
+  /// Deletes this one's object, if any, then takes `other`'s name, leaving it empty.
   GlObject& operator=(GlObject&& other) noexcept {
     if (this != &other) {
       reset();
@@ -32,6 +36,7 @@ class GlObject {
 
   /// The name, for GL calls; 0 when empty.
   GLuint get() const { return name_; }
+  /// True when it owns an object.
   explicit operator bool() const { return name_ != 0; }
   /// Deletes the object now (when there is one).
   void reset() {
@@ -43,6 +48,7 @@ class GlObject {
   GLuint name_ = 0;
 };
 
+/// The deleters of the owners below: each frees one name with the matching glDelete* call.
 namespace gl_delete {
 inline void buffer(GLuint name) { glDeleteBuffers(1, &name); }
 inline void vertex_array(GLuint name) { glDeleteVertexArrays(1, &name); }
@@ -53,6 +59,7 @@ inline void program(GLuint name) { glDeleteProgram(name); }
 inline void shader(GLuint name) { glDeleteShader(name); }
 }  // namespace gl_delete
 
+/// Owners of one buffer, vertex array, texture, framebuffer, renderbuffer, program or shader.
 using GlBuffer = GlObject<gl_delete::buffer>;
 using GlVertexArray = GlObject<gl_delete::vertex_array>;
 using GlTexture = GlObject<gl_delete::texture>;

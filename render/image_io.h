@@ -9,18 +9,22 @@ namespace pixelgym::render {
 
 /// Interleaved 8-bit pixels, row 0 at the top; `channels` is 1 (gray), 3 (RGB) or 4 (RGBA).
 struct ImageView {
+  /// height x width x channels bytes, not owned: they must outlive the view.
   const std::uint8_t* pixels = nullptr;
+  /// Rows and columns, in pixels.
   int height = 0;
   int width = 0;
   int channels = 3;
 };
 
-/// An image read from a file, owning its pixels.
+/// An image read from a file, owning its pixels (layout as ImageView's).
 struct Image {
   int height = 0;
   int width = 0;
   int channels = 3;
+  /// height x width x channels bytes.
   std::vector<std::uint8_t> pixels;
+  /// A view of `pixels`, valid while this image lives and its pixels are not reallocated.
   ImageView view() const { return {pixels.data(), height, width, channels}; }
 };
 

@@ -28,10 +28,12 @@ namespace pixelgym::render {
 /// with the reason.
 class MesaCopy {
  public:
-  /// The most copies, copy 0 included: PIXELGYM_MESA_COPIES when set (1 to 16), else 8.
+  /// The most copies, copy 0 included: PIXELGYM_MESA_COPIES when set (1 to 16), else 8. Throws
+  /// std::invalid_argument when the variable is set to anything else.
   static int max_copies();
   /// The copy a context asking for `copy` gets: `copy` modulo max_copies(), loaded if need be,
-  /// or 0 when it could not be loaded (then `why_not(copy)` says why).
+  /// or 0 when it could not be loaded (then `why_not` of that copy says why). Throws
+  /// std::invalid_argument for copy < 0, and as max_copies(). Thread-safe.
   static int resolve(int copy);
   /// Whether copy `copy` is loaded (copy 0: once any context was made).
   static bool loaded(int copy);

@@ -16,12 +16,18 @@ namespace pixelgym::render {
 
 /// Where one mesh lies in an arena (or in another buffer drawn the same way).
 struct GpuMesh {
+  /// The mesh, kept alive so that its address stays a valid key.
   std::shared_ptr<const MeshData> keep_alive;
-  GLint base_vertex = 0;          // of its first vertex
-  std::uint32_t first_index = 0;  // of its first index
+  /// Position of its first vertex in the vertex buffer (added to every index when drawn).
+  GLint base_vertex = 0;
+  /// Position of its first index in the index buffer.
+  std::uint32_t first_index = 0;
+  /// Its indices: three per triangle.
   std::uint32_t index_count = 0;
-  float radius = 0.0F;         // of a sphere about the origin that holds every vertex
-  Eigen::AlignedBox3f bounds;  // in mesh coordinates
+  /// Radius of a sphere about the mesh origin that holds every vertex, in mesh units.
+  float radius = 0.0F;
+  /// The box around its vertices, in mesh coordinates.
+  Eigen::AlignedBox3f bounds;
 };
 
 /// Every mesh in one vertex buffer, one index buffer and one vertex array, so that drawing another
@@ -33,6 +39,7 @@ struct GpuMesh {
 /// alpha -1 means "the instance's colour", for a part without its own).
 class MeshArena {
  public:
+  /// Floats per vertex (see above).
   static constexpr int kStride = 12;
 
   /// Creates the GL buffers and vertex array (a context must be current).
@@ -44,6 +51,7 @@ class MeshArena {
   const GpuMesh& at(const MeshData* mesh) const { return meshes_.at(mesh); }
   /// Binds the arena's vertex array and sends meshes added since the last call to the GPU.
   void sync();
+  /// The arena's vertex array object.
   GLuint vertex_array() const { return vertex_array_.get(); }
 
   /// Draws `mesh`'s triangles from the bound vertex array (the arena's, or one laid out alike).

@@ -14,16 +14,22 @@ struct MeshData {
   /// A run of triangles with one colour (a mesh file's material); `has_color` false means the
   /// instance's material colour applies.
   struct Part {
+    /// Position of the run's first index in `indices`.
     std::uint32_t first_index = 0;
+    /// Indices in the run: three per triangle.
     std::uint32_t index_count = 0;
+    /// The part's colour, RGBA in [0, 1], used when `has_color`.
     Eigen::Vector4f rgba{1.0F, 1.0F, 1.0F, 1.0F};
     bool has_color = false;
   };
 
+  /// Vertex positions, in mesh units.
   std::vector<Eigen::Vector3f> positions;
+  /// Unit normals, one per position (a vertex without one is drawn with +z).
   std::vector<Eigen::Vector3f> normals;
   /// Empty, or one per position (for textured materials).
   std::vector<Eigen::Vector2f> texcoords;
+  /// Three per triangle, indexing `positions`.
   std::vector<std::uint32_t> indices;
   /// Empty means one part covering every index.
   std::vector<Part> parts;
@@ -34,7 +40,10 @@ struct MeshData {
   /// primitive's segment count must resolve.) Null for none. Shadows are cast by one level
   /// coarser than the camera draws, when there is one.
   std::shared_ptr<const MeshData> low_detail;
+  /// The radius, in mesh units, whose size on screen chooses `low_detail` (see above).
   float low_detail_radius = 1.0F;
+  /// The size on screen, in pixels of the image's height, below which `low_detail` is drawn; 0
+  /// never draws it for the camera (it may still cast shadows).
   float low_detail_below_px = 0.0F;
 
   /// A closed, outward-wound surface (see `is_closed_surface`): faces turned away from a viewer
@@ -42,6 +51,7 @@ struct MeshData {
   /// face. Primitives are closed; `simplify_by_clustering` keeps its source's flag.
   bool closed = false;
 
+  /// indices.size() / 3.
   std::size_t triangle_count() const { return indices.size() / 3; }
 };
 
@@ -51,11 +61,14 @@ struct MeshData {
 /// the enclosed volume is positive. Degenerate triangles are ignored.
 bool is_closed_surface(const MeshData& mesh);
 
-/// Unit primitives, centred at the origin; instances scale them. Cylinders and capsules lie along
-/// z. `segments` sets the smoothness of round shapes.
-std::shared_ptr<const MeshData> make_box_mesh();                        // 1 x 1 x 1
-std::shared_ptr<const MeshData> make_sphere_mesh(int segments = 24);    // radius 1
-std::shared_ptr<const MeshData> make_cylinder_mesh(int segments = 24);  // radius 1, length 1
+/// Unit primitives, centred at the origin and closed; instances scale them. Cylinders and
+/// capsules lie along z. `segments` sets the smoothness of round shapes (segments around z).
+/// A 1 x 1 x 1 box.
+std::shared_ptr<const MeshData> make_box_mesh();
+/// A sphere of radius 1.
+std::shared_ptr<const MeshData> make_sphere_mesh(int segments = 24);
+/// A cylinder of radius 1 and length 1, capped at both ends.
+std::shared_ptr<const MeshData> make_cylinder_mesh(int segments = 24);
 /// A capsule of radius 1 whose cylindrical part is `length / radius` long (capsules do not scale
 /// uniformly, so each aspect ratio is its own mesh).
 std::shared_ptr<const MeshData> make_capsule_mesh(double length_over_radius, int segments = 24);

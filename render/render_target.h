@@ -17,7 +17,8 @@ void check_framebuffer(const char* what);
 /// plus, when `resolvable` and multisampled, a single-sampled copy to read from.
 class ColorTarget {
  public:
-  /// Creates the buffers (a context must be current). `what` names the target in errors.
+  /// Creates the buffers (a context must be current), leaving a framebuffer bound. `what` names
+  /// the target in errors: std::runtime_error when a framebuffer is not complete.
   ColorTarget(int width, int height, int samples, bool resolvable, const char* what);
 
   /// What is drawn into (multisampled when samples > 0).
@@ -44,7 +45,10 @@ class ColorTarget {
 /// A 32-bit integer id and a 24-bit depth renderbuffer of one size in a framebuffer.
 class SegmentationTarget {
  public:
+  /// Creates the buffers (a context must be current), leaving the framebuffer bound. Throws
+  /// std::runtime_error when it is not complete.
   SegmentationTarget(int width, int height);
+  /// What ids are drawn into.
   GLuint framebuffer() const { return framebuffer_.get(); }
 
  private:
@@ -62,7 +66,7 @@ void read_rgb(int width, int height, std::vector<std::uint8_t>& rgba, std::uint8
 /// `far_m`.
 void read_depth(int width, int height, float near_m, float far_m, float* depth);
 
-/// Reads the bound read framebuffer's integer ids.
+/// Reads the bound read framebuffer's integer ids into `ids` (width x height values).
 void read_segmentation(int width, int height, std::int32_t* ids);
 
 }  // namespace pixelgym::render

@@ -46,10 +46,12 @@ class ContextGroup {
  public:
   /// Throws std::invalid_argument for mesa_copy < 0.
   explicit ContextGroup(int mesa_copy = 0, GlBackend backend = GlBackend::kOSMesa);
+  /// Drops the group's share of the context; the renderers made with it keep theirs.
   ~ContextGroup();
   ContextGroup(const ContextGroup&) = delete;
   ContextGroup& operator=(const ContextGroup&) = delete;
 
+  /// The GL implementation its context comes from.
   GlBackend backend() const { return backend_; }
   /// The copy of Mesa its context is made in, as asked (Context::mesa_copy says which it got).
   int mesa_copy() const { return mesa_copy_; }
@@ -84,6 +86,8 @@ class Renderer {
   /// Draws with `group`'s context (created now if it is the group's first renderer), which it
   /// keeps alive: the group object itself may go first. Throws as above.
   explicit Renderer(ContextGroup& group);
+  /// Drops its share of the context: a context of its own is destroyed with everything drawn
+  /// with it, a group's with the last of the group and its renderers.
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
@@ -94,7 +98,7 @@ class Renderer {
   /// that cannot be read.
   void render(const Scene& scene, const Camera& camera, const RenderTargets& targets);
 
-  /// The GL implementation in use.
+  /// The GL implementation in use (Context::description).
   std::string description();
 
  private:

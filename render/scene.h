@@ -13,9 +13,12 @@ namespace pixelgym::render {
 
 /// How a surface looks. Colours are linear RGB in [0, 1].
 struct RenderMaterial {
+  /// The colour of mesh parts without one of their own. Its alpha is ignored: everything is drawn
+  /// opaque.
   Eigen::Vector4f base_color{0.7F, 0.7F, 0.7F, 1.0F};
   /// Strength of the white highlight, 0 (matte) to 1.
   float specular = 0.3F;
+  /// The Blinn-Phong exponent: larger gives a smaller, sharper highlight.
   float shininess = 32.0F;
   /// A PNG multiplied into the base colour through the mesh's texture coordinates; empty for none.
   std::string texture_path;
@@ -23,9 +26,11 @@ struct RenderMaterial {
 
 /// One drawn copy of a mesh.
 struct Instance {
+  /// What to draw, shared; Renderer::render refuses an instance without one.
   std::shared_ptr<const MeshData> mesh;
   /// Applied before the pose: primitives are unit-sized and scaled here.
   Eigen::Vector3f scale{1.0F, 1.0F, 1.0F};
+  /// The mesh frame's pose in the world.
   Eigen::Isometry3f X_world_instance = Eigen::Isometry3f::Identity();
   RenderMaterial material;
   /// Written to segmentation images; 0 is the background.
@@ -40,27 +45,36 @@ struct Light {
   /// default comes from above and from the -y side, where task cameras usually stand, so that
   /// the faces they see are lit.
   Eigen::Vector3f direction{-0.35F, 0.5F, -0.8F};
+  /// The direct light's colour, which multiplies the diffuse term and the highlight.
   Eigen::Vector3f color{0.7F, 0.7F, 0.67F};
+  /// Light that reaches every surface alike, in shadow or not.
   Eigen::Vector3f ambient{0.4F, 0.4F, 0.43F};
 };
 
 /// The ground: an infinite checkerboard in the plane z = height.
 struct Floor {
+  /// False draws no floor (the sky shows below the horizon too).
   bool enabled = true;
+  /// The plane's height, m.
   float height_m = 0.0F;
+  /// The side of one checker tile, m.
   float tile_m = 0.25F;
+  /// The two tile colours.
   Eigen::Vector3f color_a{0.32F, 0.36F, 0.42F};
   Eigen::Vector3f color_b{0.42F, 0.46F, 0.52F};
 };
 
 /// The background: a vertical gradient from the horizon colour to the zenith colour.
 struct Sky {
+  /// The colour at and below the horizon.
   Eigen::Vector3f horizon{0.78F, 0.84F, 0.92F};
+  /// The colour straight up.
   Eigen::Vector3f zenith{0.38F, 0.55F, 0.78F};
 };
 
 /// Everything a frame shows.
 struct Scene {
+  /// What to draw, in any order.
   std::vector<Instance> instances;
   Light light;
   Floor floor;

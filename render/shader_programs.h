@@ -14,6 +14,8 @@ GlProgram link_program(const char* vertex_source, const char* fragment_source);
 /// Instances: Blinn-Phong with the shadow lookup, a per-vertex part colour and an optional
 /// texture.
 struct LitProgram {
+  /// The linked program; each GLint below is the location of the uniform of its name (-1 until
+  /// looked up, or when the shader does not use it). The same for the structs below.
   GlProgram program;
   GLint model = -1, normal_matrix = -1, view_projection = -1, light_matrix = -1, base_color = -1,
         specular = -1, shininess = -1, to_light = -1, light_color = -1, ambient = -1,
@@ -49,6 +51,7 @@ struct SegmentationProgram {
 /// Every program the renderer draws with. Needs a current context; throws std::runtime_error
 /// when a shader does not build.
 struct ShaderPrograms {
+  /// Builds every program and looks up its uniforms.
   ShaderPrograms();
 
   LitProgram lit;

@@ -51,11 +51,13 @@ class ShadowPass {
 /// stream buffer of their own, drawn with the floor program (position only).
 class ShadowFootprints {
  public:
+  /// Creates the stream buffers and vertex array (a context must be current).
   ShadowFootprints();
 
   /// Replaces the buffer's triangles with two per rectangle (in floor coordinates: z = 0 before
   /// the floor's height is applied) and returns what to draw with `vertex_array()` bound.
   const GpuMesh& upload(const std::vector<Eigen::AlignedBox2f>& rectangles);
+  /// The vertex array to bind when drawing what upload() returned.
   GLuint vertex_array() const { return vertex_array_.get(); }
 
  private:

@@ -30,7 +30,7 @@ inline ::testing::AssertionResult to_assertion_result(const SnapshotResult& resu
   return ::testing::AssertionFailure() << result.message();
 }
 
-/// For EXPECT_PRED_FORMAT2/3: compare_to_golden(frame, golden_path, tolerance).
+/// For EXPECT_PRED_FORMAT2: compare_to_golden(frame, golden_path) with the default tolerance.
 template <typename Frame>
 ::testing::AssertionResult matches_golden_format(const char* frame_text, const char* path_text,
                                                  const Frame& frame,
@@ -43,6 +43,7 @@ template <typename Frame>
          << result.message();
 }
 
+/// For EXPECT_PRED_FORMAT3: compare_to_golden(frame, golden_path, tolerance).
 template <typename Frame>
 ::testing::AssertionResult matches_golden_within_format(const char* frame_text,
                                                         const char* path_text, const char*,
@@ -57,6 +58,7 @@ template <typename Frame>
          << result.message();
 }
 
+/// For EXPECT_PRED_FORMAT2: compare_segmentation_to_golden(labels, golden_path).
 template <typename Labels>
 ::testing::AssertionResult segmentation_matches_golden_format(const char* labels_text,
                                                               const char* path_text,
@@ -75,15 +77,18 @@ template <typename Labels>
 /// frame: an (H, W, 3) uint8 pixelgym::Array or a render::ImageView; golden_path: a PNG path.
 #define EXPECT_MATCHES_GOLDEN(frame, golden_path) \
   EXPECT_PRED_FORMAT2(::pixelgym::testing::matches_golden_format, frame, golden_path)
+/// As EXPECT_MATCHES_GOLDEN, ending the test on a failure.
 #define ASSERT_MATCHES_GOLDEN(frame, golden_path) \
   ASSERT_PRED_FORMAT2(::pixelgym::testing::matches_golden_format, frame, golden_path)
 /// With a pixelgym::testing::SnapshotTolerance of your own.
 #define EXPECT_MATCHES_GOLDEN_WITHIN(frame, golden_path, tolerance)                          \
   EXPECT_PRED_FORMAT3(::pixelgym::testing::matches_golden_within_format, frame, golden_path, \
                       tolerance)
+/// As EXPECT_MATCHES_GOLDEN_WITHIN, ending the test on a failure.
 #define ASSERT_MATCHES_GOLDEN_WITHIN(frame, golden_path, tolerance)                          \
   ASSERT_PRED_FORMAT3(::pixelgym::testing::matches_golden_within_format, frame, golden_path, \
                       tolerance)
-/// labels: an (H, W) int32 pixelgym::Array of segmentation labels (default SegmentationTolerance).
+/// labels: an (H, W) or (H, W, 1) int32 pixelgym::Array of segmentation labels (default
+/// SegmentationTolerance).
 #define EXPECT_SEGMENTATION_MATCHES_GOLDEN(labels, golden_path) \
   EXPECT_PRED_FORMAT2(::pixelgym::testing::segmentation_matches_golden_format, labels, golden_path)

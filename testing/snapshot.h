@@ -88,21 +88,27 @@ struct SnapshotTolerance {
 /// 84 x 84 frame is 1.2 %), and catch what it catches (a moved object).
 /// SegmentationTolerance::exact() demands every label equal.
 struct SegmentationTolerance {
+  /// Most 2 x 2 windows whose four labels all differ.
   int max_thick_windows = 4;
+  /// Most pixels whose label is absent from the other image's 3 x 3 neighbourhood, as a share of
+  /// all pixels (rounded down to a count).
   double max_displaced_fraction = 0.002;
   /// Most share of pixels whose label differs.
   double max_disagreement = 0.02;
 
+  /// Every label equal: all three bounds 0.
   static SegmentationTolerance exact();
 };
 
 /// What to do with the golden and where to put the images of a failure.
 struct SnapshotOptions {
+  /// When the golden is written instead of compared.
   enum class Update {
     kFromEnvironment,  ///< rewrite the golden when PIXELGYM_UPDATE_GOLDENS=1, else compare
     kNever,            ///< always compare
     kAlways,           ///< always (re)write the golden
   };
+  /// Whether to compare with the golden or (re)write it.
   Update update = Update::kFromEnvironment;
   /// Where <golden name>.actual.png and .diff.png go on a failure; empty: the environment
   /// variable PIXELGYM_SNAPSHOT_OUTPUT_DIR, else "snapshot_output" in the current folder.
@@ -129,25 +135,33 @@ struct SnapshotFigures {
 /// A comparison's figures and its diff image (RGB, the frame's size; see the top of this file).
 struct ImageDifference {
   SnapshotFigures figures;
+  /// height x width x 3 bytes.
   std::vector<std::uint8_t> diff_rgb;
 };
 
-/// Compares two RGB images of the same size (throws std::invalid_argument otherwise).
+/// Compares two RGB images of the same size; `tolerance` sets what counts as off and as found
+/// (off_by, neighbour_tolerance), not whether they match (see `within`). Throws
+/// std::invalid_argument for null pixels, a channel count other than 3, or sizes that differ
+/// or are not positive.
 ImageDifference difference(const render::ImageView& actual, const render::ImageView& expected,
                            const SnapshotTolerance& tolerance = {});
-/// Compares two label images of `height` x `width`.
+/// Compares two label images of `height` x `width`. Throws std::invalid_argument for null
+/// pointers or a size that is not positive, and as encode_labels for a label of `expected`
+/// outside [-1, 2^24 - 2].
 ImageDifference segmentation_difference(const std::int32_t* actual, const std::int32_t* expected,
                                         int height, int width);
 
 /// Whether `figures`, of an image of `pixels` pixels, are within `tolerance`.
 bool within(const SnapshotFigures& figures, std::int64_t pixels,
             const SnapshotTolerance& tolerance);
+/// The same for a segmentation comparison.
 bool within(const SnapshotFigures& figures, std::int64_t pixels,
             const SegmentationTolerance& tolerance);
 
 /// The outcome of compare_to_golden: converts to true when the frame matched (or the golden was
 /// written).
 struct SnapshotResult {
+  /// What happened.
   enum class Status {
     kMatched,           ///< within the tolerance
     kDiffered,          ///< compared, and outside the tolerance
@@ -157,7 +171,9 @@ struct SnapshotResult {
     kUpdated,           ///< the golden was (re)written from the frame
   };
   Status status = Status::kMatched;
+  /// True for a segmentation comparison.
   bool segmentation = false;
+  /// The golden's path, as given.
   std::string golden_path;
   /// Where the frame and the diff image were written (empty when not written).
   std::string actual_path;
@@ -165,6 +181,7 @@ struct SnapshotResult {
   /// The frame's and the golden's size (the golden's 0 when it was not read).
   int height = 0, width = 0, channels = 3;
   int golden_height = 0, golden_width = 0, golden_channels = 0;
+  /// The comparison's figures (zero unless it compared: kMatched or kDiffered).
   SnapshotFigures figures;
   /// The tolerance compared against (one of them, as `segmentation` says).
   SnapshotTolerance tolerance;
@@ -172,6 +189,7 @@ struct SnapshotResult {
   /// For kUnreadableGolden: why.
   std::string reason;
 
+  /// True for kMatched and kUpdated.
   bool matched() const { return status == Status::kMatched || status == Status::kUpdated; }
   explicit operator bool() const { return matched(); }
   /// One paragraph: what happened, the figures against their limits, the files written, and how
@@ -186,6 +204,8 @@ struct SnapshotResult {
 SnapshotResult compare_to_golden(const Array& frame, const std::string& golden_path,
                                  const SnapshotTolerance& tolerance = {},
                                  const SnapshotOptions& options = {});
+/// The same for a frame given as a view: it must have pixels, 3 channels and a positive size,
+/// else std::invalid_argument.
 SnapshotResult compare_to_golden(const render::ImageView& frame, const std::string& golden_path,
                                  const SnapshotTolerance& tolerance = {},
                                  const SnapshotOptions& options = {});
@@ -194,7 +214,9 @@ SnapshotResult compare_to_golden(const render::ImageView& frame, const std::stri
 /// 0 sky, -1 floor, an instance's segmentation_id elsewhere) with its golden. The frame is an
 /// (H, W) or (H, W, 1) int32 Array, or a pointer to height x width labels. Labels from -1 to
 /// 2^24 - 2 are stored in an RGB PNG (see encode_labels); the golden's PNG shows each label in
-/// a colour of its own. The diff image: labels that agree dimmed, disagreeing pixels in red.
+/// a colour of its own. The diff image: labels that agree dimmed to a quarter of their colour,
+/// disagreeing pixels light grey, with the thick windows and displaced pixels marked in red and
+/// blue as in the colour diff image.
 SnapshotResult compare_segmentation_to_golden(const Array& labels, const std::string& golden_path,
                                               const SegmentationTolerance& tolerance = {},
                                               const SnapshotOptions& options = {});

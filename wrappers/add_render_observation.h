@@ -34,8 +34,11 @@ class AddRenderObservation final : public ObservationWrapper {
                                 const std::string& render_key = "pixels",
                                 const std::string& obs_key = "state");
 
+  /// Whether the observation is the frame alone.
   bool render_only() const { return render_only_; }
+  /// The frame's key in a Dict observation.
   const std::string& render_key() const { return render_key_; }
+  /// The inner observation's key when a non-Dict observation is wrapped in a Dict.
   const std::string& obs_key() const { return obs_key_; }
 
  protected:

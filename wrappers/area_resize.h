@@ -32,8 +32,9 @@ namespace pixelgym::wrappers {
 /// across CPUs with and without AVX2. Speeds: docs/design-notes.md, "Wrappers".
 class AreaResize {
  public:
-  /// Requires 1 <= height <= source_height, 1 <= width <= source_width and channels >= 1.
-  /// `allow_avx2` false keeps to the portable kernel (for tests comparing the two).
+  /// Requires 1 <= height <= source_height, 1 <= width <= source_width and channels >= 1, else
+  /// throws std::invalid_argument. `allow_avx2` false keeps to the portable kernel (for tests
+  /// comparing the two).
   AreaResize(int source_height, int source_width, int height, int width, int channels,
              bool allow_avx2 = true);
 

@@ -29,7 +29,9 @@ class DtypeObservation final : public ObservationWrapper {
   /// the bound and the range).
   DtypeObservation(std::unique_ptr<Env> env, DType dtype, const std::string& key = "");
 
+  /// The dtype observations are cast to.
   DType dtype() const { return dtype_; }
+  /// The Dict key cast; empty for a bare Box.
   const std::string& key() const { return where_.key; }
 
  protected:

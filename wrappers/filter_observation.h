@@ -21,6 +21,7 @@ class FilterObservation final : public ObservationWrapper {
   /// and listing those present).
   FilterObservation(std::unique_ptr<Env> env, std::vector<std::string> keys);
 
+  /// The keys kept, in the observation's order.
   const std::vector<std::string>& keys() const { return keys_; }
 
  protected:

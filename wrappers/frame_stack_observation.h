@@ -47,15 +47,20 @@ namespace pixelgym::wrappers {
 
 /// What fills the stack before an episode has k frames.
 enum class FrameStackPadding : std::uint8_t {
-  kReset,  // copies of the reset frame (Gymnasium's padding_type="reset", its default)
-  kZero,   // zero frames (padding_type="zero")
+  /// Copies of the reset frame (Gymnasium's padding_type="reset", its default).
+  kReset,
+  /// Zero frames (padding_type="zero").
+  kZero,
 };
 
 /// How the k frames are laid out in the stacked image.
 enum class FrameStackLayout : std::uint8_t {
-  kNewAxis,        // (k, *shape): a new leading axis, as Gymnasium
-  kChannelsFirst,  // (C, H, W) images concatenated on axis 0: (k C, H, W)
-  kChannelsLast,   // concatenated on the last axis: (H, W, C k); an (H, W) image gives (H, W, k)
+  /// (k, *shape): a new leading axis, as Gymnasium.
+  kNewAxis,
+  /// (C, H, W) images concatenated on axis 0: (k C, H, W).
+  kChannelsFirst,
+  /// Concatenated on the last axis: (H, W, C k); an (H, W) image gives (H, W, k).
+  kChannelsLast,
 };
 
 /// "reset", "zero"; "new_axis", "channels_first", "channels_last" (the text spec's names).
@@ -98,8 +103,11 @@ class FrameStackObservation final : public Wrapper {
   /// for has filled it.
   Value observation_buffer(BufferFor call) override;
 
+  /// k, the number of frames stacked.
   std::int64_t stack_size() const { return stack_size_; }
+  /// What fills the stack before an episode has k frames.
   FrameStackPadding padding() const { return padding_; }
+  /// How the stacked image is laid out.
   FrameStackLayout layout() const { return layout_; }
   /// Frame slots per tape.
   std::int64_t tape_slots() const { return tape_slots_; }

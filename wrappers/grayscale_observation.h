@@ -22,6 +22,7 @@ class GrayscaleObservation final : public ObservationWrapper {
   explicit GrayscaleObservation(std::unique_ptr<Env> env, bool keep_dim = false,
                                 const std::string& key = "pixels");
 
+  /// Whether the output keeps a channel axis, (H, W, 1), rather than (H, W).
   bool keep_dim() const { return keep_dim_; }
 
  protected:

@@ -28,6 +28,7 @@ struct ImageKey {
   /// (H, W, C) or, where the wrapper allows it, (H, W).
   Shape shape;
 
+  /// H and W.
   std::int64_t height() const { return shape[0]; }
   std::int64_t width() const { return shape[1]; }
   /// C, or 0 for an (H, W) image.

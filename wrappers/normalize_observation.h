@@ -30,11 +30,14 @@ class NormalizeObservation final : public ObservationWrapper {
   explicit NormalizeObservation(std::unique_ptr<Env> env, const std::string& key = "",
                                 double epsilon = 1e-8);
 
+  /// The Dict key normalized; empty for a bare Box.
   const std::string& key() const { return where_.key; }
+  /// The constant added to the variance before its square root.
   double epsilon() const { return epsilon_; }
 
   /// Whether observations update the statistics (true at construction).
   bool update_statistics() const { return update_statistics_; }
+  /// false freezes the statistics (observations are still normalized with them); true resumes.
   void set_update_statistics(bool update) { update_statistics_ = update; }
 
   /// The current statistics, one entry per element of the normalized Box (row-major).

@@ -29,13 +29,16 @@ class NormalizeReward final : public Wrapper {
   /// Throws std::invalid_argument unless 0 <= gamma <= 1 and epsilon is finite and > 0.
   explicit NormalizeReward(std::unique_ptr<Env> env, double gamma = 0.99, double epsilon = 1e-8);
 
+  /// The discount of the return R.
   double gamma() const { return gamma_; }
+  /// The constant added to the variance before its square root.
   double epsilon() const { return epsilon_; }
   /// The discounted return R of the current episode so far.
   double discounted_return() const { return return_; }
 
   /// Whether steps update the statistics (true at construction).
   bool update_statistics() const { return update_statistics_; }
+  /// false freezes the variance (rewards are still scaled by it); true resumes.
   void set_update_statistics(bool update) { update_statistics_ = update; }
 
   /// The running statistics of R (one element).

@@ -28,16 +28,20 @@ class RecordEpisodeStatistics final : public Wrapper {
   explicit RecordEpisodeStatistics(std::unique_ptr<Env> env, std::int64_t buffer_length = 100,
                                    const std::string& stats_key = "episode");
 
+  /// How many finished episodes the queues keep.
   std::int64_t buffer_length() const { return buffer_length_; }
+  /// The info key the statistics go under.
   const std::string& stats_key() const { return stats_key_; }
   /// Episodes ended so far (by terminated or truncated) through this wrapper.
   std::int64_t episode_count() const { return episode_count_; }
-  /// The current episode's return and length so far.
+  /// The current episode's return so far.
   double episode_return() const { return return_; }
+  /// The current episode's steps so far.
   std::int64_t episode_length() const { return length_; }
 
-  /// The last min(episode_count(), buffer_length) episodes, oldest first (Gymnasium's
-  /// return_queue, length_queue and time_queue).
+  /// The last min(episode_count(), buffer_length) episodes' returns, lengths and wall times in
+  /// seconds, oldest first, as new vectors (Gymnasium's return_queue, length_queue and
+  /// time_queue).
   std::vector<double> return_queue() const;
   std::vector<std::int64_t> length_queue() const;
   std::vector<double> time_queue() const;

@@ -20,16 +20,21 @@ using EpisodeTrigger = std::function<bool(std::int64_t episode_id)>;
 using StepTrigger = std::function<bool(std::int64_t step_id)>;
 
 /// Gymnasium's default episode trigger: true for the cubes 0, 1, 8, 27, ..., 729 below 1000, then
-/// for every multiple of 1000.
+/// for every multiple of 1000; false for a negative id.
 bool capped_cubic_video_schedule(std::int64_t episode_id);
 
 /// A clip that was written.
 struct VideoClip {
-  std::filesystem::path path;  // "{folder}/{name}.mp4"
+  /// "{folder}/{name}.mp4".
+  std::filesystem::path path;
+  /// Frames written.
   std::int64_t frames = 0;
-  std::int64_t width = 0;  // of the video (the frame's, rounded up to even)
+  /// The video's size in pixels (the first frame's, rounded up to even).
+  std::int64_t width = 0;
   std::int64_t height = 0;
-  std::string codec;  // the FOURCC it was written with: "avc1" (H.264), or the fallback "mp4v"
+  /// The FOURCC it was written with: "avc1" (H.264), PIXELGYM_RECORD_VIDEO_FOURCC's when set, or
+  /// the fallback "mp4v".
+  std::string codec;
 };
 
 /// Records `render()` frames ("rgb_array") of the episodes or steps its triggers choose to .mp4
@@ -91,8 +96,11 @@ class RecordVideo final : public Wrapper {
   /// written (its temporary file removed).
   std::optional<VideoClip> stop_recording();
 
+  /// Whether a clip is in progress (started, possibly without a frame yet).
   bool recording() const { return recording_; }
+  /// Where the clips are written.
   const std::filesystem::path& video_folder() const { return folder_; }
+  /// The clips' frame rate, frames per second.
   double fps() const { return fps_; }
   /// The index of the current episode (-1 before the first reset) and of the latest step (-1
   /// before the first step), as the triggers saw them.

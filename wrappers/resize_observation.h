@@ -15,7 +15,9 @@ namespace pixelgym::wrappers {
 
 /// An image's size in pixels.
 struct ImageSize {
+  /// Rows.
   std::int64_t height = 0;
+  /// Columns.
   std::int64_t width = 0;
 };
 
@@ -43,6 +45,7 @@ class ResizeObservation final : public ObservationWrapper {
   /// when `key` does not name a uint8 (H, W), (H, W, 1) or (H, W, 3) image.
   ResizeObservation(std::unique_ptr<Env> env, ImageSize size, const std::string& key = "pixels");
 
+  /// The output image's size.
   ImageSize size() const { return size_; }
 
  protected:

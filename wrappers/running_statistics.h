@@ -18,10 +18,14 @@ namespace pixelgym::wrappers {
 /// sum(x) / (n + 1e-4) and the variance that of the samples pooled with the prior, which differs
 /// from the plain sample statistics by about 1e-4 / n relative.
 struct RunningStatistics {
+  /// The prior's pseudo-count (Gymnasium's epsilon of RunningMeanStd).
   static constexpr double kInitialCount = 1e-4;
 
+  /// The running mean of each element.
   std::vector<double> mean;
+  /// The running population variance of each element (same size as `mean`).
   std::vector<double> var;
+  /// Samples merged so far plus kInitialCount.
   double count = kInitialCount;
 
   /// The starting statistics of `size` elements: mean 0, variance 1, count 1e-4.

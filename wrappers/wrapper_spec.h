@@ -55,9 +55,12 @@ EnvDescription describe_wrapped(EnvDescription description, const std::vector<st
 
 /// One wrapper the text form knows: its name, the form with its parameters, and what it does.
 struct WrapperSpecHelp {
+  /// The name a spec starts with ("resize").
   std::string name;
-  std::string usage;    // "resize=HxW[,key=pixels]"
-  std::string summary;  // "ResizeObservation: ..."
+  /// The form with its parameters: "resize=HxW[,key=pixels]".
+  std::string usage;
+  /// The wrapper class and what it does: "ResizeObservation: ...".
+  std::string summary;
 };
 
 /// Every wrapper the text form knows, in the order `--help` lists them.

@@ -17,9 +17,12 @@ namespace pixelgym::spaces {
 class Box final : public Space {
  public:
   /// The same bounds for every element. Throws std::invalid_argument for a bool dtype, NaN
-  /// bounds, low > high, or bounds outside an integer dtype's range.
+  /// bounds, low > high (after rounding to the dtype), or, for an integer dtype, bounds that are
+  /// not whole numbers or leave no value of the dtype's range (bounds partly beyond it are
+  /// clamped).
   Box(double low, double high, Shape shape, DType dtype = DType::kFloat32);
-  /// Per-element bounds in row-major order; each vector has shape_size(shape) entries.
+  /// Per-element bounds in row-major order; each vector has shape_size(shape) entries. Throws as
+  /// above, and std::invalid_argument for a vector of another size.
   Box(std::vector<double> low, std::vector<double> high, Shape shape,
       DType dtype = DType::kFloat32);
 
@@ -34,7 +37,9 @@ class Box final : public Space {
   std::string to_string() const override;
   bool equals(const Space& other) const override;
 
+  /// The lower bound of each element, row-major, as stored (rounded or clamped to the dtype).
   const std::vector<double>& low() const { return low_; }
+  /// The upper bound of each element, row-major, as stored.
   const std::vector<double>& high() const { return high_; }
   /// True when every element is bounded below and above.
   bool is_bounded() const;

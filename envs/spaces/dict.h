@@ -15,6 +15,7 @@ namespace pixelgym::spaces {
 /// Keys keep the order given (pixel tasks list "pixels" first, then state arrays).
 class Dict final : public Space {
  public:
+  /// (key, subspace) pairs, in order.
   using Entries = std::vector<std::pair<std::string, SpacePtr>>;
 
   /// Throws std::invalid_argument for an empty or duplicate key or a null subspace.
@@ -30,7 +31,9 @@ class Dict final : public Space {
   std::string to_string() const override;
   bool equals(const Space& other) const override;
 
+  /// The entries in the order given.
   const Entries& entries() const { return entries_; }
+  /// Whether `key` is one of the keys.
   bool has(const std::string& key) const;
   /// Throws std::out_of_range naming the key and the keys present.
   const Space& at(const std::string& key) const;

@@ -9,7 +9,7 @@ namespace pixelgym::spaces {
 /// integer dtype (uint8, int32, int64), as Gymnasium accepts any numpy integer.
 class Discrete final : public Space {
  public:
-  /// Throws std::invalid_argument unless n > 0.
+  /// Throws std::invalid_argument unless n > 0 and start + n - 1 fits in an int64.
   explicit Discrete(std::int64_t n, std::int64_t start = 0);
 
   using Space::sample;
@@ -20,7 +20,9 @@ class Discrete final : public Space {
   std::string to_string() const override;
   bool equals(const Space& other) const override;
 
+  /// The number of elements.
   std::int64_t n() const { return n_; }
+  /// The smallest element.
   std::int64_t start() const { return start_; }
 
  private:

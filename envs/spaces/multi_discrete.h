@@ -26,7 +26,9 @@ class MultiDiscrete final : public Space {
   std::string to_string() const override;
   bool equals(const Space& other) const override;
 
+  /// The number of values of each element, row-major.
   const std::vector<std::int64_t>& nvec() const { return nvec_; }
+  /// The smallest value of each element, row-major.
   const std::vector<std::int64_t>& start() const { return start_; }
 
  private:

@@ -23,6 +23,7 @@ class Tuple final : public Space {
   std::string to_string() const override;
   bool equals(const Space& other) const override;
 
+  /// The subspaces, in order.
   const std::vector<SpacePtr>& spaces() const { return spaces_; }
 
  private:

@@ -31,9 +31,12 @@ class AcrobotTask final : public Task {
 
   /// World position of the lower arm's tip.
   Eigen::Vector3d tip(const engine::World& world) const;
+  /// The elbow torque at action 1, N m.
   static constexpr double kMaxTorqueNm = 2.0;
+  /// The target of the tip: where it is with both links straight up (world, m).
   static const Eigen::Vector3d kTop;
 
+  /// The registry entry for AcrobotSwingup-v0.
   static EnvSpec spec_v0();
 
  private:

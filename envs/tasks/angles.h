@@ -5,6 +5,7 @@
 
 namespace pixelgym {
 
+/// pi, as a double.
 constexpr double kPi = 3.14159265358979323846;
 
 /// `angle` wrapped into [-pi, pi).

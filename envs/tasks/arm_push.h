@@ -38,14 +38,20 @@ class ArmPushTask final : public Task {
   void observe(const engine::World& world, StateSlots& state) const override;
   double reward(const engine::World& world) const override;
 
+  /// World position of the arm's "end_effector" link frame, m.
   Eigen::Vector3d end_effector(const engine::World& world) const;
+  /// World position of the cube's centre, m.
   Eigen::Vector3d cube(const engine::World& world) const;
+  /// World position of the goal marker's centre (just above the table top), m.
   Eigen::Vector3d goal(const engine::World& world) const;
 
-  static constexpr double kMaxJointSpeed = 1.5;  // rad/s at action 1
-  /// Where the arm's base stands (on its pedestal).
+  /// Each joint's speed at action 1, rad/s.
+  static constexpr double kMaxJointSpeed = 1.5;
+  /// Where the arm's base stands (on its pedestal), m above the floor.
   static constexpr double kBaseHeight = 0.5;
+  /// Height of the table's top surface, m.
   static constexpr double kTableTop = 0.72;
+  /// The registry entry for ArmPush-v0.
   static EnvSpec spec_v0();
 
  private:

@@ -16,6 +16,7 @@ namespace pixelgym {
 ///   radians. 500 control steps of 0.02 s. Cameras: "fixed" (front-left, default), "top".
 class ArmReachTask final : public Task {
  public:
+  /// `torque_control`: actions are joint torques (kwarg control="torque"), else velocities.
   explicit ArmReachTask(bool torque_control);
 
   std::vector<std::string> camera_names() const override { return {"fixed", "top"}; }
@@ -34,10 +35,15 @@ class ArmReachTask final : public Task {
   void observe(const engine::World& world, StateSlots& state) const override;
   double reward(const engine::World& world) const override;
 
+  /// World position of the arm's "end_effector" link frame, m.
   Eigen::Vector3d end_effector(const engine::World& world) const;
+  /// World position of the target marker's centre, m.
   Eigen::Vector3d target(const engine::World& world) const;
 
-  static constexpr double kMaxJointSpeed = 1.5;  // rad/s at action 1
+  /// Each joint's speed at action 1 under velocity control, rad/s.
+  static constexpr double kMaxJointSpeed = 1.5;
+  /// The registry entry for ArmReach-v0 (with its "control" kwarg; make throws
+  /// std::invalid_argument for a value other than "velocity" or "torque").
   static EnvSpec spec_v0();
 
  private:

@@ -24,7 +24,8 @@ namespace pixelgym {
 ///   leave the view near the rail's ends).
 class CartPoleTask final : public Task {
  public:
-  /// `version` is the id's: 0 or 1 (the drawing; see above).
+  /// `swing_up`: start hanging down (Swingup) rather than near upright (Balance); `discrete`: the
+  /// Discrete(3) action space; `version` is the id's: 0 or 1 (the drawing; see above).
   CartPoleTask(bool swing_up, bool discrete, int version);
 
   std::vector<std::string> camera_names() const override { return {"fixed", "tracking", "close"}; }
@@ -42,14 +43,16 @@ class CartPoleTask final : public Task {
   void observe(const engine::World& world, StateSlots& state) const override;
   double reward(const engine::World& world) const override;
 
-  /// Named quantities.
+  /// The cart's position on the rail, m (0 at the middle).
   double cart_position(const engine::World& world) const;
-  /// Wrapped to [-pi, pi); 0 is upright.
+  /// The pole's angle, rad, wrapped to [-pi, pi); 0 is upright.
   double pole_angle(const engine::World& world) const;
+  /// The pole's angular velocity, rad/s.
   double pole_angular_velocity(const engine::World& world) const;
-  /// The last force command in [-1, 1].
+  /// The last force command in [-1, 1] (a Discrete action a gives a - 1); 0 after a reset.
   double control() const { return control_; }
 
+  /// The force on the cart at command 1, N.
   static constexpr double kMaxForceN = 10.0;
 
   /// The registry entries: CartPoleBalance, CartPoleSwingup, CartPoleBalanceDiscrete and

@@ -12,12 +12,12 @@ namespace pixelgym {
 
 /// Settings of GridWorld (its `make` kwargs).
 struct GridWorldConfig {
-  /// Size of `render()` frames in pixels.
+  /// Size of `render()` frames in pixels, each in [16, 8192].
   int render_width = 256;
   int render_height = 256;
   /// "index": Discrete(16), the agent's cell; "pixels": Dict{"pixels": (height, width, 3) uint8}.
   std::string obs_mode = "index";
-  /// Observation image size for obs_mode "pixels".
+  /// Observation image size for obs_mode "pixels", each in [16, 8192].
   int width = 84;
   int height = 84;
 
@@ -39,22 +39,31 @@ struct GridWorldConfig {
 ///   every other step.
 /// - The registered spec truncates after 50 steps (TimeLimit).
 /// The start is fixed, so the generator is not used; seeding still works as for every env.
+/// reset() takes no options (std::invalid_argument names the first one given).
 class GridWorld final : public Env {
  public:
+  /// Rows and columns of the grid.
   static constexpr int kSize = 4;
+  /// The actions, as the Discrete(4) action space numbers them.
   enum Action : std::int64_t { kLeft = 0, kDown = 1, kRight = 2, kUp = 3 };
+  /// A cell of the grid: row 0 is the top, column 0 the left.
   struct Cell {
     int row;
     int col;
     friend bool operator==(Cell a, Cell b) { return a.row == b.row && a.col == b.col; }
   };
+  /// Where the agent starts, the goal and the wall.
   static constexpr Cell kStart{0, 0};
   static constexpr Cell kGoal{3, 3};
   static constexpr Cell kWall{1, 1};
+  /// The reward of a step that does not reach the goal, and of the one that does.
   static constexpr double kStepReward = -0.04;
   static constexpr double kGoalReward = 1.0;
+  /// The registered spec's time limit, in steps.
   static constexpr std::int64_t kMaxEpisodeSteps = 50;
 
+  /// An env with `config` as given: it is not checked (GridWorldConfig::from_params checks
+  /// kwargs), and any obs_mode but "pixels" gives the index observation.
   explicit GridWorld(GridWorldConfig config = {});
 
   const Space& observation_space() const override { return *observation_space_; }

@@ -29,11 +29,14 @@ class PendulumTask final : public Task {
   void observe(const engine::World& world, StateSlots& state) const override;
   double reward(const engine::World& world) const override;
 
-  /// 0 upright, in [-pi, pi).
+  /// The rod's angle, rad: 0 upright, in [-pi, pi).
   double angle_from_upright(const engine::World& world) const;
+  /// The hinge's angular velocity, rad/s.
   double angular_velocity(const engine::World& world) const;
 
+  /// The hinge torque at action 1, N m.
   static constexpr double kMaxTorqueNm = 2.0;
+  /// The registry entry for PendulumSwingup-v0.
   static EnvSpec spec_v0();
 
  private:

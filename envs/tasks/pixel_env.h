@@ -27,12 +27,16 @@ class PixelRenderResources;
 /// a GL context of its own); it is built in the constructor when observations hold pixels, and
 /// on the first render() call otherwise, so obs_mode="state" never creates a GL context unless
 /// asked to render. A PixelEnv never truncates on its own: the registry's TimeLimit does, after
-/// the task's episode length (Task::episode_length).
+/// the task's episode length (Task::episode_length). reset() takes no options
+/// (std::invalid_argument names the first one given); a step whose command, state, observation
+/// or reward goes non-finite throws PhysicsDivergence.
 class PixelEnv final : public Env {
  public:
-  /// `name` is how messages name the env before the registry sets its id. Throws
-  /// std::invalid_argument when `render` is not null and not PixelRenderResources, and
-  /// std::runtime_error when the GL context cannot be created.
+  /// Builds the world (Task::build) and, when observations hold pixels, the renderer. `config`
+  /// is taken as given (TaskConfig::from_params checks kwargs). `name` is how messages name the
+  /// env before the registry sets its id. Throws std::invalid_argument for a null task or when
+  /// `render` is not null and not PixelRenderResources, std::runtime_error when the GL context
+  /// cannot be created, and what the task's build throws.
   PixelEnv(std::unique_ptr<Task> task, TaskConfig config, std::string name,
            std::shared_ptr<RenderResources> render = nullptr);
   ~PixelEnv() override;
@@ -41,7 +45,9 @@ class PixelEnv final : public Env {
   const Space& action_space() const override { return *action_space_; }
   const Metadata& metadata() const override { return metadata_; }
 
+  /// The task it runs.
   const Task& task() const { return *task_; }
+  /// The config it was made with.
   const TaskConfig& config() const { return config_; }
   /// The simulation, for inspection and scripted controllers (do not add bodies to it).
   const engine::World& world() const { return *world_; }
@@ -55,14 +61,21 @@ class PixelEnv final : public Env {
   /// render() is called.
   std::int64_t frames_rendered() const { return frames_rendered_; }
 
-  /// Camera `camera`'s image at any size, as a new (height, width, 3) uint8 array (for tests and
-  /// tools).
+  /// Camera `camera`'s image of the world as it is now, at any size and MSAA sample count
+  /// (0, 2, 4 or 8), as a new (height, width, 3) uint8 array (for tests and tools). Counts in
+  /// frames_rendered(); creates the renderer if there is none yet. `camera` goes to Task::camera
+  /// unchecked (the built-in tasks draw an unknown name as one of their cameras). Throws
+  /// std::invalid_argument for an invalid size or sample count (render::Camera::validate).
   Array render_camera(const std::string& camera, int width, int height, int msaa_samples);
   /// The same, drawn into `frame`: a uint8 (height, width, 3) array the caller owns. Throws
-  /// std::invalid_argument for another dtype or shape.
+  /// std::invalid_argument for another dtype or shape, and as render_camera.
   void render_camera_into(const std::string& camera, int msaa_samples, Array& frame);
 
-  /// The spaces, time limit, cameras and metadata of `task` under `config`, without a world.
+  /// The spaces, time limit, cameras and metadata of `task` under `config`, without a world: the
+  /// observation Dict ("pixels" a uint8 Box [0, 255] of (height, width, 3), then each state array
+  /// a float32 Box (-inf, inf)), max_episode_steps = ceil(episode_length / action_repeat),
+  /// render_fps = 1 / (control_timestep_s * action_repeat) and render_shape from render_width and
+  /// render_height.
   static EnvDescription describe(const Task& task, const TaskConfig& config);
 
  protected:
@@ -107,7 +120,9 @@ class PixelRenderResources final : public RenderResources {
   PixelRenderResources(int mesa_copy, bool share_context);
   ~PixelRenderResources() override;
 
+  /// The copy of Mesa asked for (see render::MesaCopy).
   int mesa_copy() const { return group_.mesa_copy(); }
+  /// Whether the renderers it makes share one GL context.
   bool shares_context() const { return share_context_; }
   /// Whether a renderer made with these resources has created the shared GL context yet.
   bool context_created() const { return group_.created(); }
@@ -123,7 +138,9 @@ class PixelRenderResources final : public RenderResources {
 /// The registry entry of a pixel task: the shared TaskConfig keys plus `extra_params`; the
 /// factory builds the task with `make_task(kwargs)` and runs it in a PixelEnv drawing with the
 /// MakeOptions' render resources (make_render_resources makes PixelRenderResources); `describe` and
-/// the default max_episode_steps come from the task and config without building a world.
+/// the default max_episode_steps come from the task and config without building a world. Calls
+/// `make_task` once, with the default kwargs, for the task's episode length, and throws what it
+/// throws.
 EnvSpec pixel_task_spec(const std::string& id, const std::string& description,
                         std::function<std::unique_ptr<Task>(const Params& kwargs)> make_task,
                         std::vector<ParamSpec> extra_params = {});

@@ -15,6 +15,7 @@ namespace pixelgym {
 ///   in the ground plane). 1000 control steps of 0.02 s. Cameras: "top" (default), "angled".
 class ReacherTask final : public Task {
  public:
+  /// `target_radius_m`: the marker's radius and the reward's bound (0.05 Easy, 0.015 Hard).
   explicit ReacherTask(double target_radius_m);
 
   std::vector<std::string> camera_names() const override { return {"top", "angled"}; }
@@ -32,10 +33,14 @@ class ReacherTask final : public Task {
   void observe(const engine::World& world, StateSlots& state) const override;
   double reward(const engine::World& world) const override;
 
+  /// World position of the "fingertip" link frame, m.
   Eigen::Vector3d fingertip(const engine::World& world) const;
+  /// World position of the target marker's centre, m.
   Eigen::Vector3d target(const engine::World& world) const;
 
+  /// Each joint's torque at action 1, N m.
   static constexpr double kMaxTorqueNm = 0.05;
+  /// The registry entries: ReacherEasy-v0 and ReacherHard-v0.
   static std::vector<EnvSpec> specs();
 
  private:

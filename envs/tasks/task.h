@@ -33,6 +33,7 @@ struct TaskConfig {
   int render_height = 256;
   /// Control steps per env step; rewards are summed over them.
   int action_repeat = 1;
+  /// Whether observations and render() frames draw shadows.
   bool shadows = true;
   /// Multisample anti-aliasing of observation images: 0 (off), 2, 4 or 8 samples per pixel.
   /// Without it a part thinner than a pixel (the cart-pole's pole at 64x64) covers a pixel only
@@ -41,21 +42,25 @@ struct TaskConfig {
   /// whose observations stay as they were (render() frames always use 4).
   int msaa = 0;
 
+  /// Whether observations hold "pixels" (obs_mode is not "state").
   bool has_pixels() const { return obs_mode != "state"; }
+  /// Whether observations hold the state arrays (obs_mode is not "pixels").
   bool has_state() const { return obs_mode != "pixels"; }
 
   /// The keys above with their defaults and docs.
   static std::vector<ParamSpec> params();
-  /// Reads resolved kwargs. Throws std::invalid_argument, naming `env` and the key, for a size
-  /// outside [16, 8192], an unknown obs_mode or camera, action_repeat < 1, or msaa other than
-  /// 0, 2, 4 or 8.
+  /// Reads resolved kwargs; `cameras` are the task's camera names. Throws std::invalid_argument,
+  /// naming `env` and the key, for a size outside [16, 8192], an unknown obs_mode or camera,
+  /// action_repeat outside [1, 1000], or msaa other than 0, 2, 4 or 8.
   static TaskConfig from_params(const Params& params, const std::vector<std::string>& cameras,
                                 const std::string& env);
 };
 
 /// A named float32 state array of the observation.
 struct StateSpec {
+  /// The observation key.
   std::string name;
+  /// The array's shape.
   Shape shape;
 };
 
@@ -74,6 +79,7 @@ class StateSlots {
     float* out = slot(name, static_cast<std::int64_t>(values.size()));
     for (Eigen::Index i = 0; i < values.size(); ++i) out[i] = static_cast<float>(values(i));
   }
+  /// The same for values listed in place: `state.set("joint_pos", {angle})`.
   void set(const char* name, std::initializer_list<double> values);
 
  private:
@@ -93,11 +99,15 @@ class Task {
 
   /// Camera names; the first is the default for observations and render().
   virtual std::vector<std::string> camera_names() const = 0;
+  /// The actions before_step accepts.
   virtual SpacePtr action_space() const = 0;
   /// The state arrays, in observation order.
   virtual std::vector<StateSpec> state_specs() const = 0;
-  /// Seconds of simulated time per control step, and the physics steps that make it.
+  /// Seconds of simulated time per control step. PixelEnv runs
+  /// round(control_timestep_s / world_config().timestep_s) physics steps (at least 1) per control
+  /// step.
   virtual double control_timestep_s() const = 0;
+  /// The settings of the world PixelEnv builds for the task (physics timestep, gravity, ground).
   virtual engine::WorldConfig world_config() const = 0;
   /// Control steps per episode: the registry's TimeLimit truncates after
   /// ceil(episode_length / action_repeat) env steps unless `make` is given max_episode_steps.
@@ -117,6 +127,8 @@ class Task {
   virtual void observe(const engine::World& world, StateSlots& state) const = 0;
   /// This control step's reward, in [0, 1].
   virtual double reward(const engine::World& world) const = 0;
+  /// Whether the episode ends at this control step (the goal reached, a fall); PixelEnv stops
+  /// the action repeat there. Never, by default.
   virtual bool terminated(const engine::World& /*world*/) const { return false; }
 };
 

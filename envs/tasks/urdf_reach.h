@@ -18,7 +18,8 @@ namespace pixelgym {
 /// marker (never touched).
 /// - Targets: each episode draws a joint configuration uniformly within the joint limits
 ///   (continuous joints: [-pi, pi]) and puts the target where it would put the end link, so every
-///   target can be reached (drawn again, up to 100 times, while it would be under 0.05 m).
+///   target can be reached (drawn again, up to 100 times, while it would be less than 0.05 m
+///   above the floor; after 100 draws the last is lifted to 0.05 m).
 /// - Start: every joint at 0 (or the limit nearest it) plus up to 0.1 of its range at random.
 /// - Actions: Box(-1, 1, (dofs,)): joint velocities times each joint's velocity limit (1.5 rad/s
 ///   or m/s where the URDF sets none).
@@ -29,10 +30,13 @@ namespace pixelgym {
 /// - State: joint_pos (dofs), joint_vel (dofs), end_effector_pos (3), target_pos (3). 500 control
 ///   steps of 0.02 s. Cameras "fixed" (front-left) and "top", framed from R.
 /// The URDF is read when the env is made (not when the id is registered). make throws the
-/// importer's UrdfError for a URDF it cannot use, and std::invalid_argument naming
-/// the links for an `end_link` the URDF lacks, or one no movable joint moves.
+/// importer's UrdfError for a URDF it cannot use, and std::invalid_argument for a `urdf` that
+/// names no file (as given or in the asset folders), for an `end_link` the URDF lacks (naming its
+/// links), and for one that no movable joint moves or that stays at the root link's origin.
 class UrdfReachTask final : public Task {
  public:
+  /// Keeps the kwargs; reads nothing. The URDF is read on the first call that needs it (the
+  /// spaces, the world, the accessors below), which throws as make does.
   UrdfReachTask(const std::string& urdf, const std::string& end_link);
 
   std::vector<std::string> camera_names() const override { return {"fixed", "top"}; }
@@ -49,7 +53,9 @@ class UrdfReachTask final : public Task {
   void observe(const engine::World& world, StateSlots& state) const override;
   double reward(const engine::World& world) const override;
 
+  /// World position of the end link's URDF frame, m.
   Eigen::Vector3d end_effector(const engine::World& world) const;
+  /// World position of the target marker's centre, m.
   Eigen::Vector3d target(const engine::World& world) const;
   /// The arm's reach R in metres (see above).
   double reach_m() const { return arm().reach_m; }
@@ -59,11 +65,13 @@ class UrdfReachTask final : public Task {
   Eigen::Vector3d end_link_position(const Eigen::VectorXd& q) const;
 
   /// The range each degree of freedom's targets and starts are drawn from: its limits, or
-  /// [-pi, pi] for a continuous joint.
+  /// [-pi, pi] for a continuous joint. `dof` must be in [0, dofs) (not checked).
   double lower(int dof) const;
   double upper(int dof) const;
 
-  static constexpr double kDefaultJointSpeed = 1.5;  // rad/s or m/s at action 1
+  /// A joint's speed at action 1 (rad/s or m/s) when its URDF sets no velocity limit.
+  static constexpr double kDefaultJointSpeed = 1.5;
+  /// The registry entry for UrdfReach-v0, with its "urdf" and "end_link" kwargs.
   static EnvSpec spec_v0();
 
  private:

@@ -15,11 +15,18 @@ namespace pixelgym {
 /// Meshes are converted once per process and shared by every WorldScene.
 class WorldScene {
  public:
+  /// One instance per world.visual_shapes() entry, in that order, posed as the world is now. A
+  /// mesh with a URDF colour is drawn in that colour, one without in its file's part colours.
+  /// Keeps no reference to `world`.
   explicit WorldScene(const engine::World& world);
 
   /// Copies the current visual poses of `world` (the one it was built from) into the scene.
+  /// Throws std::invalid_argument when the world's visual shape count differs from the scene's
+  /// (shapes were added after it was built).
   void update(const engine::World& world);
 
+  /// The scene to draw. update() rewrites only the instance poses: the light, floor, sky and
+  /// shadow settings are the caller's to change.
   render::Scene& scene() { return scene_; }
   const render::Scene& scene() const { return scene_; }
 
@@ -33,8 +40,9 @@ class WorldScene {
 };
 
 /// A camera that frames `box` whole, looking from the direction given by azimuth (degrees,
-/// counter-clockwise from +x) and elevation (degrees above the horizon). Throws
-/// std::invalid_argument for an empty box.
+/// counter-clockwise from +x) and elevation (degrees above the horizon), from the closest
+/// distance at which the box's corners fall within 95% of the image of `width` x `height` pixels
+/// and `fov_y_deg`. Throws std::invalid_argument for an empty box.
 render::Camera frame_box(const Eigen::AlignedBox3f& box, float azimuth_deg, float elevation_deg,
                          int width, int height, float fov_y_deg = 40.0F);
 

@@ -41,6 +41,8 @@ using EnvFactory = std::function<std::unique_ptr<Env>(int index)>;
 /// usable again (worker threads are kept).
 class BatchRunner : public VectorEnv {
  public:
+  /// Destroys whatever envs a subclass destructor left, on the calling thread, without calling
+  /// their close().
   ~BatchRunner() override;
 
   /// Closes every env (on the thread that runs it). Calling it again does nothing. Throws the
@@ -51,11 +53,14 @@ class BatchRunner : public VectorEnv {
   /// Env 0's spaces.
   const Space& single_observation_space() const override;
   const Space& single_action_space() const override;
+  /// batch_space of env 0's spaces, built once by build().
   const Space& observation_space() const override { return *observation_space_; }
   const Space& action_space() const override { return *action_space_; }
   /// Env 0's metadata, with the autoreset mode.
   const VectorMetadata& metadata() const override { return metadata_; }
   bool closed() const override { return closed_; }
+  /// "SyncVectorEnv(CartPoleSwingup-v0, num_envs=4)": the type name, env 0's registered id (when
+  /// it has one) and num_envs.
   std::string name() const override;
   /// Env `i`, for inspection between calls (never while AsyncVectorEnv has a step pending).
   /// AsyncVectorEnv runs env i on one worker thread; a pixel env inspected from another thread
@@ -96,6 +101,7 @@ class BatchRunner : public VectorEnv {
   /// finished) and batches the results. AsyncVectorEnv exposes them as step_async / step_wait.
   void begin_step(const Value& actions, const char* method, bool wait);
   const VectorStepResult& end_step(const char* method);
+  /// Whether begin_step has started a step that end_step has not yet finished.
   bool step_pending() const { return step_pending_; }
 
  private:

@@ -14,15 +14,19 @@ namespace pixelgym::vector {
 
 /// How make_vec runs the envs.
 enum class VectorMode : std::uint8_t {
-  kSync,   // SyncVectorEnv: a loop on the calling thread
-  kAsync,  // AsyncVectorEnv: a pool of worker threads
+  /// SyncVectorEnv: a loop on the calling thread.
+  kSync,
+  /// AsyncVectorEnv: a pool of worker threads.
+  kAsync,
 };
 
 /// make_vec's settings beside the env's own kwargs.
 struct VectorOptions {
+  /// Which runner make_vec builds.
   VectorMode mode = VectorMode::kSync;
   /// AsyncVectorEnv's worker threads: 0 for one per core; clamped to num_envs. Ignored by kSync.
   int num_threads = 0;
+  /// What the vector env does with an env whose episode ended (see AutoresetMode).
   AutoresetMode autoreset = AutoresetMode::kNextStep;
   /// Whether the envs one thread runs share their render resources' GL context (the pixel tasks:
   /// one context per thread, whose compiled shaders, meshes and framebuffers its envs share);

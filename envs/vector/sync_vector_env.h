@@ -20,6 +20,7 @@ class SyncVectorEnv final : public BatchRunner {
   /// Takes envs built already (env i is `envs[i]`). Throws as above.
   explicit SyncVectorEnv(std::vector<std::unique_ptr<Env>> envs,
                          AutoresetMode autoreset = AutoresetMode::kNextStep);
+  /// Destroys the envs, without calling their close().
   ~SyncVectorEnv() override;
 
  protected:

@@ -34,12 +34,13 @@ enum class AutoresetMode : std::uint8_t {
 
 /// "NextStep", "SameStep" or "Disabled" (Gymnasium's names).
 const char* autoreset_mode_name(AutoresetMode mode);
-/// The mode named `name` as autoreset_mode_name spells it (case-insensitive; "next_step",
-/// "same_step" also accepted). Throws std::invalid_argument listing the names.
+/// The mode named `name` as autoreset_mode_name spells it (case-insensitive, underscores ignored:
+/// "next_step", "same_step" also accepted). Throws std::invalid_argument listing the names.
 AutoresetMode parse_autoreset_mode(const std::string& name);
 
 /// The envs' metadata (env 0's) and the autoreset mode (Gymnasium's metadata["autoreset_mode"]).
 struct VectorMetadata : Metadata {
+  /// The mode the vector env was built with.
   AutoresetMode autoreset_mode = AutoresetMode::kNextStep;
 };
 
@@ -59,8 +60,9 @@ struct VectorStepResult {
   Value obs;
   /// float64 (num_envs,).
   Array rewards;
-  /// bool (num_envs,) each.
+  /// bool (num_envs,): whether env i's task ended its episode at this step.
   Array terminated;
+  /// bool (num_envs,): whether env i's episode was cut off at this step (a time limit).
   Array truncated;
   /// As VectorResetResult::infos.
   Info infos;
@@ -113,6 +115,7 @@ class VectorEnv {
   /// Closes every env. Calling it again does nothing.
   virtual void close() = 0;
 
+  /// How many envs it steps, >= 1.
   virtual int num_envs() const = 0;
   /// One env's spaces (every env's are equal).
   virtual const Space& single_observation_space() const = 0;
@@ -120,8 +123,11 @@ class VectorEnv {
   /// The batched spaces (see batch_space).
   virtual const Space& observation_space() const = 0;
   virtual const Space& action_space() const = 0;
+  /// Env 0's metadata and the autoreset mode.
   virtual const VectorMetadata& metadata() const = 0;
+  /// metadata().autoreset_mode.
   AutoresetMode autoreset_mode() const { return metadata().autoreset_mode; }
+  /// True once `close()` was called.
   virtual bool closed() const = 0;
   /// "SyncVectorEnv(CartPoleSwingup-v0, num_envs=4)",
   /// "NormalizeReward<SyncVectorEnv(CartPoleSwingup-v0, num_envs=4)>".
@@ -139,6 +145,7 @@ class VectorEnv {
   /// reset: `reset_mask` null for every env, else the mask (checked by the BatchRunner).
   virtual const VectorResetResult& do_reset(std::optional<std::uint64_t> seed,
                                             const Options& options, const Array* reset_mask) = 0;
+  /// step.
   virtual const VectorStepResult& do_step(const Value& actions) = 0;
 };
 

@@ -36,7 +36,9 @@ class NormalizeReward final : public VectorWrapper {
   explicit NormalizeReward(std::unique_ptr<VectorEnv> env, double gamma = 0.99,
                            double epsilon = 1e-8);
 
+  /// The discount of the returns R_i.
   double gamma() const { return gamma_; }
+  /// The constant added to the variance before its square root.
   double epsilon() const { return epsilon_; }
   /// Each env's discounted return R_i of its current episode so far (num_envs entries).
   const std::vector<double>& discounted_returns() const { return returns_; }
@@ -46,6 +48,7 @@ class NormalizeReward final : public VectorWrapper {
 
   /// Whether steps update the statistics (true at construction).
   bool update_statistics() const { return update_statistics_; }
+  /// false freezes the variance (rewards are still scaled by it); true resumes.
   void set_update_statistics(bool update) { update_statistics_ = update; }
 
   /// The running statistics of the returns (one element).

@@ -50,7 +50,9 @@ class RecordEpisodeStatistics final : public VectorWrapper {
   explicit RecordEpisodeStatistics(std::unique_ptr<VectorEnv> env, std::int64_t buffer_length = 100,
                                    const std::string& stats_key = "episode");
 
+  /// How many finished episodes the queues keep.
   std::int64_t buffer_length() const { return buffer_length_; }
+  /// The infos key the statistics go under (their mask under "_" + stats_key).
   const std::string& stats_key() const { return stats_key_; }
   /// Episodes ended so far, across every env.
   std::int64_t episode_count() const { return episode_count_; }
@@ -59,7 +61,8 @@ class RecordEpisodeStatistics final : public VectorWrapper {
   const std::vector<double>& episode_returns() const { return returns_; }
   const std::vector<std::int64_t>& episode_lengths() const { return lengths_; }
 
-  /// The last min(episode_count(), buffer_length) episodes, oldest first.
+  /// The last min(episode_count(), buffer_length) episodes' returns, lengths and wall times in
+  /// seconds, oldest first, as new vectors.
   std::vector<double> return_queue() const;
   std::vector<std::int64_t> length_queue() const;
   std::vector<double> time_queue() const;
