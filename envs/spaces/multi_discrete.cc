@@ -1,5 +1,6 @@
 #include "envs/spaces/multi_discrete.h"
 
+#include <limits>
 #include <stdexcept>
 
 namespace pixelgym::spaces {
@@ -32,6 +33,12 @@ MultiDiscrete::MultiDiscrete(std::vector<std::int64_t> nvec, std::vector<std::in
     if (nvec_[i] <= 0) {
       throw std::invalid_argument("MultiDiscrete: nvec must be positive, got " + join(nvec_));
     }
+    // start + nvec - 1, the largest value of an entry, must be an int64 (as Discrete's).
+    if (start_[i] > std::numeric_limits<std::int64_t>::max() - (nvec_[i] - 1)) {
+      throw std::invalid_argument(
+          "MultiDiscrete: start + nvec - 1 must fit in int64, got start = " + join(start_) +
+          ", nvec = " + join(nvec_) + " (entry " + std::to_string(i) + ")");
+    }
   }
 }
 
@@ -54,7 +61,7 @@ std::string MultiDiscrete::mismatch(const Value& value) const {
   for (std::int64_t i = 0; i < array.size(); ++i) {
     const auto k = static_cast<std::size_t>(i);
     const std::int64_t x = array.element_as_int64(i);  // exactly: not through a double
-    if (x < start_[k] || x >= start_[k] + nvec_[k]) {
+    if (x < start_[k] || x > start_[k] + (nvec_[k] - 1)) {
       return "element " + std::to_string(i) + " = " + std::to_string(x) + " is outside {" +
              std::to_string(start_[k]) + ", ..., " + std::to_string(start_[k] + nvec_[k] - 1) + "}";
     }

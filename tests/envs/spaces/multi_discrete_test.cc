@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
 
 namespace pixelgym::spaces {
 namespace {
@@ -37,6 +40,27 @@ TEST(MultiDiscreteTest, RejectsInvalidConstruction) {
   EXPECT_THROW(MultiDiscrete({3, 0}), std::invalid_argument);
   EXPECT_THROW(MultiDiscrete({3, 2}, {0}), std::invalid_argument);
   EXPECT_THROW(MultiDiscrete({3, 2}, {}, Shape{3}), std::invalid_argument);
+}
+
+// The largest value of an entry, start + nvec - 1, must be an int64; one that is exactly the
+// largest int64 is contained (start + nvec alone would overflow there).
+TEST(MultiDiscreteTest, EntriesUpToTheLargestInt64) {
+  constexpr std::int64_t kMax = std::numeric_limits<std::int64_t>::max();
+  try {
+    MultiDiscrete({3, 2}, {0, kMax});
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("start + nvec - 1 must fit in int64"),
+              std::string::npos)
+        << error.what();
+    EXPECT_NE(std::string(error.what()).find("(entry 1)"), std::string::npos) << error.what();
+  }
+  const MultiDiscrete space({3}, {kMax - 2});
+  EXPECT_TRUE(space.contains(Array::from_vector<std::int64_t>({1}, {kMax})));
+  EXPECT_TRUE(space.contains(Array::from_vector<std::int64_t>({1}, {kMax - 2})));
+  EXPECT_FALSE(space.contains(Array::from_vector<std::int64_t>({1}, {kMax - 3})));
+  Rng rng(0);
+  for (int i = 0; i < 20; ++i) ASSERT_TRUE(space.contains(space.sample(rng)));
 }
 
 TEST(MultiDiscreteTest, ToStringAndEquals) {
