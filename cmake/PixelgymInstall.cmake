@@ -16,8 +16,12 @@ set_target_properties(pixelgym_testing_gtest PROPERTIES EXPORT_NAME testing_gtes
 install(TARGETS ${pixelgym_libraries} pixelgym_testing_gtest EXPORT pixelgymTargets
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/pixelgym)
+# The renderer's private headers (each says "Private" at its top: the OpenGL declarations and the
+# GL objects behind render/renderer.h) are for render/*.cc only; no installed header includes them.
 install(DIRECTORY engine envs render testing wrappers
-        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/pixelgym FILES_MATCHING PATTERN "*.h")
+        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/pixelgym FILES_MATCHING PATTERN "*.h"
+        REGEX "/render/(gl|gl_library|gl_object|lod|mesh_arena|render_target|shader_programs|shadow_fit|shadow_pass|texture_cache|transforms)\\.h$"
+        EXCLUDE)
 install(DIRECTORY assets/ DESTINATION ${PIXELGYM_INSTALL_ASSETS_DIR} PATTERN tools EXCLUDE)
 
 set(pixelgym_cmake_dir ${CMAKE_INSTALL_LIBDIR}/cmake/pixelgym)
