@@ -92,3 +92,6 @@ template <typename Labels>
 /// SegmentationTolerance).
 #define EXPECT_SEGMENTATION_MATCHES_GOLDEN(labels, golden_path) \
   EXPECT_PRED_FORMAT2(::pixelgym::testing::segmentation_matches_golden_format, labels, golden_path)
+/// As EXPECT_SEGMENTATION_MATCHES_GOLDEN, ending the test on a failure.
+#define ASSERT_SEGMENTATION_MATCHES_GOLDEN(labels, golden_path) \
+  ASSERT_PRED_FORMAT2(::pixelgym::testing::segmentation_matches_golden_format, labels, golden_path)

@@ -57,6 +57,18 @@ struct Folder {
   SnapshotOptions options;
 };
 
+// Segmentation labels: 0 above row 16, -1 below, a two-pixel pole labelled 7 at column `pole`.
+Array labels(int pole) {
+  Array image(DType::kInt32, {kSize, kSize});
+  std::int32_t* p = image.data<std::int32_t>();
+  for (int row = 0; row < kSize; ++row) {
+    for (int col = 0; col < kSize; ++col) {
+      p[row * kSize + col] = (col == pole || col == pole + 1) && row > 4 ? 7 : (row < 16 ? 0 : -1);
+    }
+  }
+  return image;
+}
+
 SnapshotResult write_golden(const Array& image, const std::string& path) {
   SnapshotOptions options;
   options.update = SnapshotOptions::Update::kAlways;
@@ -185,17 +197,6 @@ TEST(SnapshotTest, WrongFrameIsAnInvalidArgument) {
 
 TEST(SnapshotTest, SegmentationGoldenRoundTripsAndCatchesAMove) {
   Folder folder("segmentation");
-  const auto labels = [](int pole) {
-    Array image(DType::kInt32, {kSize, kSize});
-    std::int32_t* p = image.data<std::int32_t>();
-    for (int row = 0; row < kSize; ++row) {
-      for (int col = 0; col < kSize; ++col) {
-        p[row * kSize + col] =
-            (col == pole || col == pole + 1) && row > 4 ? 7 : (row < 16 ? 0 : -1);
-      }
-    }
-    return image;
-  };
   SnapshotOptions write = folder.options;
   write.update = SnapshotOptions::Update::kAlways;
   EXPECT_EQ(compare_segmentation_to_golden(labels(10), folder.golden("seg.png"), {}, write).status,
@@ -228,6 +229,22 @@ TEST(SnapshotGtestTest, ExpectMatchesGoldenPassesAndFails) {
   EXPECT_MATCHES_GOLDEN_WITHIN(frame(20), folder.golden(), loose);
   EXPECT_FATAL_FAILURE(ASSERT_MATCHES_GOLDEN(frame(20), "/nonexistent/golden.png"),
                        "no golden /nonexistent/golden.png");
+  ::unsetenv("PIXELGYM_SNAPSHOT_OUTPUT_DIR");
+}
+
+TEST(SnapshotGtestTest, SegmentationMacrosPassAndFail) {
+  Folder folder("gtest_segmentation");
+  SnapshotOptions write = folder.options;
+  write.update = SnapshotOptions::Update::kAlways;
+  ASSERT_EQ(compare_segmentation_to_golden(labels(10), folder.golden("seg.png"), {}, write).status,
+            Status::kUpdated);
+  ::setenv("PIXELGYM_SNAPSHOT_OUTPUT_DIR", (folder.root / "out").c_str(), 1);
+  EXPECT_SEGMENTATION_MATCHES_GOLDEN(labels(10), folder.golden("seg.png"));
+  ASSERT_SEGMENTATION_MATCHES_GOLDEN(labels(10), folder.golden("seg.png"));
+  EXPECT_NONFATAL_FAILURE(EXPECT_SEGMENTATION_MATCHES_GOLDEN(labels(14), folder.golden("seg.png")),
+                          "2x2 windows of differing labels");
+  EXPECT_FATAL_FAILURE(ASSERT_SEGMENTATION_MATCHES_GOLDEN(labels(14), "/nonexistent/seg.png"),
+                       "no golden /nonexistent/seg.png");
   ::unsetenv("PIXELGYM_SNAPSHOT_OUTPUT_DIR");
 }
 
