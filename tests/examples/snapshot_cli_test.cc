@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
@@ -17,6 +18,14 @@ namespace pixelgym {
 namespace {
 
 namespace fs = std::filesystem;
+
+// These tests set the update switch themselves where they test it; `make goldens`
+// (PIXELGYM_UPDATE_GOLDENS=1 ctest -R Golden) must not reach the others.
+[[maybe_unused]] const bool kUpdateSwitchCleared = [] {
+  ::unsetenv("PIXELGYM_UPDATE_GOLDENS");
+  return true;
+}();
+
 using ::testing::HasSubstr;
 using ::testing::Not;
 

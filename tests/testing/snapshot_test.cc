@@ -20,6 +20,14 @@ namespace pixelgym::testing {
 namespace {
 
 namespace fs = std::filesystem;
+
+// These tests set the update switch themselves where they test it; `make goldens`
+// (PIXELGYM_UPDATE_GOLDENS=1 ctest -R Golden) must not reach the others.
+[[maybe_unused]] const bool kUpdateSwitchCleared = [] {
+  ::unsetenv("PIXELGYM_UPDATE_GOLDENS");
+  return true;
+}();
+
 using Status = SnapshotResult::Status;
 
 constexpr int kSize = 32;
@@ -227,8 +235,9 @@ TEST(SnapshotGtestTest, ExpectMatchesGoldenPassesAndFails) {
   loose.max_thick_windows = 1000;
   loose.max_displaced_fraction = 1.0;
   EXPECT_MATCHES_GOLDEN_WITHIN(frame(20), folder.golden(), loose);
-  EXPECT_FATAL_FAILURE(ASSERT_MATCHES_GOLDEN(frame(20), "/nonexistent/golden.png"),
-                       "no golden /nonexistent/golden.png");
+  // Under /dev/null no golden can exist, nor be written by a run with the update switch on.
+  EXPECT_FATAL_FAILURE(ASSERT_MATCHES_GOLDEN(frame(20), "/dev/null/golden.png"),
+                       "no golden /dev/null/golden.png");
   ::unsetenv("PIXELGYM_SNAPSHOT_OUTPUT_DIR");
 }
 
@@ -243,8 +252,8 @@ TEST(SnapshotGtestTest, SegmentationMacrosPassAndFail) {
   ASSERT_SEGMENTATION_MATCHES_GOLDEN(labels(10), folder.golden("seg.png"));
   EXPECT_NONFATAL_FAILURE(EXPECT_SEGMENTATION_MATCHES_GOLDEN(labels(14), folder.golden("seg.png")),
                           "2x2 windows of differing labels");
-  EXPECT_FATAL_FAILURE(ASSERT_SEGMENTATION_MATCHES_GOLDEN(labels(14), "/nonexistent/seg.png"),
-                       "no golden /nonexistent/seg.png");
+  EXPECT_FATAL_FAILURE(ASSERT_SEGMENTATION_MATCHES_GOLDEN(labels(14), "/dev/null/seg.png"),
+                       "no golden /dev/null/seg.png");
   ::unsetenv("PIXELGYM_SNAPSHOT_OUTPUT_DIR");
 }
 

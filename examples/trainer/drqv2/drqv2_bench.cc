@@ -108,9 +108,10 @@ int main(int argc, char** argv) {
     else if (arg == "--channels-last")
       config.channels_last = true;
     else {
-      std::cerr << "drqv2_bench: unknown argument " << arg
-                << " (--size, --encoder, --batch, --stack, --channels, --updates, --threads, "
-                   "--bfloat16, --channels-last)\n";
+      std::cerr
+          << "drqv2_bench: unknown argument " << arg
+          << " (--size, --encoder, --batch, --stack, --channels, --updates, --hidden, --threads, "
+             "--bfloat16, --channels-last)\n";
       return 2;
     }
   }
