@@ -6,8 +6,9 @@ back to back on this machine, written to bench/RESULTS.md with the frames each p
     /usr/bin/python3 bench/report.py [--build build] [--repeats 5] [--out bench/RESULTS.md]
     /usr/bin/python3 bench/report.py --check-readme
 
-Every measurement runs once per round, all of them one after the other, and the rounds repeat:
-drift on a shared machine then reaches pixelgym and its reference alike. Each figure is the
+Every measurement runs once per round, all of them one after the other, and the rounds repeat.
+Each ratio's reference runs just before and just after its subject (its value is the mean of the
+two), so that a change in the machine's speed reaches both sides alike. Each figure is the
 median over the rounds; each ratio is the median of the ratios taken within one round. Before
 each round the report waits (up to --idle-wait seconds) until other processes use less than a
 tenth of a core, and it records how much CPU they took during the measurements.
@@ -162,56 +163,84 @@ class Report:
 
     # ---- the measurements: each returns {key: value} ----------------------------------------
     def probes(self):
+        """Each ratio's two sides run seconds apart, the reference before and after its subject
+        (the mean of the two is its value): this VM's speed moved by up to 2x over minutes with
+        no other process running, and a pair measured a minute apart caught that instead."""
         probes = []
         for size in SIZES:
-            frames = {64: 4000, 84: 4000, 128: 2500, 256: 800}[size]
-            probes.append((f"render {size} floor", lambda size=size, n=frames: {
-                f"render:{size}:floor": field(run([self.floor_bin, str(size), str(size), str(n)]),
-                                              "frames_per_s")}))
-            for scene in ("cartpole", "arm"):
-                for shadows in (False, True):
-                    key = f"render:{size}:{scene}:{'on' if shadows else 'off'}"
-                    argv = [self.bench("render_bench"), scene, str(size), str(size), str(frames)]
-                    argv += ["shadows"] if shadows else []
-                    probes.append((key, lambda key=key, argv=argv: {key: self.render(argv)}))
-        probes.append(("MuJoCo full", lambda: {"mj:full": field(
-            run(self.mujoco("-n", "400", "-w", "84", "-h", "84")), "steps_per_s")}))
-        probes.append(("MuJoCo lite", lambda: {"mj:lite": field(
-            run(self.mujoco("-n", "3000", "-w", "84", "-h", "84", "-lite")), "steps_per_s")}))
-        probes.append(("MuJoCo physics", lambda: {"mj:phys": field(
-            run(self.mujoco("-phys", "-n", "200000")), "steps_per_s")}))
-        # Timed loops of a few tenths of a second or more: shorter ones moved by tens of percent
-        # from round to round.
+            probes.append((f"render {size}", lambda size=size: self.render_size(size)))
+        mj_full = self.mujoco("-n", "300", "-w", "84", "-h", "84")
+        mj_lite = self.mujoco("-n", "3000", "-w", "84", "-h", "84", "-lite")
+        mj_phys = self.mujoco("-phys", "-n", "200000")
+        cart = ["bench", "CartPoleSwingup-v0"]
+        probes.append(("cart-pole against MuJoCo with dm_control's visuals", lambda: self.around(
+            "mj:full", lambda: self.rate(mj_full),
+            "env:CartPoleSwingup-v0:pixels", lambda: self.cli_rate(cart + ["--steps", "3000"]))))
+        probes.append(("cart-pole without shadows against MuJoCo lite", lambda: self.around(
+            "mj:lite", lambda: self.rate(mj_lite), "env:CartPoleSwingup-v0:noshadow",
+            lambda: self.cli_rate(cart + ["--steps", "6000", "--set", "shadows=false"]))))
+        probes.append(("cart-pole without pixels against MuJoCo's physics", lambda: self.around(
+            "mj:phys", lambda: self.rate(mj_phys), "env:CartPoleSwingup-v0:state",
+            lambda: self.cli_rate(cart + ["--steps", "20000", "--set", "obs_mode=state"]))))
+        # Timed loops of a few tenths of a second or more: 5k-step loops of 40 ms moved by tens of
+        # percent from round to round.
         for env_id in self.ids:
+            if env_id == "CartPoleSwingup-v0":
+                continue  # measured beside MuJoCo above
             grid = env_id == "GridWorld-v0"
             pixels = ["--set", "obs_mode=pixels"] if grid else []
             state = [] if grid else ["--set", "obs_mode=state"]
             pixel_steps, state_steps = ("30000", "500000") if grid else ("3000", "20000")
-            probes.append((f"{env_id} pixels", lambda i=env_id, p=pixels, n=pixel_steps: {
-                f"env:{i}:pixels": self.cli_rate(["bench", i, "--steps", n] + p)}))
-            probes.append((f"{env_id} state", lambda i=env_id, s=state, n=state_steps: {
-                f"env:{i}:state": self.cli_rate(["bench", i, "--steps", n] + s)}))
-        probes.append(("CartPoleSwingup-v0 shadows off", lambda: {
-            "env:CartPoleSwingup-v0:noshadow": self.cli_rate(
-                ["bench", "CartPoleSwingup-v0", "--steps", "6000", "--set", "shadows=false"])}))
+            probes.append((f"{env_id}", lambda i=env_id, p=pixels, s=state, n=pixel_steps,
+                           m=state_steps: {
+                f"env:{i}:pixels": self.cli_rate(["bench", i, "--steps", n] + p),
+                f"env:{i}:state": self.cli_rate(["bench", i, "--steps", m] + s)}))
         for env_id in VECTOR_IDS:
-            steps = "8000" if env_id.startswith("CartPole") else "3000"
-            for threads in (0, 2):
-                key = f"vec:{env_id}:{threads}"
-                argv = ["bench", env_id, "--num-envs", str(VECTOR_ENVS), "--threads", str(threads),
-                        "--steps", steps]
-                probes.append((key, lambda key=key, argv=argv: {key: self.cli_rate(argv)}))
-        probes.append(("MuJoCo full, 2 processes", lambda: {
-            "mj:full2": self.two_processes(self.mujoco("-n", "400", "-w", "84", "-h", "84"))}))
-        probes.append(("MuJoCo lite, 2 processes", lambda: {
-            "mj:lite2": self.two_processes(
-                self.mujoco("-n", "3000", "-w", "84", "-h", "84", "-lite"))}))
+            argv = ["bench", env_id, "--num-envs", str(VECTOR_ENVS), "--steps",
+                    "8000" if env_id.startswith("CartPole") else "3000", "--threads"]
+            probes.append((f"{env_id} vector", lambda i=env_id, argv=argv: self.around(
+                f"vec:{i}:0", lambda: self.cli_rate(argv + ["0"]),
+                f"vec:{i}:2", lambda: self.cli_rate(argv + ["2"]))))
+        probes.append(("MuJoCo as 2 processes", lambda: self.around(
+            "mj:full1", lambda: self.rate(mj_full), "mj:full2",
+            lambda: self.two_processes(mj_full))))
+        probes.append(("MuJoCo lite as 2 processes", lambda: self.around(
+            "mj:lite1", lambda: self.rate(mj_lite), "mj:lite2",
+            lambda: self.two_processes(mj_lite))))
         probes.append(("Python vector env against C++", self.python_against_cpp))
-        probes.append(("trainer", self.trainer))
-        probes.append(("demo env without learning", lambda: {"train:envonly": self.cli_rate(
-            ["bench"] + DEMO_ENV + ["--num-envs", "8", "--threads", "2", "--steps", "2000"])}))
+        demo_envs = ["bench"] + DEMO_ENV + ["--num-envs", "8", "--threads", "2", "--steps", "2000"]
+        probes.append(("trainer against its envs alone", lambda: self.around(
+            "train:envonly", lambda: self.cli_rate(demo_envs), "train", self.trainer)))
         probes.append(("engine_bench", self.engine))
         return probes
+
+    def around(self, reference_key, reference, subject_key, subject):
+        """The reference, the subject, the reference again: {reference_key: mean of the two,
+        subject_key: the subject's value} (a subject returning a dict is merged as it is)."""
+        before = reference()
+        value = subject()
+        after = reference()
+        values = value if isinstance(value, dict) else {subject_key: value}
+        return {reference_key: (before + after) / 2, **values}
+
+    def render_size(self, size):
+        frames = {64: 4000, 84: 4000, 128: 2500, 256: 800}[size]
+        floor = [self.floor_bin, str(size), str(size), str(frames)]
+        values = {}
+
+        def scenes():
+            for scene in ("cartpole", "arm"):
+                for shadows in (False, True):
+                    key = f"render:{size}:{scene}:{'on' if shadows else 'off'}"
+                    argv = [self.bench("render_bench"), scene, str(size), str(size), str(frames)]
+                    values[key] = self.render(argv + (["shadows"] if shadows else []))
+            return values
+
+        return self.around(f"render:{size}:floor", lambda: field(run(floor), "frames_per_s"),
+                           None, scenes)
+
+    def rate(self, argv):
+        return field(run(argv), "steps_per_s")
 
     def render(self, argv):
         out = run(argv)
@@ -342,6 +371,7 @@ class Report:
         compiler_version = subprocess.run([compiler, "--version"], capture_output=True,
                                           text=True).stdout.splitlines()[0] if compiler != "?" else "?"
         cpu_model = read("/proc/cpuinfo", r"^model name\s*:(.*)$")
+        cart_physics = self.values["engine:BM_CartPole"]
         build_type = read(os.path.join(self.build, "CMakeCache.txt"),
                           r"^CMAKE_BUILD_TYPE:\w+=(.*)$")
         return [
@@ -360,6 +390,11 @@ class Report:
                        f"minutes in all"),
             ("other processes", f"{self.foreign_cores:.2f} cores on average during the measurements "
                                 f"(waited {self.waited:.0f} s for them before rounds)"),
+            ("the machine's own speed", f"`engine_bench`'s cart-pole, the same code every round, "
+                                        f"ran at {min(cart_physics):,.0f} to {max(cart_physics):,.0f} "
+                                        f"physics steps per second over the rounds: absolute "
+                                        f"figures move with that; the ratios pair runs made seconds "
+                                        f"apart"),
             ("LP_NUM_THREADS", "0 for every program (pixelgym's default: llvmpipe draws on the "
                                "calling thread)"),
         ]
@@ -382,7 +417,7 @@ class Report:
             f"- **{r('vec:CartPoleSwingup-v0:2', 'vec:CartPoleSwingup-v0:0'):.2f}x on 2 threads**: "
             f"8 envs in `AsyncVectorEnv` against the same 8 on one thread "
             f"(`ArmReach-v0`: {r('vec:ArmReach-v0:2', 'vec:ArmReach-v0:0'):.2f}x; MuJoCo as two "
-            f"processes against one: {r('mj:full2', 'mj:full'):.2f}x).",
+            f"processes against one: {r('mj:full2', 'mj:full1'):.2f}x).",
             f"- **{r('py:vector', 'py:cpp'):.2f}x C++ from Python**: the binding's vector env "
             f"stepped from a Python loop, against the same from C++.",
             f"- **{v('train:fps'):,.0f} env steps per second of PPO from pixels, updates "
@@ -400,8 +435,9 @@ class Report:
             "",
             "Written by `make bench-report` (bench/report.py; bench/README.md says what it runs). "
             "Each figure is the median over the rounds; each ratio is the median of the ratios "
-            "taken within one round, pixelgym and its reference measured back to back. Every "
-            "round's value is in [results/raw.json](results/raw.json).",
+            "taken within one round, where the reference ran just before and just after "
+            "pixelgym (the mean of the two). Every round's value is in "
+            "[results/raw.json](results/raw.json).",
             "",
             "## Machine",
             "",
@@ -491,8 +527,8 @@ class Report:
                          f"{v(f'vec:{env_id}:2'):,.0f} | "
                          f"{r(f'vec:{env_id}:2', f'vec:{env_id}:0'):.2f}x |")
         for key, name in (("full", "dm_control's visuals"), ("lite", "visuals off")):
-            lines.append(f"| MuJoCo + OSMesa, {name} | {v(f'mj:{key}'):,.0f} | "
-                         f"{v(f'mj:{key}2'):,.0f} | {r(f'mj:{key}2', f'mj:{key}'):.2f}x |")
+            lines.append(f"| MuJoCo + OSMesa, {name} | {v(f'mj:{key}1'):,.0f} | "
+                         f"{v(f'mj:{key}2'):,.0f} | {r(f'mj:{key}2', f'mj:{key}1'):.2f}x |")
 
         lines += [
             "",
