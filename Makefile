@@ -13,7 +13,7 @@
 #   make deb         builds the Debian package in build-deb/ (prefix /usr, tests off):
 #                    build-deb/pixelgym_VERSION_ARCH.deb, for `apt install ./build-deb/pixelgym_*.deb`
 #   make bench-report   builds, then runs the benchmarks beside the reference programs of
-#                       ../shared/peers in interleaved rounds (REPEATS=5, about 15 minutes here) and
+#                       ../shared/peers in interleaved rounds (REPEATS=5, about 17 minutes here) and
 #                       writes bench/RESULTS.md and README.md's headline figures (bench/README.md)
 #   make format-check   the project's C++ files against .clang-format (clang-format 14); exits 1
 #                       naming the files that differ. `make format` rewrites them.

@@ -207,7 +207,10 @@ class Report:
         probes.append(("MuJoCo lite as 2 processes", lambda: self.around(
             "mj:lite1", lambda: self.rate(mj_lite), "mj:lite2",
             lambda: self.two_processes(mj_lite))))
-        probes.append(("Python vector env against C++", self.python_against_cpp))
+        cpp_vector = ["bench", "CartPoleSwingup-v0", "--num-envs", str(VECTOR_ENVS), "--threads",
+                      "2", "--steps", "8000"]
+        probes.append(("Python vector env against C++", lambda: self.around(
+            "py:cpp", lambda: self.cli_rate(cpp_vector), None, self.python_against_cpp)))
         demo_envs = ["bench"] + DEMO_ENV + ["--num-envs", "8", "--threads", "2", "--steps", "2000"]
         probes.append(("trainer against its envs alone", lambda: self.around(
             "train:envonly", lambda: self.cli_rate(demo_envs), "train", self.trainer)))
@@ -256,11 +259,17 @@ class Report:
                                   stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
                  for seed in (11, 22)]
         total = 0.0
-        for proc in procs:
-            out, _ = proc.communicate(timeout=900)
-            if proc.returncode != 0:
-                raise BenchError(f"{' '.join(argv)} exited {proc.returncode}")
-            total += field(out, "steps_per_s")
+        try:
+            for proc in procs:
+                out, _ = proc.communicate(timeout=900)
+                if proc.returncode != 0:
+                    raise BenchError(f"{' '.join(argv)} exited {proc.returncode}")
+                total += field(out, "steps_per_s")
+        finally:
+            for proc in procs:
+                if proc.poll() is None:
+                    proc.kill()
+                    proc.wait()
         return total
 
     def python_against_cpp(self):
@@ -273,7 +282,9 @@ class Report:
         if not match:
             raise BenchError(f"python_vector_bench.py printed no round line:\n{out[-1000:]}")
         cpp, vector, loop = (float(v.replace(",", "")) for v in match.groups())
-        return {"py:cpp": cpp, "py:vector": vector, "py:loop": loop}
+        # The script's own C++ figure runs only before its Python ones; the ratio's C++ side is
+        # the same command run just before and just after the script (around()).
+        return {"py:cpp_in_script": cpp, "py:vector": vector, "py:loop": loop}
 
     def trainer(self):
         out = run([os.path.join(ROOT, "bench", "train_throughput.sh"), self.args.build,
@@ -306,8 +317,24 @@ class Report:
             foreign_cpu_s += max(0.0, (b1 - b0) / hz - (c1 - c0))
             print(f"report: round {round_index + 1} of {self.args.repeats} took {t1 - t0:.0f} s",
                   flush=True)
+            self.write_raw(round_index + 1)
         self.wall_s = time.time() - start
         self.foreign_cores = foreign_cpu_s / measured_s
+
+    def write_raw(self, rounds):
+        """Every round's values so far, in results/raw.json beside the report (written after each
+        round, so a run that fails later keeps what it measured)."""
+        folder = os.path.join(os.path.dirname(self.args.out_path), "results")
+        os.makedirs(folder, exist_ok=True)
+        raw = os.path.join(folder, "raw.json")
+        with open(raw + ".tmp", "w") as f:
+            json.dump({"rounds": rounds, "values": self.values}, f, indent=1)
+        os.replace(raw + ".tmp", raw)
+
+    def spread(self, key, base):
+        """(lowest, highest) per-round ratio."""
+        ratios = [a / b for a, b in zip(self.values[key], self.values[base])]
+        return min(ratios), max(ratios)
 
     def median(self, key):
         return statistics.median(self.values[key])
@@ -422,8 +449,9 @@ class Report:
             f"stepped from a Python loop, against the same from C++.",
             f"- **{v('train:fps'):,.0f} env steps per second of PPO from pixels, updates "
             f"included** ({v('train:fps') * DEMO_ACTION_REPEAT:,.0f} control steps with action "
-            f"repeat 8), on `make demo`'s settings; its 8 envs alone step at "
-            f"{v('train:envonly'):,.0f}.",
+            f"repeat 8), on `make demo`'s settings: "
+            f"{r('train:fps', 'train:envonly'):.2f}x "
+            f"the {v('train:envonly'):,.0f} env steps per second of its 8 envs stepped alone.",
         ])
 
     def write(self):
@@ -446,6 +474,28 @@ class Report:
         ]
         lines += [f"| {name} | {value} |" for name, value in self.facts()]
         lines += ["", "## Headline figures", "", HEADLINE_BEGIN, self.headline(), HEADLINE_END, ""]
+        lines += [
+            "How far the headline ratios moved from round to round (each round's ratio pairs runs "
+            "made seconds apart):",
+            "",
+            "| ratio | median | lowest round | highest round |",
+            "|---|---:|---:|---:|",
+        ]
+        for name, key, base in (
+                ("`CartPoleSwingup-v0` pixels / MuJoCo, dm_control's visuals",
+                 "env:CartPoleSwingup-v0:pixels", "mj:full"),
+                ("`CartPoleSwingup-v0` without shadows / MuJoCo lite",
+                 "env:CartPoleSwingup-v0:noshadow", "mj:lite"),
+                ("cart-pole frame / floor, 84x84", "render:84:cartpole:off", "render:84:floor"),
+                ("`CartPoleSwingup-v0`, 2 threads / 1", "vec:CartPoleSwingup-v0:2",
+                 "vec:CartPoleSwingup-v0:0"),
+                ("`ArmReach-v0`, 2 threads / 1", "vec:ArmReach-v0:2", "vec:ArmReach-v0:0"),
+                ("MuJoCo, 2 processes / 1", "mj:full2", "mj:full1"),
+                ("Python vector env / C++", "py:vector", "py:cpp"),
+                ("PPO training / its envs alone", "train:fps", "train:envonly")):
+            low, high = self.spread(key, base)
+            lines.append(f"| {name} | {r(key, base):.2f}x | {low:.2f}x | {high:.2f}x |")
+        lines.append("")
 
         lines += [
             "## Render frames per second",
@@ -476,8 +526,9 @@ class Report:
             "pixels. The reference: `../shared/peers/mujoco_osmesa` stepping its cart-pole and "
             f"drawing it at 84x84, with dm_control's visuals (shadow map, reflective floor, "
             f"skybox, 4x MSAA): **{v('mj:full'):,.0f}** steps per second; with all of them off "
-            f"(`-lite`): **{v('mj:lite'):,.0f}**. The last column divides by the first: a scale "
-            "for every env, like for like only for the cart-poles.",
+            f"(`-lite`): **{v('mj:lite'):,.0f}**. The last column divides each env's pixel rate by "
+            "that MuJoCo rate, measured just before and after `CartPoleSwingup-v0` in the same "
+            "round: a scale for every env, paired and like for like only for that cart-pole.",
             "",
             "| env | pixels | no pixels | pixels / MuJoCo with dm_control's visuals |",
             "|---|---:|---:|---:|",
@@ -535,8 +586,12 @@ class Report:
             "## Python against C++",
             "",
             f"`bench/python_vector_bench.py --num-envs {VECTOR_ENVS} --threads 2 --steps 8000`, one "
-            "of its rounds per round here: `CartPoleSwingup-v0` at 84x84, total env steps per "
-            "second.",
+            "of its rounds per round here (`CartPoleSwingup-v0` at 84x84, total env steps per "
+            f"second), with `pixelgym bench CartPoleSwingup-v0 --num-envs {VECTOR_ENVS} --threads 2 "
+            "--steps 8000` run just before and just after it as the C++ side (the script's own "
+            "C++ figure, measured only before its Python ones, is `py:cpp_in_script` in "
+            "raw.json). Ratios are medians of the rounds' ratios, so they need not equal the "
+            "ratio of the medians beside them.",
             "",
             "| stepped by | env steps per second | ratio to C++ |",
             "|---|---:|---:|",
@@ -581,15 +636,15 @@ class Report:
             f"![frames at 256x256]({pictures[256]})",
             "",
         ]
-        raw = os.path.join(os.path.dirname(out_path), "results", "raw.json")
-        with open(raw + ".tmp", "w") as f:
-            json.dump({"rounds": self.args.repeats, "values": self.values}, f, indent=1)
-        os.replace(raw + ".tmp", raw)
         with open(out_path + ".tmp", "w") as f:
             f.write("\n".join(lines))
         os.replace(out_path + ".tmp", out_path)
         print(f"report: wrote {os.path.relpath(out_path, ROOT)}")
-        if self.args.readme and update_readme(self.headline()):
+        if not self.args.readme:
+            return
+        if os.path.abspath(out_path) != os.path.join(ROOT, "bench", "RESULTS.md"):
+            print("report: README.md left as it is (its headline figures are bench/RESULTS.md's)")
+        elif update_readme(self.headline()):
             print("report: README.md's headline figures now match")
 
 
@@ -635,7 +690,7 @@ def check_readme(results):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0],
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                      formatter_class=argparse.RawDescriptionHelpFormatter,
                                      epilog=__doc__.split("\n", 1)[1])
     parser.add_argument("--build", default="build", help="build folder (Release; default build)")
