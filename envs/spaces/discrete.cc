@@ -33,7 +33,7 @@ std::string Discrete::mismatch(const Value& value) const {
   if (x < start_ || static_cast<std::uint64_t>(x) - static_cast<std::uint64_t>(start_) >=
                         static_cast<std::uint64_t>(n_)) {
     return std::to_string(x) + " is outside {" + std::to_string(start_) + ", ..., " +
-           std::to_string(start_ + n_ - 1) + "}";
+           std::to_string(start_ + (n_ - 1)) + "}";
   }
   return "";
 }

@@ -63,7 +63,8 @@ std::string MultiDiscrete::mismatch(const Value& value) const {
     const std::int64_t x = array.element_as_int64(i);  // exactly: not through a double
     if (x < start_[k] || x > start_[k] + (nvec_[k] - 1)) {
       return "element " + std::to_string(i) + " = " + std::to_string(x) + " is outside {" +
-             std::to_string(start_[k]) + ", ..., " + std::to_string(start_[k] + nvec_[k] - 1) + "}";
+             std::to_string(start_[k]) + ", ..., " + std::to_string(start_[k] + (nvec_[k] - 1)) +
+             "}";
     }
   }
   return "";

@@ -7,6 +7,7 @@
 #include <limits>
 #include <set>
 #include <stdexcept>
+#include <string>
 
 namespace pixelgym::spaces {
 namespace {
@@ -53,6 +54,12 @@ TEST(DiscreteTest, RejectsARangePastInt64AndChecksTheEdgesWithoutOverflow) {
   EXPECT_TRUE(wide.contains(Array::scalar<std::int64_t>(-2)));
   EXPECT_FALSE(wide.contains(Array::scalar<std::int64_t>(-1)));
   EXPECT_FALSE(wide.contains(Array::scalar<std::int64_t>(0)));
+  // {int64 max - 2, ..., int64 max}: the message names the largest value without computing
+  // start + n (UBSan caught that).
+  const Discrete top(3, kMax - 2);
+  EXPECT_TRUE(top.contains(Array::scalar<std::int64_t>(kMax)));
+  EXPECT_NE(top.mismatch(Array::scalar<std::int64_t>(kMax - 3)).find(std::to_string(kMax) + "}"),
+            std::string::npos);
 }
 
 // Values past 2^53 are judged exactly, not through a double (found by fuzz/spaces_fuzz).

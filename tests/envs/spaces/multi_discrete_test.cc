@@ -59,6 +59,10 @@ TEST(MultiDiscreteTest, EntriesUpToTheLargestInt64) {
   EXPECT_TRUE(space.contains(Array::from_vector<std::int64_t>({1}, {kMax})));
   EXPECT_TRUE(space.contains(Array::from_vector<std::int64_t>({1}, {kMax - 2})));
   EXPECT_FALSE(space.contains(Array::from_vector<std::int64_t>({1}, {kMax - 3})));
+  // The message names the largest value without computing start + nvec (UBSan caught that).
+  EXPECT_NE(space.mismatch(Array::from_vector<std::int64_t>({1}, {kMax - 3}))
+                .find(std::to_string(kMax) + "}"),
+            std::string::npos);
   Rng rng(0);
   for (int i = 0; i < 20; ++i) ASSERT_TRUE(space.contains(space.sample(rng)));
 }
