@@ -83,6 +83,12 @@ SnapshotResult write_golden(const Array& image, const std::string& path) {
   return compare_to_golden(image, path, {}, options);
 }
 
+SnapshotResult write_segmentation_golden(const Array& labels, const std::string& path) {
+  SnapshotOptions options;
+  options.update = SnapshotOptions::Update::kAlways;
+  return compare_segmentation_to_golden(labels, path, {}, options);
+}
+
 TEST(SnapshotTest, UpdateWritesTheGoldenAndSaysSo) {
   Folder folder("update");
   const SnapshotResult result = write_golden(frame(), folder.golden());
@@ -205,9 +211,7 @@ TEST(SnapshotTest, WrongFrameIsAnInvalidArgument) {
 
 TEST(SnapshotTest, SegmentationGoldenRoundTripsAndCatchesAMove) {
   Folder folder("segmentation");
-  SnapshotOptions write = folder.options;
-  write.update = SnapshotOptions::Update::kAlways;
-  EXPECT_EQ(compare_segmentation_to_golden(labels(10), folder.golden("seg.png"), {}, write).status,
+  EXPECT_EQ(write_segmentation_golden(labels(10), folder.golden("seg.png")).status,
             Status::kUpdated);
   const SnapshotResult same =
       compare_segmentation_to_golden(labels(10), folder.golden("seg.png"), {}, folder.options);
@@ -243,9 +247,7 @@ TEST(SnapshotGtestTest, ExpectMatchesGoldenPassesAndFails) {
 
 TEST(SnapshotGtestTest, SegmentationMacrosPassAndFail) {
   Folder folder("gtest_segmentation");
-  SnapshotOptions write = folder.options;
-  write.update = SnapshotOptions::Update::kAlways;
-  ASSERT_EQ(compare_segmentation_to_golden(labels(10), folder.golden("seg.png"), {}, write).status,
+  ASSERT_EQ(write_segmentation_golden(labels(10), folder.golden("seg.png")).status,
             Status::kUpdated);
   ::setenv("PIXELGYM_SNAPSHOT_OUTPUT_DIR", (folder.root / "out").c_str(), 1);
   EXPECT_SEGMENTATION_MATCHES_GOLDEN(labels(10), folder.golden("seg.png"));
