@@ -42,7 +42,8 @@ CLI::Validator integer_in(int min, int max) {
       unbounded ? ">= " + std::to_string(min) : std::to_string(min) + " to " + std::to_string(max));
 }
 
-void add_seed_option(CLI::App& command, std::uint64_t& seed, const std::string& description) {
+CLI::Option* add_seed_option(CLI::App& command, std::uint64_t& seed,
+                             const std::string& description) {
   const CLI::Validator unsigned_64(
       [](std::string& text) -> std::string {
         std::uint64_t value = 0;
@@ -52,7 +53,7 @@ void add_seed_option(CLI::App& command, std::uint64_t& seed, const std::string& 
       },
       "");
   seed = 0;
-  command.add_option("--seed", seed, description)
+  return command.add_option("--seed", seed, description)
       ->type_name("UINT64")
       ->capture_default_str()
       ->check(unsigned_64);

@@ -34,7 +34,8 @@ class UsageError : public std::invalid_argument {
 CLI::Validator integer_in(int min, int max = std::numeric_limits<int>::max());
 
 /// Adds `--seed N` (default 0, any unsigned 64-bit integer; "-1" is refused, not wrapped around).
-void add_seed_option(CLI::App& command, std::uint64_t& seed, const std::string& description);
+CLI::Option* add_seed_option(CLI::App& command, std::uint64_t& seed,
+                             const std::string& description);
 
 /// Accepts a path ending in ".png" (any case): pixelgym writes PNG only.
 CLI::Validator png_path();

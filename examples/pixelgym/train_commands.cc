@@ -95,8 +95,7 @@ void add_run_options(CLI::App& train, TrainArguments& args) {
 
 // The run's settings, which a resume checks against the run's: --seed to --eval-episodes.
 void add_run_setting_options(CLI::App& train, TrainArguments& args) {
-  train
-      .add_option("--seed", args.seed,
+  add_seed_option(train, args.seed,
                   "Seed for torch, the envs and augmentation (default: the config's seed, 0 unless "
                   "--config sets it)")
       ->each([&args](const std::string&) { args.seed_given = true; });

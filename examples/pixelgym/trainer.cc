@@ -40,11 +40,8 @@ const trainer::AlgorithmFactory& algorithm_named(const std::string& name) {
 
 // The algorithm of the run in `folder` (its config.json names it).
 const trainer::AlgorithmFactory& algorithm_of_run(const fs::path& folder) {
-  std::ifstream config_file(folder / "config.json");
-  if (!config_file) {
-    throw std::runtime_error("--resume " + folder.string() + ": no config.json there");
-  }
-  const nlohmann::json config = nlohmann::json::parse(config_file, nullptr, false);
+  const nlohmann::json config =
+      trainer::read_run_config(folder / "config.json", "--resume " + folder.string());
   return trainer::algorithm_of(config, folder / "config.json", kAlgorithms);
 }
 

@@ -517,6 +517,125 @@ TEST(TrainCliTest, TruncatedAndCorruptCheckpointsAreRefused) {
   fs::remove_all(folder);
 }
 
+// A config.json edited after the run started is refused on resume, naming each setting that
+// differs from the checkpoint's (it was recorded while the checkpoint's network went on), and a
+// corrupt one is named as not valid JSON (it was "no member names an algorithm").
+TEST(TrainCliTest, AResumeRefusesAConfigEditedAfterTheRunStarted) {
+  const fs::path folder = fresh_folder("edited");
+  const fs::path run = folder / "run";
+  const CliRun trained = run_cli(train_arguments(folder, "--steps 32 --out " + run.string()));
+  ASSERT_EQ(trained.exit_code, 0) << trained.output;
+  const std::string original = read_text(run / "config.json");
+  const auto resume = [&] {
+    return run_cli("train --resume " + run.string() + " --steps 64 --quiet");
+  };
+  json edited = json::parse(original);
+  edited["ppo"]["policy"]["trunk_hidden"] = 128;
+  edited["ppo"]["num_minibatches"] = 4;
+  edited["env_id"] = "CartPoleSwingup-v0";
+  std::ofstream(run / "config.json", std::ios::trunc) << edited.dump(2);
+  CliRun refused = resume();
+  EXPECT_EQ(refused.exit_code, 1) << refused.output;
+  for (const char* named :
+       {"config.json differs from the settings ckpt-000001.pgck was trained with",
+        "env_id: config.json has \"CartPoleSwingup-v0\", the checkpoint \"CartPoleBalance-v0\"",
+        "ppo.num_minibatches: config.json has 4, the checkpoint 2", "ppo.policy: config.json has",
+        "\"trunk_hidden\":128"}) {
+    EXPECT_NE(refused.output.find(named), std::string::npos) << named << "\n" << refused.output;
+  }
+  EXPECT_EQ(trainer::read_progress_csv(run / "progress.csv").rows.size(), 1U);
+
+  std::ofstream(run / "config.json", std::ios::trunc) << original.substr(0, original.size() / 2);
+  refused = resume();
+  EXPECT_EQ(refused.exit_code, 1) << refused.output;
+  EXPECT_NE(refused.output.find((run / "config.json").string() + ": not valid JSON"),
+            std::string::npos)
+      << refused.output;
+  EXPECT_EQ(refused.output.find("no member names an algorithm"), std::string::npos)
+      << refused.output;
+  std::ofstream(run / "config.json", std::ios::trunc) << "[1, 2]";
+  refused = resume();
+  EXPECT_NE(refused.output.find("the file holds array, not an object"), std::string::npos)
+      << refused.output;
+
+  // Restored, it resumes.
+  std::ofstream(run / "config.json", std::ios::trunc) << original;
+  const CliRun resumed = resume();
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  EXPECT_EQ(trainer::read_progress_csv(run / "progress.csv").rows.size(), 2U);
+  fs::remove_all(folder);
+}
+
+// Settings no machine can hold are refused before anything is allocated, naming the member, the
+// estimate and the memory available (they allocated until the machine ran out, or ended in an
+// allocator's trace); integer members are integers (2.9 was truncated, 1e30 undefined, -1 wrapped
+// to 2^64 - 1, as was --seed -1).
+TEST(TrainCliTest, SettingsTooLargeOrNotIntegersAreRefusedByName) {
+  const fs::path folder = fresh_folder("hostile");
+  const auto train = [&](const std::string& algo, const std::string& config) {
+    std::ofstream(folder / "config.json", std::ios::trunc) << config;
+    return run_cli("train CartPoleBalance-v1 --algo " + algo +
+                   " --set obs_mode=pixels --set width=64 --set height=64 --wrap grayscale "
+                   "--wrap frame_stack=3 --num-envs 1 --threads 1 --quiet --config " +
+                   (folder / "config.json").string() + " --out " + (folder / "run").string());
+  };
+  const auto refused = [&](const CliRun& run, const std::vector<std::string>& named) {
+    EXPECT_NE(run.exit_code, 0) << run.output;
+    EXPECT_NE(run.exit_code, -1) << "a crash\n" << run.output;
+    for (const std::string& text : named) {
+      EXPECT_NE(run.output.find(text), std::string::npos) << text << "\n" << run.output;
+    }
+    EXPECT_FALSE(fs::exists(folder / "run" / "progress.csv"));
+  };
+  const std::vector<std::string> memory = {"of memory, but ", " is available (", "Lower "};
+  const auto with = [](std::vector<std::string> texts, const std::string& more) {
+    texts.push_back(more);
+    return texts;
+  };
+  refused(train("drqv2", R"({"batch_size": 1e9})"),
+          with(memory, "the most is batch_size 1000000000: about"));
+  refused(train("drqv2", R"({"hidden_dim": 1000000000})"),
+          with(memory, "the most is hidden_dim 1000000000: about"));
+  refused(train("drqv2", R"({"replay_capacity": 1e12})"),
+          with(memory, "the most is replay_capacity 1000000000000: about"));
+  refused(train("ppo", R"({"num_steps": 1000000000, "num_minibatches": 1})"),
+          with(memory, "the most is num_steps 1000000000: about"));
+  refused(train("drqv2", R"({"batch_size": 2.9})"),
+          {"member \"batch_size\" must be an integer from", "got 2.9"});
+  refused(train("drqv2", R"({"hidden_dim": 1e30})"),
+          {"member \"hidden_dim\" must be an integer from", "got 1e+30"});
+  refused(train("ppo", R"({"num_steps": 1.5})"), {"member \"num_steps\" must be an integer"});
+  refused(train("ppo", R"({"seed": -1})"),
+          {"member \"seed\" must be an integer from 0 to 18446744073709551615, got -1"});
+  const CliRun seed =
+      run_cli("train CartPoleBalance-v1 --seed -1 --out " + (folder / "run").string());
+  EXPECT_EQ(seed.exit_code, 2) << seed.output;
+  EXPECT_NE(seed.output.find("must be an integer from 0 to 18446744073709551615, got \"-1\""),
+            std::string::npos)
+      << seed.output;
+  EXPECT_FALSE(fs::exists(folder / "run" / "config.json"));
+  fs::remove_all(folder);
+}
+
+// A random-shift pad wider than the image (65 at 64x64) trains: it wrote out of bounds (SIGSEGV
+// or "malloc(): corrupted top size").
+TEST(TrainCliTest, DrqV2TrainsWithAShiftPadWiderThanTheImage) {
+  const fs::path folder = fresh_folder("shift_pad");
+  std::ofstream(folder / "config.json")
+      << R"({"total_env_steps": 300, "iteration_env_steps": 100, "seed_env_steps": 100,
+             "batch_size": 32, "shift_pad": 65})";
+  const CliRun run = run_cli(
+      "train CartPoleBalance-v1 --algo drqv2 --set obs_mode=pixels --set width=64 "
+      "--set height=64 --wrap grayscale --wrap frame_stack=3 --num-envs 1 --threads 1 "
+      "--eval-episodes 1 --set max_episode_steps=100 --quiet --config " +
+      (folder / "config.json").string() + " --out " + (folder / "run").string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const trainer::ProgressTable progress = trainer::read_progress_csv(folder / "run/progress.csv");
+  ASSERT_EQ(progress.rows.size(), 3U);
+  EXPECT_TRUE(std::isfinite(progress.column("critic_loss").back()));
+  fs::remove_all(folder);
+}
+
 // `train --help` names every DrqV2Config member with its default (the JSON --config reads).
 TEST(TrainCliTest, TrainHelpListsEveryDrqV2Setting) {
   const CliRun help = run_cli("train --help");

@@ -129,10 +129,13 @@ void DrqV2Config::validate() const {
   const auto fail = [](const std::string& what) {
     throw std::invalid_argument(std::string(kConfigName) + ": " + what);
   };
+  // Counts are at most 2^40 (about 1.1e12): far past any run, and far from overflowing the
+  // products of counts that sizes are made of; the memory they take is checked with the env.
+  constexpr std::int64_t kMost = std::int64_t{1} << 40;
   const auto at_least = [&](const char* name, std::int64_t value, std::int64_t minimum) {
-    if (value < minimum) {
-      fail(std::string(name) + " must be at least " + std::to_string(minimum) + ", got " +
-           std::to_string(value));
+    if (value < minimum || value > kMost) {
+      fail(std::string(name) + " must be from " + std::to_string(minimum) + " to " +
+           std::to_string(kMost) + ", got " + std::to_string(value));
     }
   };
   const auto in_range = [&](const char* name, double value, double low, double high) {
@@ -167,7 +170,9 @@ void DrqV2Config::validate() const {
   at_least("noise_schedule_env_steps", noise_schedule_env_steps, 0);
   in_range("noise_clip", noise_clip, 0.0, 10.0);
   in_range("actor_preactivation_penalty", actor_preactivation_penalty, 0.0, 1e3);
-  at_least("shift_pad", shift_pad, 0);
+  // Any pad is well defined (past the image's size every shifted pixel repeats an edge); the
+  // bound only keeps 2 pad + 1, the count of offsets drawn, far from overflowing.
+  in_range("shift_pad", static_cast<double>(shift_pad), 0.0, 65536.0);
 }
 
 double DrqV2Config::noise_std(std::int64_t env_steps) const {
@@ -364,6 +369,62 @@ void soft_update(const torch::nn::Module& from, torch::nn::Module& to, double ta
 
 }  // namespace
 
+std::vector<trainer::MemoryUse> memory_estimate(const InputLayout& input,
+                                                const DrqV2Config& config) {
+  const auto d = [](std::int64_t value) { return static_cast<double>(value); };
+  constexpr double kFloat = 4.0;
+  // The encoder's activations per image (conv and ReLU outputs) and its output size.
+  double activations = 0;
+  double image_features = 0;
+  double stack_bytes = 0;
+  if (input.has_image) {
+    double height = d(input.height);
+    double width = d(input.width);
+    for (const std::int64_t stride : encoder_strides(config.encoder)) {
+      height = std::max(1.0, std::floor((height - 3) / d(stride)) + 1);
+      width = std::max(1.0, std::floor((width - 3) / d(stride)) + 1);
+      activations += 2 * 32 * height * width;
+    }
+    image_features = 32 * height * width;
+    stack_bytes = d(input.stack) * d(input.height) * d(input.width) * d(input.channels);
+  }
+  double vector_size = 0;
+  for (const std::int64_t size : input.vector_sizes) vector_size += d(size);
+  const double features = image_features + vector_size;
+  const double actions = d(input.action_size);
+  const double hidden = d(config.hidden_dim);
+  const double feature_dim = d(config.feature_dim);
+  // Trained weights are kept four times (weights, gradients, Adam's two moments); the target
+  // critic's once. Actor and critic trunks are trained, the target trunk is not.
+  const double trunk = features * feature_dim + 3 * feature_dim;
+  const double mlp_actor = feature_dim * hidden + hidden * hidden + hidden * actions;
+  const double mlp_q = (feature_dim + actions) * hidden + hidden * hidden + hidden;
+  const double trunk_bytes = kFloat * (4 * 2 * trunk + trunk);
+  const double mlp_bytes = kFloat * (4 * (mlp_actor + 2 * mlp_q) + 2 * mlp_q);
+  // Per sampled transition: its stacks and their shifted copies (obs and next obs), the float
+  // images, the encoder's activations and their gradients (obs) and without (next obs), and the
+  // MLPs' activations.
+  const double per_sample = 4 * stack_bytes + 2 * kFloat * stack_bytes + 3 * kFloat * activations +
+                            kFloat * 4 * (features + vector_size) +
+                            kFloat * 24 * (hidden + feature_dim);
+  // Per replay slot: the newest frame, the vector keys, the action, reward, flags, start.
+  const double per_slot = stack_bytes / std::max<double>(1, d(input.stack)) +
+                          kFloat * (vector_size + actions + 1) + 1 + 8;
+  return {
+      {"replay_capacity", d(config.replay_capacity), "the replay buffer",
+       d(config.replay_capacity) * per_slot},
+      {"batch_size", d(config.batch_size), "the sampled batches and the activations of an update",
+       d(config.batch_size) * per_sample},
+      {"hidden_dim", d(config.hidden_dim),
+       "the actor's and critics' hidden layers (weights, gradients, Adam's moments, targets)",
+       mlp_bytes},
+      {"feature_dim", d(config.feature_dim),
+       "the trunks from the encoder's " + std::to_string(static_cast<std::int64_t>(features)) +
+           " features (weights, gradients, Adam's moments, target)",
+       trunk_bytes},
+  };
+}
+
 Agent::Agent(InputLayout input, const DrqV2Config& config)
     : input_(std::move(input)),
       autocast_(config.bfloat16 && cpu_has_bfloat16()),
@@ -443,9 +504,10 @@ void shift_frames(const std::uint8_t* images, std::uint8_t* shifted, std::int64_
     const std::int64_t dy = shifts[2 * b] - pad;
     const std::int64_t dx = shifts[2 * b + 1] - pad;
     // Output column x reads source column clamp(x + dx): the columns in range are one copy,
-    // the ones past an edge repeat the edge pixel.
-    const std::int64_t first = std::max<std::int64_t>(0, -dx);            // first x in range
-    const std::int64_t last = std::min<std::int64_t>(width, width - dx);  // one past the last
+    // the ones past an edge repeat the edge pixel. A shift as wide as the image (pad >= width)
+    // leaves no column in range: first == last, and every column repeats an edge.
+    const std::int64_t first = std::clamp<std::int64_t>(-dx, 0, width);  // first x in range
+    const std::int64_t last = std::clamp<std::int64_t>(width - dx, first, width);  // one past it
     for (std::int64_t f = 0; f < frames; ++f) {
       const std::uint8_t* source = images + (b * frames + f) * frame_bytes;
       std::uint8_t* dest = shifted + (b * frames + f) * frame_bytes;
@@ -456,8 +518,10 @@ void shift_frames(const std::uint8_t* images, std::uint8_t* shifted, std::int64_
         for (std::int64_t x = 0; x < first; ++x) {
           std::memcpy(out + x * channels, in, static_cast<std::size_t>(channels));
         }
-        std::memcpy(out + first * channels, in + (first + dx) * channels,
-                    static_cast<std::size_t>((last - first) * channels));
+        if (last > first) {
+          std::memcpy(out + first * channels, in + (first + dx) * channels,
+                      static_cast<std::size_t>((last - first) * channels));
+        }
         for (std::int64_t x = last; x < width; ++x) {
           std::memcpy(out + x * channels, in + (width - 1) * channels,
                       static_cast<std::size_t>(channels));

@@ -14,6 +14,7 @@
 
 #include "envs/space.h"
 #include "examples/trainer/drqv2/replay_buffer.h"
+#include "examples/trainer/run/memory_budget.h"
 
 namespace pixelgym::drqv2 {
 
@@ -140,6 +141,14 @@ struct InputLayout {
 /// action space among them).
 InputLayout input_layout(const Space& observation_space, const Space& action_space,
                          std::int64_t frame_stack, const std::string& env_name);
+
+/// The memory a run of `config` on inputs `input` needs, by the member that sets each part
+/// (replay_capacity: the replay buffer; batch_size: the sampled batches, their copies and the
+/// activations kept for backward; hidden_dim and feature_dim: the weights with their gradients,
+/// Adam's moments and the target copies). An estimate within a factor of about 2, for refusing
+/// settings that cannot fit (trainer::require_memory), not for planning to the byte.
+std::vector<trainer::MemoryUse> memory_estimate(const InputLayout& input,
+                                                const DrqV2Config& config);
 
 /// The encoder, actor, critic and target critic. Built from torch's default generator (call
 /// torch::manual_seed first). Orthogonal weights (gain sqrt(2) before ReLU, else 1), zero

@@ -66,6 +66,10 @@ const DrqV2Config& checked(const DrqV2Config& config, const vector::VectorEnv& e
     throw std::invalid_argument("drqv2: config num_envs is " + std::to_string(config.num_envs) +
                                 " but the vector env has " + std::to_string(env.num_envs()));
   }
+  trainer::require_memory("drqv2", memory_estimate(input_layout(env.single_observation_space(),
+                                                                env.single_action_space(),
+                                                                config.frame_stack, env.name()),
+                                                   config));
   return config;
 }
 

@@ -65,15 +65,25 @@ void PpoConfig::validate() const {
       fail(std::string(name) + " must be in [0, 1], got " + std::to_string(value));
     }
   };
-  positive("num_envs", static_cast<double>(num_envs));
-  positive("num_steps", static_cast<double>(num_steps));
-  positive("total_env_steps", static_cast<double>(total_env_steps));
+  // Counts are at most 2^40 (about 1.1e12): far past any run, and far from overflowing the
+  // products of counts that sizes are made of (num_steps * num_envs); the memory they take is
+  // checked with the env (memory_estimate).
+  constexpr std::int64_t kMost = std::int64_t{1} << 40;
+  auto count = [&](const char* name, std::int64_t value) {
+    if (value < 1 || value > kMost) {
+      fail(std::string(name) + " must be from 1 to " + std::to_string(kMost) + ", got " +
+           std::to_string(value));
+    }
+  };
+  count("num_envs", num_envs);
+  count("num_steps", num_steps);
+  count("total_env_steps", total_env_steps);
   positive("learning_rate", learning_rate);
   positive("adam_epsilon", adam_epsilon);
   unit("gamma", gamma);
   unit("gae_lambda", gae_lambda);
-  positive("update_epochs", static_cast<double>(update_epochs));
-  positive("num_minibatches", static_cast<double>(num_minibatches));
+  count("update_epochs", update_epochs);
+  count("num_minibatches", num_minibatches);
   if (num_minibatches > 0 && (num_steps * num_envs) % num_minibatches != 0) {
     fail("num_steps * num_envs (" + std::to_string(num_steps * num_envs) +
          ") must be a multiple of num_minibatches (" + std::to_string(num_minibatches) + ")");
@@ -83,7 +93,9 @@ void PpoConfig::validate() const {
   non_negative("value_coef", value_coef);
   positive("max_grad_norm", max_grad_norm);
   non_negative("target_kl", target_kl);
-  if (shift_pad < 0) fail("shift_pad must be >= 0, got " + std::to_string(shift_pad));
+  if (shift_pad < 0 || shift_pad > 65536) {
+    fail("shift_pad must be from 0 to 65536, got " + std::to_string(shift_pad));
+  }
   unit("preempt_done_fraction", preempt_done_fraction);
   unit("preempt_min_steps_fraction", preempt_min_steps_fraction);
   if (preempt_stragglers && num_minibatches > 0 &&
@@ -310,6 +322,8 @@ constexpr std::uint64_t kRankSeedStride = 1'000'003;
 
 std::shared_ptr<Policy> make_policy(const vector::VectorEnv& env, const PpoConfig& config) {
   config.validate();
+  trainer::require_memory(
+      "ppo", memory_estimate(env.single_observation_space(), env.single_action_space(), config));
   if (env.autoreset_mode() != vector::AutoresetMode::kSameStep) {
     throw std::invalid_argument(
         std::string("Trainer: the vector env must autoreset in SameStep mode (truncated steps "
@@ -326,6 +340,56 @@ std::shared_ptr<Policy> make_policy(const vector::VectorEnv& env, const PpoConfi
 }
 
 }  // namespace
+
+std::vector<trainer::MemoryUse> memory_estimate(const Space& observation_space,
+                                                const Space& action_space,
+                                                const PpoConfig& config) {
+  const auto d = [](std::int64_t value) { return static_cast<double>(value); };
+  constexpr double kFloat = 4.0;
+  double observation_bytes = 0;
+  double observation_elements = 0;
+  double image_elements = 0;  // uint8 keys: the CNNs' inputs
+  for (const Array& array : observation_space.zeros().leaves()) {
+    observation_bytes += static_cast<double>(array.nbytes());
+    observation_elements += static_cast<double>(array.size());
+    if (array.dtype() == DType::kUInt8) image_elements += static_cast<double>(array.size());
+  }
+  double action_elements = 0;
+  for (const Array& array : action_space.zeros().leaves()) {
+    action_elements += static_cast<double>(array.size());
+  }
+  const PolicyConfig& policy = config.policy;
+  // Per stored step of one env: its observation, action (int64 or float32) and the ten per-step
+  // figures; per sample of a minibatch: the float observation (twice with augmentation) and the
+  // activations kept for backward, about six times the input.
+  const double per_step = observation_bytes + 8 * action_elements + 10 * kFloat;
+  const double minibatch = d(config.num_steps) * d(config.num_envs) / d(config.num_minibatches);
+  const double per_sample = kFloat * 8 * observation_elements;
+  // The widths: the CNN's closing layer reads at most a quarter of the input's elements (a
+  // stride of 2 or more, 32 or fewer channels), the trunk the fused features; trained weights are
+  // kept four times (weights, gradients, Adam's two moments), twice with a value network.
+  double mlp = 0;
+  double widest = 0;
+  double previous = observation_elements - image_elements;
+  for (const std::int64_t width : policy.mlp_hidden) {
+    mlp += previous * d(width);
+    previous = d(width);
+    widest = std::max(widest, d(width));
+  }
+  const double fused = (image_elements > 0 ? d(policy.cnn_features) : 0) + previous;
+  const double copies = kFloat * 4 * (policy.separate_value_network ? 2 : 1);
+  return {
+      {"num_steps", d(config.num_steps),
+       "the rollout of " + std::to_string(config.num_envs) +
+           " envs and the activations of a minibatch",
+       d(config.num_steps) * d(config.num_envs) * per_step + minibatch * per_sample},
+      {"policy.cnn_features", d(policy.cnn_features), "the CNN's closing layer",
+       copies * d(policy.cnn_features) * image_elements / 4},
+      {"policy.mlp_hidden", widest, "the MLP over the vector keys", copies * mlp},
+      {"policy.trunk_hidden", d(policy.trunk_hidden), "the trunk and heads",
+       copies * d(policy.trunk_hidden) * (fused + action_elements + 1)},
+  };
+}
 
 Trainer::Trainer(vector::VectorEnv& env, PpoConfig config, trainer::Communicator* communicator)
     : config_(std::move(config)),

@@ -15,6 +15,7 @@
 #include "envs/vector/vector_env.h"
 #include "examples/trainer/ppo/policy.h"
 #include "examples/trainer/run/communicator.h"
+#include "examples/trainer/run/memory_budget.h"
 #include "wrappers/running_statistics.h"
 #include "wrappers/vector/normalize_reward.h"
 #include "wrappers/vector/record_episode_statistics.h"
@@ -89,6 +90,13 @@ struct PpoConfig {
   /// Throws std::invalid_argument naming the first field out of range and its value.
   void validate() const;
 };
+
+/// The memory a run of `config` on envs of these spaces needs, by the member that sets each
+/// part: num_steps (the rollout storage and a minibatch's activations) and the policy's widths
+/// (weights, gradients and Adam's moments). An estimate within a factor of about 2, for refusing
+/// settings that cannot fit (trainer::require_memory; Trainer does), not for planning.
+std::vector<trainer::MemoryUse> memory_estimate(const Space& observation_space,
+                                                const Space& action_space, const PpoConfig& config);
 
 /// JSON form of PpoConfig: an object with one member per field, named as the fields, the CNN by
 /// its name (to_string(CnnArchitecture)), `policy` a nested object. from_json takes any subset of

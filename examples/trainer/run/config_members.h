@@ -2,25 +2,73 @@
 // the member and what was wrong (an unknown member lists the known ones).
 #pragma once
 
+#include <cmath>
+#include <cstdint>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace pixelgym::trainer {
 
+/// Reads an integer member's value: an integer, or a number with no fraction (1e6) that `T`
+/// holds. Throws std::invalid_argument "{what} JSON: member \"{name}\" must be an integer from
+/// {lowest} to {highest}, got {value}" otherwise: JSON's conversions truncate 2.9 to 2, wrap -1
+/// to 2^64 - 1 and leave 1e30 undefined.
+template <typename T>
+T integer_member(const nlohmann::json& value, const char* name, const char* what) {
+  static_assert(std::is_integral_v<T> && !std::is_same_v<T, bool>);
+  using Limits = std::numeric_limits<T>;
+  const auto refuse = [&] {
+    throw std::invalid_argument(std::string(what) + " JSON: member \"" + name +
+                                "\" must be an integer from " + std::to_string(Limits::min()) +
+                                " to " + std::to_string(Limits::max()) + ", got " + value.dump());
+  };
+  if (value.is_number_unsigned()) {
+    const auto number = value.get<std::uint64_t>();
+    if (number > static_cast<std::uint64_t>(Limits::max())) refuse();
+    return static_cast<T>(number);
+  }
+  if (value.is_number_integer()) {
+    const auto number = value.get<std::int64_t>();
+    if (number < 0 && !Limits::is_signed) refuse();
+    if (Limits::is_signed && (number < static_cast<std::int64_t>(Limits::min()) ||
+                              number > static_cast<std::int64_t>(Limits::max()))) {
+      refuse();
+    }
+    return static_cast<T>(number);
+  }
+  if (value.is_number_float()) {
+    // Exactly representable bounds: min() is -2^k or 0, and max() + 1 is 2^k.
+    const double number = value.get<double>();
+    const double below = static_cast<double>(Limits::min());
+    const double past = static_cast<double>(Limits::max() / 2 + 1) * 2.0;
+    if (!(number >= below && number < past) || std::trunc(number) != number) refuse();
+    return static_cast<T>(number);
+  }
+  throw std::invalid_argument(std::string(what) + " JSON: member \"" + name +
+                              "\" has the wrong type: expected an integer, got " +
+                              value.type_name() + " " + value.dump());
+}
+
 /// Reads member `name` of `json` into `field` when present (absent: `field` keeps its value).
 /// Throws std::invalid_argument "{what} JSON: member \"{name}\" has the wrong type: ..." when it
-/// does not convert.
+/// does not convert; integers as integer_member reads them.
 template <typename T>
 void read_member(const nlohmann::json& json, const char* name, T& field, const char* what) {
   const auto found = json.find(name);
   if (found == json.end()) return;
-  try {
-    field = found->get<T>();
-  } catch (const nlohmann::json::exception& error) {
-    throw std::invalid_argument(std::string(what) + " JSON: member \"" + name +
-                                "\" has the wrong type: " + error.what());
+  if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
+    field = integer_member<T>(*found, name, what);
+  } else {
+    try {
+      field = found->get<T>();
+    } catch (const nlohmann::json::exception& error) {
+      throw std::invalid_argument(std::string(what) + " JSON: member \"" + name +
+                                  "\" has the wrong type: " + error.what());
+    }
   }
 }
 

@@ -1,7 +1,6 @@
 #include "examples/trainer/run/evaluation.h"
 
 #include <cmath>
-#include <fstream>
 #include <memory>
 #include <stdexcept>
 #include <utility>
@@ -65,14 +64,13 @@ std::pair<RunSettings, const AlgorithmFactory*> checkpoint_settings(
   if (const auto embedded = checkpoint.blobs.find("config"); embedded != checkpoint.blobs.end()) {
     return read(json::parse(embedded->second), checkpoint.path);
   }
-  std::ifstream config_file(folder / "config.json");
-  if (!config_file) {
+  if (!fs::exists(folder / "config.json")) {
     throw std::runtime_error("eval: " + checkpoint.path.string() +
                              " does not carry its run's settings, and there is no config.json "
                              "in " +
                              folder.string() + " (the run folder it belongs to)");
   }
-  return read(json::parse(config_file), folder / "config.json");
+  return read(read_run_config(folder / "config.json", "eval"), folder / "config.json");
 }
 
 }  // namespace

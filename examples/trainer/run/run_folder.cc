@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <fstream>
 #include <stdexcept>
 #include <system_error>
 #include <utility>
@@ -77,22 +78,27 @@ RunFolder::~RunFolder() {
 RunLock RunLock::acquire(const fs::path& folder, const std::string& what) {
   std::error_code error;
   fs::create_directories(folder, error);
-  const fs::path path = folder / ".lock";
-  const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  // The lock is on the folder itself, which cannot be unlinked from under the run while it holds
+  // files: a lock on a file in it was defeated by deleting that file, after which a second run
+  // locked a new one and both wrote one progress.csv. .lock only tells the second the PID.
+  const fs::path pid_path = folder / ".lock";
+  const int fd = error ? -1 : ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (error || fd < 0) {
     throw std::runtime_error(what + ": cannot lock the run folder " + quoted(folder) + ": " +
                              (error ? error.message() : std::string(std::strerror(errno))));
   }
   if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
     const int reason = errno;
-    char text[32] = {};
-    const ssize_t got = ::pread(fd, text, sizeof(text) - 1, 0);
     ::close(fd);
-    std::string holder = got > 0 ? std::string(text, static_cast<std::size_t>(got)) : "";
-    holder.erase(holder.find_last_not_of(" \n") + 1);
     if (reason != EWOULDBLOCK) {
       throw std::runtime_error(what + ": cannot lock the run folder " + quoted(folder) + ": " +
                                std::strerror(reason));
+    }
+    std::string holder;
+    if (std::ifstream pid_file(pid_path); pid_file) std::getline(pid_file, holder);
+    holder.erase(holder.find_last_not_of(" \n") + 1);
+    if (holder.size() > 20 || holder.find_first_not_of("0123456789") != std::string::npos) {
+      holder.clear();
     }
     throw std::runtime_error(
         what + ": " + quoted(folder) + " is in use: another process" +
@@ -100,8 +106,12 @@ RunLock RunLock::acquire(const fs::path& folder, const std::string& what) {
         " is training in it; wait for it to end, or stop it, before training there");
   }
   const std::string pid = std::to_string(::getpid()) + "\n";
-  if (::ftruncate(fd, 0) != 0 || ::pwrite(fd, pid.data(), pid.size(), 0) < 0) {
-    // The lock holds; only the PID in the message of a second process is lost.
+  const int pid_fd = ::open(pid_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (pid_fd >= 0) {
+    // The lock holds without it; only the PID in the message of a second process is lost.
+    const ssize_t written = ::write(pid_fd, pid.data(), pid.size());
+    static_cast<void>(written);
+    ::close(pid_fd);
   }
   return RunLock(fd);
 }

@@ -79,9 +79,11 @@ class RunFolder {
   int progress_fd_ = -1;
 };
 
-/// The lock of a run folder while a process trains in it: an exclusive flock(2) on
-/// {folder}/.lock, which holds the holder's PID. The kernel releases it when the holder exits
-/// (however it ends), so a lock left by a dead process never blocks; the file stays.
+/// The lock of a run folder while a process trains in it: an exclusive flock(2) on the folder
+/// itself (a folder that holds files cannot be removed, where a lock file could be deleted from
+/// under the run); {folder}/.lock holds the holder's PID for the message of a second process.
+/// The kernel releases it when the holder exits (however it ends), so a lock left by a dead
+/// process never blocks; .lock stays.
 class RunLock {
  public:
   /// Takes the lock of `folder` (created with its parents). Throws std::runtime_error

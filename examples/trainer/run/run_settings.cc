@@ -1,5 +1,6 @@
 #include "examples/trainer/run/run_settings.h"
 
+#include <fstream>
 #include <stdexcept>
 
 #include "envs/registry.h"
@@ -65,8 +66,67 @@ RunSettings settings_from_json(const json& in, const std::filesystem::path& wher
   }
 }
 
+json read_run_config(const std::filesystem::path& path, const std::string& what) {
+  std::ifstream file(path);
+  if (!file) {
+    throw std::runtime_error(what + ": no " + path.filename().string() + " in " +
+                             path.parent_path().string());
+  }
+  json config;
+  try {
+    config = json::parse(file);
+  } catch (const json::exception& error) {
+    throw std::runtime_error(path.string() + ": not valid JSON (" + error.what() +
+                             "); it was written whole, so it was changed after: restore it");
+  }
+  if (!config.is_object()) {
+    throw std::runtime_error(path.string() + ": not a pixelgym train config: the file holds " +
+                             config.type_name() + ", not an object");
+  }
+  return config;
+}
+
+std::string settings_differences(const RunSettings& run, const RunSettings& checkpoint) {
+  json mine = settings_to_json(run);
+  json theirs = settings_to_json(checkpoint);
+  for (json* settings : {&mine, &theirs}) {
+    settings->erase("minutes");
+    if (settings->contains(run.algorithm)) (*settings)[run.algorithm].erase("total_env_steps");
+  }
+  std::string differ;
+  const auto note = [&](const std::string& name, const json& a, const json& b) {
+    if (a == b) return;
+    differ += (differ.empty() ? "" : "; ") + name + ": config.json has " +
+              (a.is_null() ? std::string("none") : a.dump()) + ", the checkpoint " +
+              (b.is_null() ? std::string("none") : b.dump());
+  };
+  const auto value = [](const json& object, const std::string& key) {
+    const auto found = object.find(key);
+    return found == object.end() ? json() : *found;
+  };
+  json keys = mine;
+  keys.update(theirs);
+  for (const auto& item : keys.items()) {
+    const json a = value(mine, item.key());
+    const json b = value(theirs, item.key());
+    if (item.key() == run.algorithm && a.is_object() && b.is_object()) {
+      json members = a;
+      members.update(b);
+      for (const auto& member : members.items()) {
+        note(item.key() + "." + member.key(), value(a, member.key()), value(b, member.key()));
+      }
+    } else {
+      note(item.key(), a, b);
+    }
+  }
+  return differ;
+}
+
 const AlgorithmFactory& algorithm_of(const json& in, const std::filesystem::path& where,
                                      const AlgorithmFactories& algorithms) {
+  if (in.is_discarded()) {
+    throw std::runtime_error(where.string() + ": not valid JSON");
+  }
   std::string names;
   for (const AlgorithmFactory* algorithm : algorithms) {
     if (in.is_object() && in.contains(algorithm->name())) return *algorithm;

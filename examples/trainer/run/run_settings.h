@@ -67,6 +67,18 @@ nlohmann::json settings_to_json(const RunSettings& settings);
 RunSettings settings_from_json(const nlohmann::json& in, const std::filesystem::path& where,
                                const AlgorithmFactory& algorithm);
 
+/// The JSON of the run config at `path` (config.json). Throws std::runtime_error "{what}: no
+/// config.json in {folder}" when it cannot be opened, and "{path}: not valid JSON ({the parser's
+/// message, with the byte}); ..." or "{path}: not a pixelgym train config: the file holds {type},
+/// not an object" when it is corrupt.
+nlohmann::json read_run_config(const std::filesystem::path& path, const std::string& what);
+
+/// The settings of `checkpoint` ("config" blob) that differ from `run`'s (config.json's), but
+/// the budget (total_env_steps and minutes, which a resume may change): "name: config.json has A,
+/// the checkpoint B" joined by "; " (the algorithm's members as "{algorithm}.{member}"); "" when
+/// none differs, or when the checkpoint carries no settings (written before they were saved).
+std::string settings_differences(const RunSettings& run, const RunSettings& checkpoint);
+
 /// The algorithms a run may use, by AlgorithmFactory::name.
 using AlgorithmFactories = std::vector<const AlgorithmFactory*>;
 

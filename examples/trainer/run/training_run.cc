@@ -184,11 +184,7 @@ TrainingRun TrainingRun::create(const AlgorithmFactory& algorithm, EnvKwargsPars
 TrainingRun TrainingRun::resume(const AlgorithmFactory& algorithm, EnvKwargsParser parse_sets,
                                 fs::path folder, TrainBudget budget, const ResumeChecks& given,
                                 RunOutput output) {
-  std::ifstream config_file(folder / "config.json");
-  if (!config_file) {
-    throw std::runtime_error("--resume " + folder.string() + ": no config.json there");
-  }
-  const json config = json::parse(config_file);
+  const json config = read_run_config(folder / "config.json", "--resume " + folder.string());
   RunSettings settings = settings_from_json(config, folder / "config.json", algorithm);
   check_resume_settings(given, settings, folder);
   // Before the checkpoint is read: a run being trained by another process is left to it.
@@ -231,6 +227,21 @@ void TrainingRun::load_resume_point(const json& config) {
   }
   checkpoint_ = std::move(search.latest);
   meta_ = read_meta(*checkpoint_);
+  // The checkpoint's own settings are the run's: a config.json edited since (another env, a
+  // wider network, another batch) would be recorded as the run's while the checkpoint's network
+  // and envs go on, or would train another env from this one's state.
+  if (const auto saved = checkpoint_->blobs.find("config"); saved != checkpoint_->blobs.end()) {
+    const json saved_json = json::parse(saved->second, nullptr, /*allow_exceptions=*/false);
+    const std::string differ = settings_differences(
+        settings_, settings_from_json(saved_json, checkpoint_->path, *factory_));
+    if (!differ.empty()) {
+      throw std::runtime_error(
+          "--resume " + folder_.string() + ": config.json differs from the settings " +
+          checkpoint_->path.filename().string() + " was trained with (" + differ +
+          "); config.json was edited after the run started: restore it, or train a new run "
+          "with these settings into another --out");
+    }
+  }
   wall_before_s_ = meta_.at("wall_time_s").get<double>();
 }
 

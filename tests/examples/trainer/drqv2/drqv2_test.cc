@@ -178,6 +178,34 @@ TEST(DrqV2AugmentationTest, ShiftsMatchPpoRandomShiftAndStayInsideThePaddedWindo
   }
 }
 
+// A pad wider and taller than the image (shift_pad 65 at 64x64 once wrote out of bounds: the
+// copy's length went negative): shifts past an edge repeat the edge pixel, as replicate padding
+// by that much and cropping does, and as ppo::random_shift computes it.
+TEST(DrqV2AugmentationTest, APadLargerThanTheImageRepeatsTheEdges) {
+  const std::int64_t batch = 7, frames = 2, h = 6, w = 5, c = 1, pad = 13;
+  std::mt19937 rng(11);
+  std::vector<std::uint8_t> images(static_cast<std::size_t>(batch * frames * h * w * c));
+  for (auto& v : images) v = static_cast<std::uint8_t>(rng());
+  // Offsets 0 and 2 pad shift the whole image past an edge; pad - w and pad + w just so.
+  std::vector<std::int64_t> shifts = {0,       0,       2 * pad, 2 * pad, 0,       2 * pad, pad - w,
+                                      pad + w, pad + w, pad - w, pad - 1, pad + 4, pad,     pad};
+  std::vector<std::uint8_t> shifted(images.size(), 0);
+  shift_frames(images.data(), shifted.data(), batch, frames, h, w, c, pad, shifts.data());
+  const auto as_chw = [&](std::vector<std::uint8_t>& bytes) {
+    return torch::from_blob(bytes.data(), {batch, frames, h, w, c}, torch::kUInt8)
+        .permute({0, 1, 4, 2, 3})
+        .reshape({batch, frames * c, h, w})
+        .to(torch::kFloat32);
+  };
+  const torch::Tensor expected =
+      ppo::random_shift(as_chw(images), torch::tensor(shifts, torch::kInt64).view({batch, 2}), pad);
+  EXPECT_TRUE(torch::equal(as_chw(shifted), expected));
+  // Offset (0, 0) reads from 13 rows above and columns left of the image: every pixel of the
+  // first frame is the source's top-left one.
+  const std::size_t frame = static_cast<std::size_t>(h * w * c);
+  for (std::size_t i = 0; i < frame; ++i) EXPECT_EQ(shifted[i], images[0]) << i;
+}
+
 // A learner on 32x32 gray stacks of 3 with one state key, and a batch of random transitions.
 struct Fixture {
   InputLayout input;

@@ -104,6 +104,25 @@ TEST(RunLockTest, ASecondLockIsRefusedNamingTheHolderAndAStaleOneDoesNotBlock) {
   EXPECT_NO_THROW(RunLock::acquire(folder, "train"));
 }
 
+// Deleting .lock (or all of the folder's files) while a run holds the lock does not free it: a
+// lock on the file itself was granted to a second run, and both then wrote one progress.csv.
+TEST(RunLockTest, DeletingTheLockFileDoesNotFreeTheLock) {
+  const fs::path folder = fresh_folder("run_lock_deleted");
+  const RunLock held = RunLock::acquire(folder, "train");
+  std::ofstream(folder / "progress.csv") << "steps\n";
+  fs::remove(folder / ".lock");
+  EXPECT_THROW(RunLock::acquire(folder, "train"), std::runtime_error);
+  fs::remove(folder / "progress.csv");
+  EXPECT_THROW(RunLock::acquire(folder, "train --resume"), std::runtime_error);
+  // Without the PID file the refusal still says why, only without the PID.
+  try {
+    RunLock::acquire(folder, "train");
+    FAIL() << "a second lock was granted";
+  } catch (const std::runtime_error& error) {
+    EXPECT_THAT(error.what(), HasSubstr("\" is in use: another process is training in it"));
+  }
+}
+
 TEST(RunFolderTest, CreateRejectsABadConfig) {
   const fs::path folder = fresh_folder("run_bad_config");
   EXPECT_THROW(RunFolder::create(folder, nlohmann::json::array()), std::invalid_argument);
