@@ -16,6 +16,9 @@
 #include <set>
 #include <sstream>
 
+#include "engine/regular_file.h"
+#include "engine/xml_depth.h"
+
 namespace pixelgym::engine {
 namespace fs = std::filesystem;
 
@@ -60,60 +63,25 @@ struct XmlFacts {
 };
 
 std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, "cannot be read (missing or unreadable)");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+  try {
+    return read_regular_file(path, "a URDF file", kMaxUrdfBytes);
+  } catch (const FileProblem& problem) {
+    fail(path, problem.what());
+  }
 }
 
-// The deepest nesting of elements in `text`, counted without parsing it (tinyxml, under urdfdom,
-// parses recursively: a file nested 50,000 deep overflowed the stack). Comments, declarations,
-// processing instructions, CDATA and quoted attribute values are skipped; it need not be exact
-// for malformed XML, which the parser then refuses.
-std::size_t element_depth(const std::string& text) {
-  std::size_t depth = 0;
-  std::size_t deepest = 0;
-  std::size_t i = 0;
-  const auto skip_past = [&](const char* end) {
-    const std::size_t found = text.find(end, i);
-    i = found == std::string::npos ? text.size() : found + std::strlen(end);
-  };
-  while (i < text.size()) {
-    if (text[i] != '<') {
-      ++i;
-      continue;
-    }
-    if (text.compare(i, 4, "<!--") == 0) {
-      skip_past("-->");
-    } else if (text.compare(i, 9, "<![CDATA[") == 0) {
-      skip_past("]]>");
-    } else if (text.compare(i, 2, "<?") == 0 || text.compare(i, 2, "<!") == 0) {
-      skip_past(">");
-    } else if (text.compare(i, 2, "</") == 0) {
-      if (depth > 0) --depth;
-      skip_past(">");
-    } else {
-      // An opening tag: to its '>' outside quotes; "/>" closes it at once.
-      char quote = 0;
-      std::size_t j = i + 1;
-      for (; j < text.size(); ++j) {
-        const char c = text[j];
-        if (quote != 0) {
-          if (c == quote) quote = 0;
-        } else if (c == '"' || c == '\'') {
-          quote = c;
-        } else if (c == '>') {
-          break;
-        }
-      }
-      const bool self_closing = j < text.size() && j > i + 1 && text[j - 1] == '/';
-      if (!self_closing) deepest = std::max(deepest, ++depth);
-      i = j + 1;
-    }
+// Refuses `xml` (the file's text, or the text urdfdom is given) when TinyXML would nest elements
+// deeper than kMaxElementDepth in it: its recursion overflowed the stack on a file 50,000 deep.
+void check_element_depth(const std::string& xml, const std::string& path) {
+  if (tinyxml_element_depth(xml, kMaxElementDepth) > kMaxElementDepth) {
+    fail(path, "elements nested more than " + std::to_string(kMaxElementDepth) +
+                   " deep; a URDF nests at most " + std::to_string(kMaxElementDepth) +
+                   " (a robot's file needs about 6)");
   }
-  return deepest;
 }
+
+// `xml` with the zero bytes TinyXML must find after it (see kTinyXmlPadding).
+std::string padded(const std::string& xml) { return xml + std::string(kTinyXmlPadding, '\0'); }
 
 // The numbers in attribute `attribute` of `element`, when it has one: `count` of them, each
 // finite and (when `positive`) > 0, or the file is refused naming `where`. urdfdom reads them
@@ -209,13 +177,9 @@ void check_joint_numbers(const TiXmlElement* joint, const std::string& name,
 // Checks the structure that urdfdom reports poorly (or not at all) and rewrites capsules.
 XmlFacts inspect_xml(const std::string& path) {
   const std::string text = read_file(path);
-  const std::size_t depth = element_depth(text);
-  if (depth > kMaxElementDepth) {
-    fail(path, "elements nested " + std::to_string(depth) + " deep; a URDF nests at most " +
-                   std::to_string(kMaxElementDepth) + " (a robot's file needs about 6)");
-  }
+  check_element_depth(text, path);
   TiXmlDocument document;
-  document.Parse(text.c_str());
+  document.Parse(padded(text).c_str());
   if (document.Error()) {
     fail(path, "malformed XML at line " + std::to_string(document.ErrorRow()) + ", column " +
                    std::to_string(document.ErrorCol()) + ": " + document.ErrorDesc());
@@ -516,6 +480,9 @@ std::string resolve_uri(const std::string& uri, const std::string& urdf_path) {
 
 std::shared_ptr<const RobotModel> parse_urdf(const std::string& path, MeshCache& meshes) {
   const XmlFacts facts = inspect_xml(path);
+  // urdfdom parses the XML as TinyXML prints it back, which need not nest as the file did: a
+  // declaration's values are printed without escaping, so '&lt;a&gt;' in one becomes '<a>'.
+  check_element_depth(facts.xml, path);
 
   urdf::ModelInterfaceSharedPtr urdf;
   std::string urdfdom_messages;
@@ -524,7 +491,7 @@ std::shared_ptr<const RobotModel> parse_urdf(const std::string& path, MeshCache&
     CapturedLog log;
     console_bridge::OutputHandler* previous = console_bridge::getOutputHandler();
     console_bridge::useOutputHandler(&log);
-    urdf = urdf::parseURDF(facts.xml);
+    urdf = urdf::parseURDF(padded(facts.xml));
     console_bridge::useOutputHandler(previous);
     urdfdom_messages = log.messages;
   }
