@@ -115,12 +115,48 @@ void check_numbers(const TiXmlElement* element, const char* attribute, std::size
   }
 }
 
-// An origin's xyz and rpy: three finite numbers each.
+// The numbers of attribute `attribute` of `element` (already checked to be finite), each within
+// [-max_abs, max_abs], or the file is refused naming `where`, the value and the range. A finite but
+// huge value (a limit of 1e300) passed the finite check and failed later, deep in the physics or
+// the renderer, without naming the file.
+void check_magnitudes(const TiXmlElement* element, const char* attribute, double max_abs,
+                      const char* units, const std::string& path, const std::string& where) {
+  if (element == nullptr || element->Attribute(attribute) == nullptr) return;
+  const char* text = element->Attribute(attribute);
+  for (const char* at = text; *at != '\0';) {
+    while (std::isspace(static_cast<unsigned char>(*at)) != 0) ++at;
+    char* end = nullptr;
+    const double value = std::strtod(at, &end);
+    if (end == at) break;
+    if (std::fabs(value) > max_abs) {
+      std::ostringstream message;
+      message << where << " <" << element->Value() << " " << attribute << "=\"" << text
+              << "\">: " << std::string(at, static_cast<std::size_t>(end - at)) << " is outside [-"
+              << max_abs << ", " << max_abs << "] " << units;
+      fail(path, message.str());
+    }
+    at = end;
+  }
+}
+
+// Bounds no real robot approaches, well inside what the physics and the renderer handle. An origin
+// 10 km from its parent link; a joint limit of 10,000 rad (1,600 turns) or 10 km; an actuator of
+// 1e9 N m or N; a speed of 1e6 rad/s or m/s; damping and friction of 1e9.
+constexpr double kMaxOffsetM = 1e4;
+constexpr double kMaxAngleRad = 1e4;
+constexpr double kMaxJointPosition = 1e4;
+constexpr double kMaxEffort = 1e9;
+constexpr double kMaxSpeed = 1e6;
+constexpr double kMaxDamping = 1e9;
+
+// An origin's xyz and rpy: three finite numbers each, within the bounds above.
 void check_origin(const TiXmlElement* parent, const std::string& path, const std::string& where) {
   if (parent == nullptr) return;
   const TiXmlElement* origin = parent->FirstChildElement("origin");
   check_numbers(origin, "xyz", 3, false, path, where);
   check_numbers(origin, "rpy", 3, false, path, where);
+  check_magnitudes(origin, "xyz", kMaxOffsetM, "m", path, where);
+  check_magnitudes(origin, "rpy", kMaxAngleRad, "rad", path, where);
 }
 
 // The numbers of a link's inertial, visuals and collisions: finite, sizes > 0, mass >= 0.
@@ -166,11 +202,18 @@ void check_joint_numbers(const TiXmlElement* joint, const std::string& name,
   const std::string where = "joint \"" + name + "\"";
   check_origin(joint, path, where);
   check_numbers(joint->FirstChildElement("axis"), "xyz", 3, false, path, where);
-  for (const char* limit : {"lower", "upper", "effort", "velocity"}) {
-    check_numbers(joint->FirstChildElement("limit"), limit, 1, false, path, where);
+  const TiXmlElement* limit = joint->FirstChildElement("limit");
+  for (const char* bound : {"lower", "upper", "effort", "velocity"}) {
+    check_numbers(limit, bound, 1, false, path, where);
   }
-  for (const char* dynamics : {"damping", "friction"}) {
-    check_numbers(joint->FirstChildElement("dynamics"), dynamics, 1, false, path, where);
+  check_magnitudes(limit, "lower", kMaxJointPosition, "rad or m", path, where);
+  check_magnitudes(limit, "upper", kMaxJointPosition, "rad or m", path, where);
+  check_magnitudes(limit, "effort", kMaxEffort, "N m or N", path, where);
+  check_magnitudes(limit, "velocity", kMaxSpeed, "rad/s or m/s", path, where);
+  const TiXmlElement* dynamics = joint->FirstChildElement("dynamics");
+  for (const char* coefficient : {"damping", "friction"}) {
+    check_numbers(dynamics, coefficient, 1, false, path, where);
+    check_magnitudes(dynamics, coefficient, kMaxDamping, "N m s/rad, N s/m, N m or N", path, where);
   }
 }
 

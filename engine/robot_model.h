@@ -205,11 +205,12 @@ inline constexpr std::size_t kMaxUrdfBytes = 32 * 1024 * 1024;
 /// followed) or a file larger than kMaxUrdfBytes, unreadable or malformed XML, elements nested
 /// deeper than kMaxElementDepth, no
 /// links, more than kMaxLinks links, a number that is not finite (an origin, an axis, a limit, a
-/// mass or inertia) or a size that is not > 0 (box, sphere, cylinder, capsule), a negative mass,
-/// two roots, a joint cycle, an unknown parent or child, an unsupported joint type (planar,
-/// floating), lower limit > upper limit, a zero axis, a moving link with non-positive mass or a
-/// non-positive-definite inertia, and any mesh that is missing, unreadable, of an unsupported
-/// format or without triangles.
+/// mass or inertia) or beyond the bounds no robot approaches (origin xyz ±1e4 m, rpy ±1e4 rad,
+/// joint limits ±1e4 rad or m, effort ±1e9, velocity ±1e6, damping and friction ±1e9) or a size
+/// that is not > 0 (box, sphere, cylinder, capsule), a negative mass, two roots, a joint cycle, an
+/// unknown parent or child, an unsupported joint type (planar, floating), lower limit > upper
+/// limit, a zero axis, a moving link with non-positive mass or a non-positive-definite inertia, and
+/// any mesh that is missing, unreadable, of an unsupported format or without triangles.
 std::shared_ptr<const RobotModel> parse_urdf(const std::string& path, MeshCache& meshes);
 
 /// Parses each URDF once and shares the result (and its meshes) with every caller. Thread-safe.

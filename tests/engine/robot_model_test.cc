@@ -289,6 +289,60 @@ TEST(RobotModelTest, OnlyRegularFilesOfBoundedSizeAreRead) {
   std::filesystem::remove_all(folder);
 }
 
+TEST(RobotModelTest, HugeFiniteLimitsAndOriginsAreRefusedNamingTheRange) {
+  // A limit of 1e300 made UrdfReach-v0's reset diverge ("joint_pos[0] is inf") and an origin of
+  // 1e200 failed in the camera ("the pose is not finite"), neither naming the URDF.
+  const auto urdf = [](const std::string& joint_origin, const std::string& limit) {
+    const std::string inertial =
+        "<inertial><mass value=\"1\"/><inertia ixx=\"0.01\" iyy=\"0.01\" izz=\"0.01\" "
+        "ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>";
+    return "<robot name=\"r\"><link name=\"a\">" + inertial + "</link><link name=\"b\">" +
+           inertial +
+           "</link><joint name=\"j\" type=\"prismatic\"><parent link=\"a\"/><child "
+           "link=\"b\"/><axis xyz=\"1 0 0\"/>" +
+           joint_origin + limit + "<dynamics damping=\"0.1\"/></joint></robot>";
+  };
+  const std::string limit = "<limit lower=\"-1\" upper=\"1\" effort=\"10\" velocity=\"1\"/>";
+  MeshCache meshes;
+  // At the bounds: accepted.
+  EXPECT_EQ(parse_urdf(write_temporary("at_bounds.urdf",
+                                       urdf("<origin xyz=\"10000 -10000 0\" rpy=\"0 -10000 0\"/>",
+                                            "<limit lower=\"-10000\" upper=\"10000\" "
+                                            "effort=\"1e9\" velocity=\"1e6\"/>")),
+                       meshes)
+                ->joints()[0]
+                .upper,
+            1e4);
+  struct Case {
+    std::string origin;
+    std::string limit;
+    std::string problem;
+  };
+  const std::vector<Case> cases = {
+      {"", "<limit lower=\"-1\" upper=\"1e300\" effort=\"10\" velocity=\"1\"/>",
+       "joint \"j\" <limit upper=\"1e300\">: 1e300 is outside [-10000, 10000] rad or m"},
+      {"", "<limit lower=\"-10000.1\" upper=\"1\" effort=\"10\" velocity=\"1\"/>",
+       "<limit lower=\"-10000.1\">: -10000.1 is outside [-10000, 10000] rad or m"},
+      {"<origin xyz=\"0 0 1e200\"/>", limit,
+       "joint \"j\" <origin xyz=\"0 0 1e200\">: 1e200 is outside [-10000, 10000] m"},
+      {"<origin rpy=\"0 0 -2e4\"/>", limit, "<origin rpy=\"0 0 -2e4\">: -2e4 is outside"},
+      {"", "<limit lower=\"-1\" upper=\"1\" effort=\"1.1e9\" velocity=\"1\"/>",
+       "<limit effort=\"1.1e9\">: 1.1e9 is outside [-1e+09, 1e+09] N m or N"},
+      {"", "<limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1e300\"/>",
+       "<limit velocity=\"1e300\">: 1e300 is outside [-1e+06, 1e+06] rad/s or m/s"},
+  };
+  for (const Case& c : cases) {
+    const std::string path = write_temporary("huge.urdf", urdf(c.origin, c.limit));
+    try {
+      parse_urdf(path, meshes);
+      FAIL() << c.problem << ": accepted";
+    } catch (const UrdfError& error) {
+      EXPECT_THAT(error.what(), HasSubstr("URDF " + path + ": "));
+      EXPECT_THAT(error.what(), HasSubstr(c.problem));
+    }
+  }
+}
+
 std::string chain_urdf(std::size_t links) {
   std::string text = "<robot name=\"chain\">";
   const std::string inertial =
