@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "engine/regular_file.h"
+
 namespace pixelgym::engine {
 namespace {
 
@@ -130,9 +132,12 @@ std::shared_ptr<const Mesh> load_mesh(const std::string& path) {
     throw std::runtime_error("mesh " + path + ": unsupported format \"" + extension +
                              "\" (supported: .obj, .stl, .dae, .ply)");
   }
-  std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error)) {
-    throw std::runtime_error("mesh " + path + ": file not found");
+  // assimp reads the file itself: refuse a FIFO or a device before it opens one (no size cap: a
+  // scanned mesh of hundreds of MB is a real input).
+  try {
+    check_regular_file(path, "a mesh");
+  } catch (const FileProblem& problem) {
+    throw std::runtime_error("mesh " + path + ": " + problem.what());
   }
   if (extension == ".ply") check_ply_header(path);
   Assimp::Importer importer;

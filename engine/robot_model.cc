@@ -16,6 +16,9 @@
 #include <set>
 #include <sstream>
 
+#include "engine/regular_file.h"
+#include "engine/xml_depth.h"
+
 namespace pixelgym::engine {
 namespace fs = std::filesystem;
 
@@ -60,60 +63,25 @@ struct XmlFacts {
 };
 
 std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, "cannot be read (missing or unreadable)");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+  try {
+    return read_regular_file(path, "a URDF file", kMaxUrdfBytes);
+  } catch (const FileProblem& problem) {
+    fail(path, problem.what());
+  }
 }
 
-// The deepest nesting of elements in `text`, counted without parsing it (tinyxml, under urdfdom,
-// parses recursively: a file nested 50,000 deep overflowed the stack). Comments, declarations,
-// processing instructions, CDATA and quoted attribute values are skipped; it need not be exact
-// for malformed XML, which the parser then refuses.
-std::size_t element_depth(const std::string& text) {
-  std::size_t depth = 0;
-  std::size_t deepest = 0;
-  std::size_t i = 0;
-  const auto skip_past = [&](const char* end) {
-    const std::size_t found = text.find(end, i);
-    i = found == std::string::npos ? text.size() : found + std::strlen(end);
-  };
-  while (i < text.size()) {
-    if (text[i] != '<') {
-      ++i;
-      continue;
-    }
-    if (text.compare(i, 4, "<!--") == 0) {
-      skip_past("-->");
-    } else if (text.compare(i, 9, "<![CDATA[") == 0) {
-      skip_past("]]>");
-    } else if (text.compare(i, 2, "<?") == 0 || text.compare(i, 2, "<!") == 0) {
-      skip_past(">");
-    } else if (text.compare(i, 2, "</") == 0) {
-      if (depth > 0) --depth;
-      skip_past(">");
-    } else {
-      // An opening tag: to its '>' outside quotes; "/>" closes it at once.
-      char quote = 0;
-      std::size_t j = i + 1;
-      for (; j < text.size(); ++j) {
-        const char c = text[j];
-        if (quote != 0) {
-          if (c == quote) quote = 0;
-        } else if (c == '"' || c == '\'') {
-          quote = c;
-        } else if (c == '>') {
-          break;
-        }
-      }
-      const bool self_closing = j < text.size() && j > i + 1 && text[j - 1] == '/';
-      if (!self_closing) deepest = std::max(deepest, ++depth);
-      i = j + 1;
-    }
+// Refuses `xml` (the file's text, or the text urdfdom is given) when TinyXML would nest elements
+// deeper than kMaxElementDepth in it: its recursion overflowed the stack on a file 50,000 deep.
+void check_element_depth(const std::string& xml, const std::string& path) {
+  if (tinyxml_element_depth(xml, kMaxElementDepth) > kMaxElementDepth) {
+    fail(path, "elements nested more than " + std::to_string(kMaxElementDepth) +
+                   " deep; a URDF nests at most " + std::to_string(kMaxElementDepth) +
+                   " (a robot's file needs about 6)");
   }
-  return deepest;
 }
+
+// `xml` with the zero bytes TinyXML must find after it (see kTinyXmlPadding).
+std::string padded(const std::string& xml) { return xml + std::string(kTinyXmlPadding, '\0'); }
 
 // The numbers in attribute `attribute` of `element`, when it has one: `count` of them, each
 // finite and (when `positive`) > 0, or the file is refused naming `where`. urdfdom reads them
@@ -147,12 +115,48 @@ void check_numbers(const TiXmlElement* element, const char* attribute, std::size
   }
 }
 
-// An origin's xyz and rpy: three finite numbers each.
+// The numbers of attribute `attribute` of `element` (already checked to be finite), each within
+// [-max_abs, max_abs], or the file is refused naming `where`, the value and the range. A finite but
+// huge value (a limit of 1e300) passed the finite check and failed later, deep in the physics or
+// the renderer, without naming the file.
+void check_magnitudes(const TiXmlElement* element, const char* attribute, double max_abs,
+                      const char* units, const std::string& path, const std::string& where) {
+  if (element == nullptr || element->Attribute(attribute) == nullptr) return;
+  const char* text = element->Attribute(attribute);
+  for (const char* at = text; *at != '\0';) {
+    while (std::isspace(static_cast<unsigned char>(*at)) != 0) ++at;
+    char* end = nullptr;
+    const double value = std::strtod(at, &end);
+    if (end == at) break;
+    if (std::fabs(value) > max_abs) {
+      std::ostringstream message;
+      message << where << " <" << element->Value() << " " << attribute << "=\"" << text
+              << "\">: " << std::string(at, static_cast<std::size_t>(end - at)) << " is outside [-"
+              << max_abs << ", " << max_abs << "] " << units;
+      fail(path, message.str());
+    }
+    at = end;
+  }
+}
+
+// Bounds no real robot approaches, well inside what the physics and the renderer handle. An origin
+// 10 km from its parent link; a joint limit of 10,000 rad (1,600 turns) or 10 km; an actuator of
+// 1e9 N m or N; a speed of 1e6 rad/s or m/s; damping and friction of 1e9.
+constexpr double kMaxOffsetM = 1e4;
+constexpr double kMaxAngleRad = 1e4;
+constexpr double kMaxJointPosition = 1e4;
+constexpr double kMaxEffort = 1e9;
+constexpr double kMaxSpeed = 1e6;
+constexpr double kMaxDamping = 1e9;
+
+// An origin's xyz and rpy: three finite numbers each, within the bounds above.
 void check_origin(const TiXmlElement* parent, const std::string& path, const std::string& where) {
   if (parent == nullptr) return;
   const TiXmlElement* origin = parent->FirstChildElement("origin");
   check_numbers(origin, "xyz", 3, false, path, where);
   check_numbers(origin, "rpy", 3, false, path, where);
+  check_magnitudes(origin, "xyz", kMaxOffsetM, "m", path, where);
+  check_magnitudes(origin, "rpy", kMaxAngleRad, "rad", path, where);
 }
 
 // The numbers of a link's inertial, visuals and collisions: finite, sizes > 0, mass >= 0.
@@ -198,24 +202,27 @@ void check_joint_numbers(const TiXmlElement* joint, const std::string& name,
   const std::string where = "joint \"" + name + "\"";
   check_origin(joint, path, where);
   check_numbers(joint->FirstChildElement("axis"), "xyz", 3, false, path, where);
-  for (const char* limit : {"lower", "upper", "effort", "velocity"}) {
-    check_numbers(joint->FirstChildElement("limit"), limit, 1, false, path, where);
+  const TiXmlElement* limit = joint->FirstChildElement("limit");
+  for (const char* bound : {"lower", "upper", "effort", "velocity"}) {
+    check_numbers(limit, bound, 1, false, path, where);
   }
-  for (const char* dynamics : {"damping", "friction"}) {
-    check_numbers(joint->FirstChildElement("dynamics"), dynamics, 1, false, path, where);
+  check_magnitudes(limit, "lower", kMaxJointPosition, "rad or m", path, where);
+  check_magnitudes(limit, "upper", kMaxJointPosition, "rad or m", path, where);
+  check_magnitudes(limit, "effort", kMaxEffort, "N m or N", path, where);
+  check_magnitudes(limit, "velocity", kMaxSpeed, "rad/s or m/s", path, where);
+  const TiXmlElement* dynamics = joint->FirstChildElement("dynamics");
+  for (const char* coefficient : {"damping", "friction"}) {
+    check_numbers(dynamics, coefficient, 1, false, path, where);
+    check_magnitudes(dynamics, coefficient, kMaxDamping, "N m s/rad, N s/m, N m or N", path, where);
   }
 }
 
 // Checks the structure that urdfdom reports poorly (or not at all) and rewrites capsules.
 XmlFacts inspect_xml(const std::string& path) {
   const std::string text = read_file(path);
-  const std::size_t depth = element_depth(text);
-  if (depth > kMaxElementDepth) {
-    fail(path, "elements nested " + std::to_string(depth) + " deep; a URDF nests at most " +
-                   std::to_string(kMaxElementDepth) + " (a robot's file needs about 6)");
-  }
+  check_element_depth(text, path);
   TiXmlDocument document;
-  document.Parse(text.c_str());
+  document.Parse(padded(text).c_str());
   if (document.Error()) {
     fail(path, "malformed XML at line " + std::to_string(document.ErrorRow()) + ", column " +
                    std::to_string(document.ErrorCol()) + ": " + document.ErrorDesc());
@@ -516,6 +523,9 @@ std::string resolve_uri(const std::string& uri, const std::string& urdf_path) {
 
 std::shared_ptr<const RobotModel> parse_urdf(const std::string& path, MeshCache& meshes) {
   const XmlFacts facts = inspect_xml(path);
+  // urdfdom parses the XML as TinyXML prints it back, which need not nest as the file did: a
+  // declaration's values are printed without escaping, so '&lt;a&gt;' in one becomes '<a>'.
+  check_element_depth(facts.xml, path);
 
   urdf::ModelInterfaceSharedPtr urdf;
   std::string urdfdom_messages;
@@ -524,7 +534,7 @@ std::shared_ptr<const RobotModel> parse_urdf(const std::string& path, MeshCache&
     CapturedLog log;
     console_bridge::OutputHandler* previous = console_bridge::getOutputHandler();
     console_bridge::useOutputHandler(&log);
-    urdf = urdf::parseURDF(facts.xml);
+    urdf = urdf::parseURDF(padded(facts.xml));
     console_bridge::useOutputHandler(previous);
     urdfdom_messages = log.messages;
   }

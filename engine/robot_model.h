@@ -190,17 +190,27 @@ std::string resolve_uri(const std::string& uri, const std::string& urdf_path);
 /// (a chain of 3,000 links took 722 MB, one of 10,000 5.7 GB).
 inline constexpr std::size_t kMaxLinks = 512;
 /// The deepest nesting of XML elements a URDF may have (a robot's file needs about 6); deeper
-/// files are refused before parsing, whose recursion would overflow the stack.
+/// files are refused before parsing, whose recursion would overflow the stack. The depth counted is
+/// TinyXML's (see tinyxml_element_depth in engine/xml_depth.h), in the file and in the XML urdfdom
+/// is then given.
 inline constexpr std::size_t kMaxElementDepth = 100;
+/// The largest URDF file read, in bytes: 32 MiB. A robot of kMaxLinks links, each with an inertial,
+/// a few visuals and collisions and a joint, takes about 2 KB a link, 1 MB in all; files generated
+/// with long comments or many digits stay well under 10 MB. Larger files (a 3 GB file, /dev/zero
+/// through a link) are refused before they are read instead of filling memory.
+inline constexpr std::size_t kMaxUrdfBytes = 32 * 1024 * 1024;
 
 /// Parses a URDF and imports its meshes through `meshes`. Throws UrdfError naming the file and
-/// the problem: unreadable or malformed XML, elements nested deeper than kMaxElementDepth, no
+/// the problem: a path that is not a regular file (a FIFO, a device, a folder, its symbolic links
+/// followed) or a file larger than kMaxUrdfBytes, unreadable or malformed XML, elements nested
+/// deeper than kMaxElementDepth, no
 /// links, more than kMaxLinks links, a number that is not finite (an origin, an axis, a limit, a
-/// mass or inertia) or a size that is not > 0 (box, sphere, cylinder, capsule), a negative mass,
-/// two roots, a joint cycle, an unknown parent or child, an unsupported joint type (planar,
-/// floating), lower limit > upper limit, a zero axis, a moving link with non-positive mass or a
-/// non-positive-definite inertia, and any mesh that is missing, unreadable, of an unsupported
-/// format or without triangles.
+/// mass or inertia) or beyond the bounds no robot approaches (origin xyz ±1e4 m, rpy ±1e4 rad,
+/// joint limits ±1e4 rad or m, effort ±1e9, velocity ±1e6, damping and friction ±1e9) or a size
+/// that is not > 0 (box, sphere, cylinder, capsule), a negative mass, two roots, a joint cycle, an
+/// unknown parent or child, an unsupported joint type (planar, floating), lower limit > upper
+/// limit, a zero axis, a moving link with non-positive mass or a non-positive-definite inertia, and
+/// any mesh that is missing, unreadable, of an unsupported format or without triangles.
 std::shared_ptr<const RobotModel> parse_urdf(const std::string& path, MeshCache& meshes);
 
 /// Parses each URDF once and shares the result (and its meshes) with every caller. Thread-safe.

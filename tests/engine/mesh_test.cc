@@ -51,7 +51,8 @@ TEST(MeshTest, LoadsColladaWithItsColour) {
 }
 
 TEST(MeshTest, BadFilesAreRefusedNamingFileAndProblem) {
-  EXPECT_THAT(error_of(data("meshes/does_not_exist.obj")), HasSubstr("file not found"));
+  EXPECT_THAT(error_of(data("meshes/does_not_exist.obj")),
+              HasSubstr("cannot be read (No such file or directory)"));
   EXPECT_THAT(error_of(data("meshes/shape.xyz")), HasSubstr("unsupported format \".xyz\""));
   EXPECT_THAT(error_of(data("meshes/no_triangles.obj")), HasSubstr("no triangles"));
   EXPECT_THAT(error_of(data("meshes/garbage.stl")), HasSubstr("garbage.stl"));

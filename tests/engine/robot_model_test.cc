@@ -2,6 +2,8 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -181,25 +183,164 @@ std::string write_temporary(const std::string& name, const std::string& text) {
   return path.string();
 }
 
-TEST(RobotModelTest, DeeplyNestedElementsAreRefusedBeforeParsing) {
-  // 50,000 nested elements overflowed tinyxml's recursion (a segfault of pixelgym inspect).
-  std::string text = "<robot name=\"deep\"><link name=\"base\"/>";
-  for (int i = 0; i < 50000; ++i) text += "<a x=\"<b>\">";
-  for (int i = 0; i < 50000; ++i) text += "</a>";
-  text += "</robot>";
-  const std::string path = write_temporary("deep.urdf", text);
+// A text of `count` copies of `piece`.
+std::string repeat(const std::string& piece, int count) {
+  std::string text;
+  for (int i = 0; i < count; ++i) text += piece;
+  return text;
+}
+
+// Refused as nested too deep; each of these overflowed the stack (a segfault) before.
+void expect_too_deep(const std::string& name, const std::string& text) {
+  const std::string path = write_temporary(name, text);
   MeshCache meshes;
   try {
     parse_urdf(path, meshes);
-    FAIL() << "a URDF nested 50,001 deep was accepted";
+    FAIL() << name << " was accepted";
   } catch (const UrdfError& error) {
-    EXPECT_THAT(error.what(), HasSubstr("elements nested 50001 deep; a URDF nests at most 100"));
+    EXPECT_THAT(error.what(), HasSubstr("URDF " + path +
+                                        ": elements nested more than 100 deep; "
+                                        "a URDF nests at most 100"));
   }
+}
+
+TEST(RobotModelTest, DeeplyNestedElementsAreRefusedBeforeParsing) {
+  // 50,000 nested elements overflowed tinyxml's recursion (a segfault of pixelgym inspect).
+  const std::string robot = "<robot name=\"deep\"><link name=\"base\"/>";
+  expect_too_deep("deep.urdf",
+                  robot + repeat("<a x=\"<b>\">", 50000) + repeat("</a>", 50000) + "</robot>");
   // Comments, CDATA, self-closing tags and quoted '>' do not count as nesting.
   std::string flat = "<robot name=\"flat\"><!-- <a><a><a> --><link name=\"base\" n=\">\"/>";
   for (int i = 0; i < 200; ++i) flat += "<a/><![CDATA[<b><b>]]><?pi <c>?>";
   flat += "</robot>";
+  MeshCache meshes;
   EXPECT_EQ(parse_urdf(write_temporary("flat.urdf", flat), meshes)->links().size(), 1U);
+  // 100 deep (the robot and 99 inside it) is allowed.
+  const std::string at_limit = robot + repeat("<a>", 99) + repeat("</a>", 99) + "</robot>";
+  EXPECT_EQ(parse_urdf(write_temporary("at_limit.urdf", at_limit), meshes)->links().size(), 1U);
+  expect_too_deep("past_limit.urdf", robot + repeat("<a>", 100) + repeat("</a>", 100) + "</robot>");
+}
+
+TEST(RobotModelTest, NestingHiddenFromASimpleReaderIsCountedAsTinyXmlParsesIt) {
+  // Issue 42: '<' then a byte that starts no name is an unknown node to TinyXML, which ends at the
+  // first '>' even inside quotes; the old count read a quoted value over the whole nest.
+  const std::string robot = "<robot name=\"r\"><link name=\"a\"/>";
+  const std::string nest = repeat("<x>", 50000) + repeat("</x>", 50000);
+  expect_too_deep("unknown_node.urdf", robot + "<1 \"> " + nest + " \"></robot>");
+  // A character reference runs to the next ';' after digits: "&#<!--#1;" hides a comment opener.
+  expect_too_deep("reference.urdf", robot + "&#<!--#1;" + nest + "--></robot>");
+  // After a UTF-8 declaration, a lead byte swallows the quote after it.
+  expect_too_deep("utf8_lead_byte.urdf", "<?xml version=\"1.0\" encoding=\"UTF-8\"?>" + robot +
+                                             "<y z=\"\xe0\" \">" + nest + "\"/></robot>");
+  // A declaration's values are printed back unescaped into the XML urdfdom parses: the file nests
+  // 2 deep, the text urdfdom is given 50,002.
+  expect_too_deep("declaration.urdf", "<?xml version=\"&quot;&gt;" + repeat("&lt;x&gt;", 50000) +
+                                          "\"?>" + robot + "</robot>");
+}
+
+TEST(RobotModelTest, OnlyRegularFilesOfBoundedSizeAreRead) {
+  // A FIFO blocked the read forever and /dev/zero filled memory; each is now refused at once. An
+  // alarm ends the test (and fails it) should the read block.
+  const auto folder = std::filesystem::temp_directory_path() / "pixelgym_robot_model_files";
+  std::filesystem::remove_all(folder);
+  std::filesystem::create_directories(folder);
+  const auto refusal = [](const std::string& path) {
+    MeshCache meshes;
+    ::alarm(20);
+    try {
+      parse_urdf(path, meshes);
+      ::alarm(0);
+      return std::string("accepted");
+    } catch (const UrdfError& error) {
+      ::alarm(0);
+      return std::string(error.what());
+    }
+  };
+  const std::string fifo = (folder / "fifo.urdf").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_EQ(refusal(fifo), "URDF " + fifo + ": is a FIFO, not a regular file");
+  const std::string zero = (folder / "zero.urdf").string();
+  std::filesystem::create_symlink("/dev/zero", zero);
+  EXPECT_EQ(refusal(zero), "URDF " + zero +
+                               ": is a symbolic link to /dev/zero, which is a character device, "
+                               "not a regular file");
+  EXPECT_EQ(refusal("/dev/urandom"),
+            "URDF /dev/urandom: is a character device, not a regular file");
+  EXPECT_EQ(refusal(folder.string()),
+            "URDF " + folder.string() + ": is a folder, not a regular file");
+  // 3 GB, sparse: nothing is written, and nothing may be read.
+  const std::string huge = (folder / "huge.urdf").string();
+  std::ofstream(huge).close();
+  std::filesystem::resize_file(huge, 3'000'000'000ULL);
+  EXPECT_EQ(refusal(huge), "URDF " + huge +
+                               ": is 2.8 GiB (3000000000 bytes); a URDF file may be at "
+                               "most 32 MiB (33554432 bytes)");
+  // Both sides of the bound: a valid URDF padded with a comment to exactly kMaxUrdfBytes is read.
+  const std::string minimal = "<robot name=\"r\"><link name=\"a\"/></robot>";
+  const std::string at_cap = (folder / "at_cap.urdf").string();
+  std::ofstream(at_cap) << minimal << "<!--" << std::string(kMaxUrdfBytes - minimal.size() - 7, ' ')
+                        << "-->";
+  ASSERT_EQ(std::filesystem::file_size(at_cap), kMaxUrdfBytes);
+  EXPECT_EQ(refusal(at_cap), "accepted");
+  std::ofstream(at_cap, std::ios::app) << " ";
+  EXPECT_EQ(refusal(at_cap), "URDF " + at_cap +
+                                 ": is 32.0 MiB (33554433 bytes); a URDF file may be at "
+                                 "most 32 MiB (33554432 bytes)");
+  std::filesystem::remove_all(folder);
+}
+
+TEST(RobotModelTest, HugeFiniteLimitsAndOriginsAreRefusedNamingTheRange) {
+  // A limit of 1e300 made UrdfReach-v0's reset diverge ("joint_pos[0] is inf") and an origin of
+  // 1e200 failed in the camera ("the pose is not finite"), neither naming the URDF.
+  const auto urdf = [](const std::string& joint_origin, const std::string& limit) {
+    const std::string inertial =
+        "<inertial><mass value=\"1\"/><inertia ixx=\"0.01\" iyy=\"0.01\" izz=\"0.01\" "
+        "ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>";
+    return "<robot name=\"r\"><link name=\"a\">" + inertial + "</link><link name=\"b\">" +
+           inertial +
+           "</link><joint name=\"j\" type=\"prismatic\"><parent link=\"a\"/><child "
+           "link=\"b\"/><axis xyz=\"1 0 0\"/>" +
+           joint_origin + limit + "<dynamics damping=\"0.1\"/></joint></robot>";
+  };
+  const std::string limit = "<limit lower=\"-1\" upper=\"1\" effort=\"10\" velocity=\"1\"/>";
+  MeshCache meshes;
+  // At the bounds: accepted.
+  EXPECT_EQ(parse_urdf(write_temporary("at_bounds.urdf",
+                                       urdf("<origin xyz=\"10000 -10000 0\" rpy=\"0 -10000 0\"/>",
+                                            "<limit lower=\"-10000\" upper=\"10000\" "
+                                            "effort=\"1e9\" velocity=\"1e6\"/>")),
+                       meshes)
+                ->joints()[0]
+                .upper,
+            1e4);
+  struct Case {
+    std::string origin;
+    std::string limit;
+    std::string problem;
+  };
+  const std::vector<Case> cases = {
+      {"", "<limit lower=\"-1\" upper=\"1e300\" effort=\"10\" velocity=\"1\"/>",
+       "joint \"j\" <limit upper=\"1e300\">: 1e300 is outside [-10000, 10000] rad or m"},
+      {"", "<limit lower=\"-10000.1\" upper=\"1\" effort=\"10\" velocity=\"1\"/>",
+       "<limit lower=\"-10000.1\">: -10000.1 is outside [-10000, 10000] rad or m"},
+      {"<origin xyz=\"0 0 1e200\"/>", limit,
+       "joint \"j\" <origin xyz=\"0 0 1e200\">: 1e200 is outside [-10000, 10000] m"},
+      {"<origin rpy=\"0 0 -2e4\"/>", limit, "<origin rpy=\"0 0 -2e4\">: -2e4 is outside"},
+      {"", "<limit lower=\"-1\" upper=\"1\" effort=\"1.1e9\" velocity=\"1\"/>",
+       "<limit effort=\"1.1e9\">: 1.1e9 is outside [-1e+09, 1e+09] N m or N"},
+      {"", "<limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1e300\"/>",
+       "<limit velocity=\"1e300\">: 1e300 is outside [-1e+06, 1e+06] rad/s or m/s"},
+  };
+  for (const Case& c : cases) {
+    const std::string path = write_temporary("huge.urdf", urdf(c.origin, c.limit));
+    try {
+      parse_urdf(path, meshes);
+      FAIL() << c.problem << ": accepted";
+    } catch (const UrdfError& error) {
+      EXPECT_THAT(error.what(), HasSubstr("URDF " + path + ": "));
+      EXPECT_THAT(error.what(), HasSubstr(c.problem));
+    }
+  }
 }
 
 std::string chain_urdf(std::size_t links) {

@@ -3,12 +3,14 @@
 // earlier run left; pictures are compared with what the library gives for the same seed.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 
 #include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
@@ -609,6 +611,40 @@ TEST(PixelgymCliTest, InspectRefusesEveryBadFileNamingTheProblem) {
     EXPECT_THAT(result.output, HasSubstr("pixelgym: error: URDF " + path + ": ")) << name;
   }
   EXPECT_EQ(run("inspect " + dir + "minimal_valid.urdf").exit_code, 0);
+}
+
+// Issue 42: hostile URDFs made inspect, view and check crash (a stack overflow) or hang (a FIFO)
+// or fill memory (/dev/zero). Each is refused with a message naming the file. `timeout` turns a
+// hang into a failure.
+TEST(PixelgymCliTest, HostileUrdfFilesAreRefusedNamingTheFile) {
+  const std::filesystem::path folder =
+      std::filesystem::path(PIXELGYM_TEST_OUTPUT_DIR) / "cli" / "hostile_urdf";
+  std::filesystem::remove_all(folder);
+  std::filesystem::create_directories(folder);
+  std::string nest;
+  for (int i = 0; i < 50000; ++i) nest += "<x>";
+  for (int i = 0; i < 50000; ++i) nest += "</x>";
+  const std::string deep = (folder / "unknown_node.urdf").string();
+  std::ofstream(deep) << "<robot name=\"r\"><link name=\"a\"/><1 \"> " << nest << " \"></robot>";
+  const std::string fifo = (folder / "fifo.urdf").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string zero = (folder / "zero.urdf").string();
+  std::filesystem::create_symlink("/dev/zero", zero);
+  const std::vector<std::pair<std::string, std::string>> files = {
+      {deep, "elements nested more than 100 deep"},
+      {fifo, "is a FIFO, not a regular file"},
+      {zero, "is a symbolic link to /dev/zero, which is a character device, not a regular file"}};
+  for (const auto& [path, problem] : files) {
+    const std::string cli = "timeout 20 " + std::string(PIXELGYM_CLI) + " ";
+    for (const std::string& command :
+         {"inspect " + path, "view " + path + " --out " + fresh_output("hostile.png"),
+          "check UrdfReach-v0 --steps 1 --set urdf=" + path}) {
+      const CliRun result = testing::run_program(cli + command);
+      EXPECT_EQ(result.exit_code, 1) << command << ": " << result.output;
+      EXPECT_THAT(result.output, HasSubstr("URDF " + path + ": " + problem)) << command;
+    }
+  }
+  std::filesystem::remove_all(folder);
 }
 
 // --- view ---

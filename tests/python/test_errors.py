@@ -189,3 +189,53 @@ def test_a_vector_env_stepped_from_two_python_threads_is_serialized():
     envs.close()
     assert errors == []
     assert steps == [1500, 1500]
+
+
+# Issue 42: hostile URDFs crashed the interpreter (a stack overflow), hung it (a FIFO) or filled
+# its memory (/dev/zero). Each is made in a child interpreter, so that a crash or a hang fails the
+# test rather than ending the suite; the child prints the exception it got.
+_MAKE_URDF_REACH = """
+import sys
+import pixelgym
+try:
+    pixelgym.make("UrdfReach-v0", urdf=sys.argv[1]).reset(seed=0)
+except Exception as error:
+    print(type(error).__name__ + ": " + str(error))
+    sys.exit(3)
+"""
+
+
+def _make_urdf_reach(path):
+    import subprocess
+    import sys
+
+    try:
+        result = subprocess.run(
+            [sys.executable, "-c", _MAKE_URDF_REACH, str(path)],
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
+    except subprocess.TimeoutExpired:
+        pytest.fail(f"UrdfReach-v0 with urdf={path} did not return in 60 s")
+    assert result.returncode == 3, (result.returncode, result.stdout, result.stderr)
+    return result.stdout
+
+
+def test_hostile_urdf_files_are_runtime_errors_naming_the_file(tmp_path):
+    import os
+
+    nest = "<x>" * 50000 + "</x>" * 50000
+    deep = tmp_path / "unknown_node.urdf"
+    deep.write_text('<robot name="r"><link name="a"/><1 "> ' + nest + ' "></robot>')
+    fifo = tmp_path / "fifo.urdf"
+    os.mkfifo(fifo)
+    zero = tmp_path / "zero.urdf"
+    zero.symlink_to("/dev/zero")
+    cases = [
+        (deep, "elements nested more than 100 deep"),
+        (fifo, "is a FIFO, not a regular file"),
+        (zero, "is a symbolic link to /dev/zero, which is a character device, not a regular file"),
+    ]
+    for path, problem in cases:
+        assert f"RuntimeError: URDF {path}: {problem}" in _make_urdf_reach(path)
