@@ -23,6 +23,15 @@ Rng::Rng(std::uint64_t seed) {
   for (std::uint64_t& word : state_) word = splitmix64(seed);
 }
 
+Rng Rng::from_state(const std::array<std::uint64_t, 4>& state) {
+  if (state == std::array<std::uint64_t, 4>{}) {
+    throw std::invalid_argument("Rng::from_state: the all-zero state is not a generator's state");
+  }
+  Rng rng;
+  rng.state_ = state;
+  return rng;
+}
+
 std::uint64_t Rng::entropy_seed() {
   std::random_device device;
   return (static_cast<std::uint64_t>(device()) << 32) ^ device();

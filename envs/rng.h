@@ -38,6 +38,10 @@ class Rng {
 
   /// The 256-bit state, which alone determines every number to come.
   const std::array<std::uint64_t, 4>& state() const { return state_; }
+  /// A generator in `state` (one that state() returned: it gives the same numbers from here on,
+  /// as copying and pickling a space need). Throws std::invalid_argument for the all-zero state,
+  /// which xoshiro256** never leaves.
+  static Rng from_state(const std::array<std::uint64_t, 4>& state);
   /// Same state: both give the same numbers from here on.
   friend bool operator==(const Rng& a, const Rng& b) { return a.state_ == b.state_; }
   friend bool operator!=(const Rng& a, const Rng& b) { return !(a == b); }

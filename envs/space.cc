@@ -15,6 +15,19 @@ std::uint64_t Space::seed(std::optional<std::uint64_t> seed) const {
   return used;
 }
 
+std::optional<std::array<std::uint64_t, 4>> Space::generator_state() const {
+  if (!rng_) return std::nullopt;
+  return rng_->state();
+}
+
+void Space::set_generator_state(const std::optional<std::array<std::uint64_t, 4>>& state) const {
+  if (state) {
+    rng_ = Rng::from_state(*state);
+  } else {
+    rng_.reset();
+  }
+}
+
 Value Space::zeros() const { return Array(*dtype(), *shape()); }
 
 std::string Space::layout_mismatch(const Value& value) const {

@@ -1,6 +1,7 @@
 // Space: the set of valid observations or actions, as in gymnasium.spaces.Space.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -28,6 +29,13 @@ class Space {
   /// Reseeds this space's own generator; returns the seed used (drawn from entropy when none is
   /// given).
   std::uint64_t seed(std::optional<std::uint64_t> seed = std::nullopt) const;
+  /// The state of that generator (Rng::state), or std::nullopt while it was neither seeded nor
+  /// used; with set_generator_state, what a copy of the space (Python's pickle and deepcopy) keeps
+  /// so that it samples as the original would.
+  std::optional<std::array<std::uint64_t, 4>> generator_state() const;
+  /// Puts that generator in `state` (std::nullopt: unseeded, as a new space). Throws as
+  /// Rng::from_state.
+  void set_generator_state(const std::optional<std::array<std::uint64_t, 4>>& state) const;
 
   /// True when `value` is an element of this space: right structure, dtype, shape and bounds.
   bool contains(const Value& value) const { return mismatch(value).empty(); }

@@ -80,7 +80,9 @@ std::string linked_library_file() {
 // - It never learns that a thread ended (only the first libc's thread exit runs), so the arena a
 //   worker thread was given is never handed to the next thread: every vector env made and closed
 //   left an arena behind, 6-13 MB of resident memory per cycle. One arena per copy (threads
-//   drawing with one copy take turns with its lock anyway) leaves nothing per thread.
+//   drawing with one copy take turns with its lock anyway) leaves no arena per thread. (Each
+//   thread's cache of freed blocks, tcache, cannot be turned off here, and is left behind too when
+//   the thread ends: vector envs run on threads that are kept and reused, WorkerThreads.)
 // Each is left alone when the user tunes it through the environment, which the copy's libc reads
 // as well.
 void tune_copy_malloc(void* handle) {
@@ -97,8 +99,8 @@ void tune_copy_malloc(void* handle) {
   if (!tuned("MALLOC_ARENA_MAX", "arena_max")) copy_mallopt(M_ARENA_MAX, 1);
 }
 
-// A private copy, or null with `why` set.
-std::unique_ptr<GlLibrary> load_private(int copy, std::string& why) {
+// A private copy, or null with `why` set; `handle` is set once the library is loaded.
+std::unique_ptr<GlLibrary> load_private(int copy, std::string& why, void*& handle) {
   const std::string file = linked_library_file();
   if (file.empty()) {
     why = "cannot find the file libOSMesa was loaded from (dladdr failed)";
@@ -106,7 +108,7 @@ std::unique_ptr<GlLibrary> load_private(int copy, std::string& why) {
   }
   // Never closed: contexts of the copy may live until the process ends, and unloading LLVM is
   // not something Mesa supports.
-  void* handle = ::dlmopen(LM_ID_NEWLM, file.c_str(), RTLD_NOW | RTLD_LOCAL);
+  handle = ::dlmopen(LM_ID_NEWLM, file.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (handle == nullptr) {
     const char* error = ::dlerror();
     why = "dlmopen(" + file + ") failed: " + (error != nullptr ? error : "no reason given");
@@ -144,6 +146,7 @@ struct Copies {
   std::mutex mutex;
   std::array<std::unique_ptr<GlLibrary>, kMostCopies> loaded;
   std::array<std::string, kMostCopies> why_not;
+  std::array<void*, kMostCopies> handles{};  // of the private copies loaded (dlmopen's)
   bool fallback_reported = false;
 };
 
@@ -161,7 +164,7 @@ const GlLibrary& library(int copy) {
   if (all.loaded[0] == nullptr) all.loaded[0] = load_linked();
   if (all.loaded[index] == nullptr && all.why_not[index].empty()) {
     std::string why;
-    all.loaded[index] = load_private(copy, why);
+    all.loaded[index] = load_private(copy, why, all.handles[index]);
     if (all.loaded[index] == nullptr) {
       all.why_not[index] = why;
       if (!all.fallback_reported) {
@@ -212,6 +215,22 @@ std::string MesaCopy::why_not(int copy) {
   Copies& all = copies();
   const std::lock_guard<std::mutex> lock(all.mutex);
   return all.why_not[static_cast<std::size_t>(copy)];
+}
+
+std::size_t MesaCopy::private_malloc_in_use() {
+  Copies& all = copies();
+  const std::lock_guard<std::mutex> lock(all.mutex);
+  std::size_t total = 0;
+  for (std::size_t copy = 1; copy < all.loaded.size(); ++copy) {
+    if (all.loaded[copy] == nullptr || all.handles[copy] == nullptr) continue;
+    // dlsym through the library's handle finds its libc's mallinfo2 (a dependency's symbol).
+    auto* copy_mallinfo2 =
+        reinterpret_cast<struct mallinfo2 (*)()>(::dlsym(all.handles[copy], "mallinfo2"));
+    if (copy_mallinfo2 == nullptr) continue;
+    const struct mallinfo2 info = copy_mallinfo2();
+    total += info.uordblks + info.hblkhd;
+  }
+  return total;
 }
 
 void prepare_thread(const GlLibrary& library) {

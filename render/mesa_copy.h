@@ -2,6 +2,7 @@
 // in parallel.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 namespace pixelgym::render {
@@ -39,6 +40,10 @@ class MesaCopy {
   static bool loaded(int copy);
   /// Why `copy` could not be loaded, or "" when it was (or was never asked for).
   static std::string why_not(int copy);
+  /// Bytes the private copies' mallocs have handed out and not had back (the sum of glibc's
+  /// mallinfo2 uordblks + hblkhd of each loaded copy's own libc, which the process's mallinfo2
+  /// does not count); 0 when none is loaded. For leak tests. Thread-safe.
+  static std::size_t private_malloc_in_use();
 };
 
 }  // namespace pixelgym::render

@@ -9,6 +9,8 @@
 #include <immintrin.h>
 #endif
 
+#include "envs/vector/worker_threads.h"
+
 namespace pixelgym::vector {
 namespace {
 
@@ -49,9 +51,10 @@ bool spin_until(const Done& done) {
 
 }  // namespace
 
-// One worker: its thread and how it is handed calls.
+// One worker: its thread (one of WorkerThreads', for this vector env's life) and how it is handed
+// calls.
 struct AsyncVectorEnv::Worker {
-  std::thread thread;
+  WorkerThreads::Task thread;
   // Bumped (under `mutex`) to hand the worker the current call.
   std::atomic<std::uint64_t> ticket{0};
   std::mutex mutex;
@@ -69,7 +72,9 @@ AsyncVectorEnv::AsyncVectorEnv(int num_envs, const EnvFactory& make_env, int num
   spin_ = threads <= static_cast<int>(std::thread::hardware_concurrency());
   for (int w = 0; w < threads; ++w) workers_.push_back(std::make_unique<Worker>());
   try {
-    for (int w = 0; w < threads; ++w) workers_[w]->thread = std::thread([this, w] { work(w); });
+    for (int w = 0; w < threads; ++w) {
+      workers_[w]->thread = WorkerThreads::start(w, [this, w] { work(w); });
+    }
     build(make_env);
   } catch (...) {
     stop();

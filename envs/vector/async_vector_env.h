@@ -27,6 +27,9 @@ namespace pixelgym::vector {
 /// step_wait. So an env runs on one thread at a time, always the same one for workers 1..T-1,
 /// and the caller or worker thread 0 (never both at once) for worker 0 (a pixel env binds its GL
 /// context only for the length of each frame, render::Context, so it may move between threads).
+/// The worker threads are WorkerThreads': parked when the vector env is destroyed and reused by
+/// the next one (worker w gets the thread that last ran a worker w), so that making and closing
+/// vector envs leaves nothing behind per thread (see WorkerThreads for what did).
 ///
 /// Waiting. A worker done with a call, and the caller done with its share, first spin (pausing
 /// the core) for up to 200 microseconds for the next call or the other threads, and only then

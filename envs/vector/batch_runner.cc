@@ -337,6 +337,7 @@ void BatchRunner::begin_step(const Value& actions, const char* method, bool wait
 }
 
 const VectorStepResult& BatchRunner::end_step(const char* method) {
+  if (closed_) throw ResetNeeded(name() + ": " + method + " called after close()");
   if (!step_pending_) {
     throw ResetNeeded(name() + ": " + method + " called without a pending step_async()");
   }

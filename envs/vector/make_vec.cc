@@ -6,6 +6,7 @@
 #include "envs/described_env.h"
 #include "envs/registry.h"
 #include "envs/vector/async_vector_env.h"
+#include "envs/vector/memory_check.h"
 #include "envs/vector/sync_vector_env.h"
 
 namespace pixelgym::vector {
@@ -16,7 +17,16 @@ std::unique_ptr<VectorEnv> make_vec(const Registry& registry, const std::string&
   // Bad ids, kwargs and wrappings are reported here, on the calling thread, without building a
   // world or a GL context.
   EnvDescription description = registry.describe(id, kwargs);
-  if (wrap) wrap(std::make_unique<DescribedEnv>(std::move(description)));
+  const SpacePtr unwrapped_observation_space = description.observation_space;
+  const std::unique_ptr<Env> wrapped =
+      wrap ? wrap(std::make_unique<DescribedEnv>(std::move(description))) : nullptr;
+  // Too many envs for the memory left are refused here, not after building envs until the
+  // machine runs out.
+  check_memory(
+      "make_vec(\"" + id + "\")", num_envs,
+      estimate_env_bytes(*unwrapped_observation_space,
+                         wrapped ? wrapped->observation_space() : *unwrapped_observation_space),
+      available_memory());
 
   const bool async = options.mode == VectorMode::kAsync;
   const int threads = async ? AsyncVectorEnv::threads_for(num_envs, options.num_threads) : 1;

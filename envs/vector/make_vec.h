@@ -48,6 +48,11 @@ struct VectorOptions {
 /// the env, before any env is built (the id and kwargs are described, and `wrap` is applied to a
 /// DescribedEnv stand-in: a wrapping must not reset, step or render the env it wraps); then as
 /// the SyncVectorEnv / AsyncVectorEnv constructors.
+///
+/// Memory: before any env is built, `num_envs` times an estimate of one env's memory (from its
+/// spaces: estimate_env_bytes) is compared with the memory available (available_memory:
+/// MemAvailable, or the process's cgroup limit when lower); std::invalid_argument naming
+/// num_envs, the estimate and the memory available when it does not fit (check_memory).
 std::unique_ptr<VectorEnv> make_vec(const Registry& registry, const std::string& id, int num_envs,
                                     const Params& kwargs = {}, const EnvWrapping& wrap = nullptr,
                                     const VectorOptions& options = {});

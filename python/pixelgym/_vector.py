@@ -24,6 +24,21 @@ else:
     _AutoresetMode = None
 
 
+_INT_MAX = 2**31 - 1  # the C++ vector env counts envs and threads in an int
+
+
+def _count(name, value, minimum):
+    """``value`` as an int from ``minimum`` to 2**31 - 1; TypeError or ValueError naming ``name``
+    otherwise (pybind11's own error lists overloads instead)."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"make_vec: {name} must be an int, got {type(value).__name__} {value!r}")
+    value = int(value)
+    if not minimum <= value <= _INT_MAX:
+        raise ValueError(f"make_vec: {name} must be from {minimum} to {_INT_MAX}, got "
+                         f"{name} = {value}")
+    return value
+
+
 def _mode_name(mode):
     text = str(getattr(mode, "value", mode))
     return _MODE_NAMES.get(text.lower(), text)
@@ -77,6 +92,8 @@ class VectorEnv(CoreBacked, _Base):
                 f"{id}: render_mode must be None or 'rgb_array', got {render_mode!r}"
             )
         wrap = wrap_list(wrap)
+        num_envs = _count("num_envs", num_envs, 1)
+        num_threads = _count("num_threads", num_threads, 0)
         self._core = _core.VectorEnv(id, num_envs, kwargs, wrap, mode, num_threads,
                                      _mode_name(autoreset_mode), share_gl_contexts)
         self._id = id

@@ -58,6 +58,30 @@ def test_bad_wrapper_specs_and_vector_options():
         pixelgym.make_vec("GridWorld-v0", 2, mode="processes")
     with pytest.raises(ValueError, match="num_envs"):
         pixelgym.make_vec("GridWorld-v0", 0)
+
+
+def test_counts_out_of_range_or_of_the_wrong_type_name_the_argument():
+    # Issue 42: 2**40 gave pybind11's "incompatible constructor arguments" listing the overloads.
+    for value in (2**40, 2**31, -1, -2**40):
+        with pytest.raises(ValueError) as error:
+            pixelgym.make_vec("GridWorld-v0", value)
+        assert str(error.value) == (f"make_vec: num_envs must be from 1 to 2147483647, got "
+                                    f"num_envs = {value}")
+    with pytest.raises(ValueError, match=r"num_threads must be from 0 to 2147483647, got "
+                                         r"num_threads = 1099511627776"):
+        pixelgym.make_vec("GridWorld-v0", 2, num_threads=2**40)
+    for value in ("4", 4.0, True, None):
+        with pytest.raises(TypeError, match=r"make_vec: num_envs must be an int, got "):
+            pixelgym.make_vec("GridWorld-v0", value)
+    assert pixelgym.make_vec("GridWorld-v0", np.int64(2), mode="sync").num_envs == 2
+
+
+def test_more_envs_than_the_memory_holds_are_refused_before_any_is_built():
+    # Issue 42: make_vec(20000) built envs until the machine ran out of memory.
+    with pytest.raises(ValueError, match=r'make_vec\("CartPoleSwingup-v0"\): num_envs = 20000000 '
+                                         r"envs would take about .* \(an estimate: .* per env\), "
+                                         r"more than the .* available \("):
+        pixelgym.make_vec("CartPoleSwingup-v0", 20_000_000)
     with pytest.raises(TypeError, match="thread pool"):
         pixelgym.make_vec("GridWorld-v0", 2, mode="sync").step_async(np.zeros(2, np.int64))
 
@@ -160,6 +184,14 @@ def test_objects_used_after_close_raise():
         with pytest.raises(pixelgym.ResetNeeded, match="after close"):
             envs.reset()
         envs.close()
+    # step_wait() after close() names the close, even with a step left pending (issue 42; it said
+    # "called without a pending step_async()").
+    envs = pixelgym.make_vec("CartPoleSwingup-v0", 2, obs_mode="state")
+    envs.reset(seed=0)
+    envs.step_async(np.zeros((2, 1), np.float32))
+    envs.close()
+    with pytest.raises(pixelgym.ResetNeeded, match=r"step_wait\(\) called after close\(\)"):
+        envs.step_wait()
 
 
 def test_a_vector_env_stepped_from_two_python_threads_is_serialized():

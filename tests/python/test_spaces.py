@@ -119,3 +119,47 @@ def test_dict_space_keeps_key_order_and_mismatch_names_keys():
         space["nope"]
     assert space.sample() in space
     assert {"pixels": np.zeros((84, 84, 3), np.uint8)} not in space
+
+
+def _samples(space, count=5):
+    return [space.sample() for _ in range(count)]
+
+
+def _same(a, b):
+    if isinstance(a, dict):
+        return list(a) == list(b) and all(_same(a[key], b[key]) for key in a)
+    return np.array_equal(np.asarray(a), np.asarray(b))
+
+
+def test_pixelgym_spaces_pickle_and_copy_with_their_generator():
+    # Issue 42: without gymnasium, make returns pixelgym's own spaces, and pickling one (as
+    # multiprocessing, Ray or a checkpoint of an agent does) raised TypeError. A copy equals the
+    # original and, as Gymnasium's spaces do, samples what the original would.
+    import copy
+    import pickle
+
+    grid = pixelgym.make_vec("GridWorld-v0", 3, mode="sync")
+    spaces = [pixelgym.info("CartPoleSwingup-v0")["observation_space"],  # Dict of Boxes
+              pixelgym.info("CartPoleSwingup-v0")["action_space"],  # Box, float32
+              pixelgym.info("GridWorld-v0")["action_space"],  # Discrete
+              grid._core.action_space,  # MultiDiscrete
+              grid._core.observation_space]
+    for space in spaces:
+        space.seed(3)
+        space.sample()  # the generator moved on from its seed: the copies carry where it is
+        copies = [pickle.loads(pickle.dumps(space)),
+                  pickle.loads(pickle.dumps(space, protocol=2)),
+                  copy.deepcopy(space), copy.copy(space)]
+        expected = _samples(space)
+        for made in copies:
+            assert type(made) is type(space) and made == space and made is not space, space
+            assert repr(made) == repr(space)
+            assert all(_same(a, b) for a, b in zip(_samples(made), expected)), space
+    grid.close()
+    # A space never seeded is copied unseeded; it samples elements all the same.
+    fresh = pickle.loads(pickle.dumps(pixelgym.info("GridWorld-v0")["action_space"]))
+    assert fresh.sample() in fresh
+    # A Dict's subspaces are copied with the Dict (each with its own generator).
+    obs_space = spaces[0]
+    copied = copy.deepcopy(obs_space)
+    assert copied["pixels"] is not obs_space["pixels"] and copied["pixels"] == obs_space["pixels"]

@@ -181,10 +181,14 @@ TEST(AsyncVectorEnvTest, StepAsyncAndStepWait) {
   const VectorStepResult& result = env.step_wait();
   EXPECT_EQ(result.rewards.shape(), (Shape{3}));
   EXPECT_THROW(env.step_wait(), ResetNeeded);
-  // A step left pending is waited for by close() (and the destructor).
+  // A step left pending is waited for by close() (and the destructor); step_wait() then names the
+  // close (it said "without a pending step_async()", issue 42).
   env.step_async(scripted_actions(3, 0.5F));
   env.close();
-  EXPECT_THROW(env.step_wait(), ResetNeeded);
+  EXPECT_THAT(thrown_message<ResetNeeded>([&] { env.step_wait(); }),
+              HasSubstr("step_wait() called after close()"));
+  EXPECT_THAT(thrown_message<ResetNeeded>([&] { env.step_async(scripted_actions(3, 0.5F)); }),
+              HasSubstr("step_async() called after close()"));
 }
 
 // Errors on the worker threads of step_async() reach the caller at step_wait(): the lowest
