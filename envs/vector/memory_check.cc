@@ -105,17 +105,20 @@ std::optional<AvailableMemory> available_memory() {
   return available;
 }
 
-std::string format_bytes(std::uint64_t bytes) {
-  const char* units[] = {"bytes", "KiB", "MiB", "GiB", "TiB", "PiB"};
-  double value = static_cast<double>(bytes);
+std::string format_bytes(double bytes) {
+  const char* units[] = {"bytes", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"};
+  double value = bytes;
   int unit = 0;
-  while (value >= 1024.0 && unit < 5) {
+  while (value >= 1024.0 && unit < 6) {
     value /= 1024.0;
     ++unit;
   }
-  if (unit == 0) return std::to_string(bytes) + " bytes";
-  char text[32];
-  std::snprintf(text, sizeof(text), value < 10 ? "%.1f %s" : "%.0f %s", value, units[unit]);
+  char text[64];
+  if (unit == 0) {
+    std::snprintf(text, sizeof(text), "%.0f bytes", value);
+  } else {
+    std::snprintf(text, sizeof(text), value < 10 ? "%.1f %s" : "%.0f %s", value, units[unit]);
+  }
   return text;
 }
 
@@ -126,9 +129,10 @@ void check_memory(const std::string& who, int num_envs, std::uint64_t per_env_by
   if (needed <= available->bytes) return;
   throw std::invalid_argument(
       who + ": num_envs = " + std::to_string(num_envs) + " envs would take about " +
-      format_bytes(needed) + " (an estimate: " + format_bytes(per_env_bytes) +
-      " per env), more than the " + format_bytes(available->bytes) + " available (" +
-      available->source + "); make fewer envs, or smaller observations");
+      format_bytes(static_cast<double>(needed)) +
+      " (an estimate: " + format_bytes(static_cast<double>(per_env_bytes)) +
+      " per env), more than the " + format_bytes(static_cast<double>(available->bytes)) +
+      " available (" + available->source + "); make fewer envs, or smaller observations");
 }
 
 }  // namespace pixelgym::vector

@@ -45,7 +45,7 @@ std::optional<AvailableMemory> available_memory();
 void check_memory(const std::string& who, int num_envs, std::uint64_t per_env_bytes,
                   const std::optional<AvailableMemory>& available);
 
-/// "1.5 GiB", "740 KiB", "12 bytes".
-std::string format_bytes(std::uint64_t bytes);
+/// "1.5 GiB", "740 KiB", "12 bytes" (up to EiB; the trainer's estimates pass 2^64 bytes).
+std::string format_bytes(double bytes);
 
 }  // namespace pixelgym::vector

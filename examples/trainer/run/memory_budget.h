@@ -17,22 +17,14 @@ struct MemoryUse {
   double bytes = 0;
 };
 
-/// The memory this process can still take, in bytes: /proc/meminfo's MemAvailable, or less
-/// when the cgroup the process runs in has a limit (memory.max less memory.current, cgroup v2;
-/// memory.limit_in_bytes less memory.usage_in_bytes, v1). `source` (when given) says which.
-/// Returns a negative value when neither can be read.
-double available_memory_bytes(std::string* source = nullptr);
-
-/// "1.5 GB", "12.0 TB", "640 kB": bytes in the largest unit (1000-based) that keeps them >= 1.
-std::string format_bytes(double bytes);
-
-/// Throws std::invalid_argument when the uses add up to more than `available` bytes (as
-/// available_memory_bytes gives it, described by `source`; negative: unknown, nothing is
-/// refused): "{what}: these settings need about {total} of memory but {available} is available
+/// Throws std::invalid_argument when the uses add up to more than `available` bytes (described
+/// by `source`; negative: unknown, nothing is refused): "{what}: these settings need about {total}
+/// of memory but {available} is available
 /// ({source}); the most is {member} {value}: {bytes} for {what}. Lower it.", every use listed.
 void require_memory(const std::string& what, const std::vector<MemoryUse>& uses, double available,
                     const std::string& source);
-/// The same, against what this process can take now.
+/// The same, against what this process can take now (vector::available_memory: MemAvailable, or
+/// the cgroup's limit when lower).
 void require_memory(const std::string& what, const std::vector<MemoryUse>& uses);
 
 }  // namespace pixelgym::trainer
