@@ -134,7 +134,10 @@ int run_train(const TrainArguments& args) {
   // A rank of a data-parallel run started by a launcher (torchrun, srun, train --nproc).
   std::optional<distributed::DistributedSettings> ranks =
       launcher ? std::nullopt
-               : distributed::DistributedSettings::from_environment(args.dist_timeout);
+               : distributed::DistributedSettings::from_environment(
+                     args.dist_timeout, args.dist_join_timeout > 0.0
+                                            ? args.dist_join_timeout
+                                            : std::max(args.dist_timeout, 60.0));
   const bool joins = ranks && ranks->rank > 0;
   // Rank 0 takes the algorithm from the command line or the run folder; the others from it.
   const trainer::AlgorithmFactory& algorithm =
