@@ -116,8 +116,8 @@ TEST(LaunchTest, ARankThatNeverComesIsNamedWithinTheJoinTimeout) {
   fs::remove_all(folder);
 }
 
-// WORLD_SIZE=3 with RANK 0, 1 and 1: the second rank 1 is refused as soon as it arrives, and rank 0
-// and the first rank 1 name rank 2, which never comes.
+// WORLD_SIZE=3 with RANK 0, 1 and 1: the second rank 1 is refused as soon as it arrives (a
+// usage error), and rank 0 and the first rank 1 name rank 2, which never comes.
 TEST(LaunchTest, ARankGivenTwiceIsRefusedAndTheMissingRankNamed) {
   const fs::path folder = fresh_folder("twice");
   const int port = test_port();
@@ -148,7 +148,7 @@ TEST(LaunchTest, ARankGivenTwiceIsRefusedAndTheMissingRankNamed) {
   const bool a_refused = ended_a.output.find("another process") != std::string::npos;
   const Ended& refused = a_refused ? ended_a : ended_b;
   const Ended& joined = a_refused ? ended_b : ended_a;
-  EXPECT_EQ(refused.exit_code, 1) << ended_a.output << "\n---\n" << ended_b.output;
+  EXPECT_EQ(refused.exit_code, 2) << ended_a.output << "\n---\n" << ended_b.output;
   EXPECT_NE(refused.output.find("rank 1 of 3: another process has already joined the run at "
                                 "MASTER_ADDR:MASTER_PORT 127.0.0.1:" +
                                 std::to_string(port) + " as rank 1 (RANK=1 given to two"),
@@ -209,6 +209,57 @@ TEST(LaunchTest, AMasterPortOfAnotherServiceIsRefusedWithinSeconds) {
     // Seconds, not the 60 s join timeout: 5 s for the store's answer, and the process's start.
     EXPECT_LT(each->seconds, 5.0 + 10.0) << each->output;
   }
+  fs::remove_all(folder);
+}
+
+TEST(LaunchTest, DistributedVariablesOutOfRangeAreUsageErrors) {
+  const fs::path folder = fresh_folder("variables");
+  const std::string arguments = train_arguments(folder, "--steps 64");
+  const std::string port = std::to_string(test_port());
+  struct Case {
+    std::string environment;
+    std::string message;
+  };
+  for (const Case& c :
+       {Case{"WORLD_SIZE=two RANK=0", "WORLD_SIZE must be an integer in [1, 65536], got \"two\""},
+        Case{"WORLD_SIZE=2 RANK=2 MASTER_ADDR=127.0.0.1 MASTER_PORT=" + port,
+             "RANK must be an integer in [0, 1], got \"2\""},
+        Case{"WORLD_SIZE=2 RANK=1 MASTER_ADDR=127.0.0.1 MASTER_PORT=70000",
+             "MASTER_PORT must be an integer in [1, 65535], got \"70000\""},
+        Case{"WORLD_SIZE=2 RANK=1 MASTER_ADDR=127.0.0.1", "but MASTER_PORT is not set"}}) {
+    const CliRun run = run_cli(arguments, "env -u MASTER_PORT " + c.environment);
+    EXPECT_EQ(run.exit_code, 2) << c.environment << "\n" << run.output;
+    EXPECT_NE(run.output.find(c.message), std::string::npos) << c.environment << "\n" << run.output;
+  }
+  fs::remove_all(folder);
+}
+
+// Every rank runs rank 0's settings; a rank whose command line differs (--num-envs here) is
+// refused before the run starts, on both ranks, naming the flag; --out and --quiet may differ.
+TEST(LaunchTest, ARankWhoseCommandLineIsNotRankZerosIsRefused) {
+  const fs::path folder = fresh_folder("command_line");
+  const int port = test_port();
+  const std::string common = "--steps 64 ";
+  const std::string zero_arguments =
+      train_arguments(folder, common + "--out " + (folder / "run").string());
+  std::string one_arguments = train_arguments(folder, common + "--out " + (folder / "x").string());
+  one_arguments.replace(one_arguments.find("--num-envs 2"), 12, "--num-envs 3");
+  const auto start = Clock::now();
+  const auto deadline = start + std::chrono::seconds(120);
+  const std::vector<Ended> ended =
+      wait_all({{start_cli(rank_environment(2, 0, port), zero_arguments, folder / "0.txt"),
+                 folder / "0.txt"},
+                {start_cli(rank_environment(2, 1, port), one_arguments, folder / "1.txt"),
+                 folder / "1.txt"}},
+               start, deadline);
+  for (const Ended* each : {&ended[0], &ended[1]}) {
+    EXPECT_EQ(each->exit_code, 2) << each->output;
+    EXPECT_NE(each->output.find("the ranks' command lines differ (--num-envs: 3 on rank 1, 2 on "
+                                "rank 0); every rank runs rank 0's settings"),
+              std::string::npos)
+        << each->output;
+  }
+  EXPECT_FALSE(fs::exists(folder / "run"));
   fs::remove_all(folder);
 }
 
