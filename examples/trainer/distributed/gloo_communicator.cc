@@ -626,7 +626,12 @@ int GlooCommunicator::mark_rollout_done(std::int64_t round) {
 }
 
 int GlooCommunicator::rollouts_done(std::int64_t round) {
-  return static_cast<int>(store_->add("rollout_done/" + std::to_string(round), 0));
+  const std::string key = "rollout_done/" + std::to_string(round);
+  if (settings_.store_file.empty()) return static_cast<int>(store_->add(key, 0));
+  // A FileStore appends every add, an add of 0 included, to its file: once per env step here.
+  if (!store_->check({key})) return 0;
+  const std::vector<std::uint8_t> value = store_->get(key);
+  return std::stoi(std::string(value.begin(), value.end()));
 }
 
 void GlooCommunicator::finish() {
