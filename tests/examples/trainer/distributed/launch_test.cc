@@ -77,27 +77,39 @@ bool wait_for_port(int port, Clock::time_point deadline) {
   return false;
 }
 
+// The start of `pixelgym train` up to its rendezvous: 2 s here, 4.4 s under ASan, more on a
+// loaded CI machine. Bounds measured from a process's start allow this much for it.
+constexpr double kStartSlack = 20.0;
+
+// Seconds from `start` until rank 0's store opens on `port` (at most until `deadline`).
+double seconds_until_served(int port, Clock::time_point start, Clock::time_point deadline) {
+  wait_for_port(port, deadline);
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
 // A rank other than 0 alone, or rank 0 alone: each names what it waited for, and ends within
-// the join timeout (+ 10 s, the bound, for starting the process) instead of waiting
-// for a rank that never comes.
+// the join timeout instead of waiting for a rank that never comes.
 TEST(LaunchTest, ARankThatNeverComesIsNamedWithinTheJoinTimeout) {
   const fs::path folder = fresh_folder("never_comes");
   const int join_s = 2;
   const std::string arguments =
       train_arguments(folder, "--steps 64 --dist-join-timeout " + std::to_string(join_s) +
                                   " --out " + (folder / "run").string());
+  const int port = test_port();
   const auto start = Clock::now();
   const auto deadline = start + std::chrono::seconds(60);
-  const std::vector<Ended> ended =
-      wait_all({{start_cli(rank_environment(2, 0, test_port()), arguments, folder / "0.txt"),
-                 folder / "0.txt"},
-                {start_cli(rank_environment(2, 1, test_port()), arguments, folder / "1.txt"),
-                 folder / "1.txt"}},
-               start, deadline);
+  const std::vector<Started> started = {
+      {start_cli(rank_environment(2, 0, port), arguments, folder / "0.txt"), folder / "0.txt"},
+      {start_cli(rank_environment(2, 1, test_port()), arguments, folder / "1.txt"),
+       folder / "1.txt"}};
+  const double served_at = seconds_until_served(port, start, deadline);
+  const std::vector<Ended> ended = wait_all(started, start, deadline);
   const Ended& alone_zero = ended[0];
   const Ended& alone_one = ended[1];
-  std::cout << "rank 0 alone ended after " << alone_zero.seconds << " s, rank 1 alone after "
-            << alone_one.seconds << " s\n";
+  // Rank 0 serves its store, then waits for the others: the join timeout counts from then.
+  const double waited = alone_zero.seconds - served_at;
+  std::cout << "rank 0 alone ended after " << alone_zero.seconds << " s, " << waited
+            << " s after its store opened; rank 1 alone after " << alone_one.seconds << " s\n";
 
   EXPECT_EQ(alone_zero.exit_code, 1) << alone_zero.output;
   EXPECT_NE(alone_zero.output.find("rank 0 of 2: rank 1 has not joined the rendezvous"),
@@ -105,14 +117,16 @@ TEST(LaunchTest, ARankThatNeverComesIsNamedWithinTheJoinTimeout) {
       << alone_zero.output;
   EXPECT_NE(alone_zero.output.find("within 2 s (--dist-join-timeout)"), std::string::npos)
       << alone_zero.output;
-  EXPECT_LT(alone_zero.seconds, join_s + 10.0) << alone_zero.output;
+  EXPECT_GE(waited, join_s - 0.5) << alone_zero.output;
+  EXPECT_LT(waited, join_s + 5.0) << alone_zero.output;
+  EXPECT_LT(alone_zero.seconds, join_s + kStartSlack) << alone_zero.output;
   EXPECT_FALSE(fs::exists(folder / "run")) << "rank 0 wrote its run folder before the others came";
 
   EXPECT_EQ(alone_one.exit_code, 1) << alone_one.output;
   EXPECT_NE(alone_one.output.find("rank 1 of 2: nothing answered at MASTER_ADDR:MASTER_PORT"),
             std::string::npos)
       << alone_one.output;
-  EXPECT_LT(alone_one.seconds, join_s + 10.0) << alone_one.output;
+  EXPECT_LT(alone_one.seconds, join_s + kStartSlack) << alone_one.output;
   fs::remove_all(folder);
 }
 
@@ -121,29 +135,36 @@ TEST(LaunchTest, ARankThatNeverComesIsNamedWithinTheJoinTimeout) {
 TEST(LaunchTest, ARankGivenTwiceIsRefusedAndTheMissingRankNamed) {
   const fs::path folder = fresh_folder("twice");
   const int port = test_port();
-  const std::string arguments = train_arguments(
-      folder, "--steps 64 --dist-join-timeout 8 --out " + (folder / "run").string());
+  const std::string arguments =
+      train_arguments(folder, "--steps 64 --out " + (folder / "run").string());
   const auto start = Clock::now();
   const auto deadline = start + std::chrono::seconds(90);
-  const pid_t zero = start_cli(rank_environment(3, 0, port), arguments, folder / "0.txt");
-  // The two rank 1s come once rank 0 serves the store, so that both find it.
-  ASSERT_TRUE(wait_for_port(port, start + std::chrono::seconds(30)))
-      << "rank 0 never served its store: " << read_text(folder / "0.txt");
-  const std::vector<Ended> ended = wait_all(
-      {{zero, folder / "0.txt"},
-       {start_cli(rank_environment(3, 1, port), arguments, folder / "1a.txt"), folder / "1a.txt"},
-       {start_cli(rank_environment(3, 1, port), arguments, folder / "1b.txt"), folder / "1b.txt"}},
-      start, deadline);
-  const Ended& ended_zero = ended[0];
-  const Ended& ended_a = ended[1];
-  const Ended& ended_b = ended[2];
-  std::cout << "rank 0 ended after " << ended_zero.seconds << " s, the rank 1s after "
-            << ended_a.seconds << " s and " << ended_b.seconds << " s\n";
+  // The two rank 1s start first and wait (up to 60 s) for rank 0's store, so that both are
+  // there within rank 0's 4 s.
+  std::vector<Started> started;
+  for (const char* log : {"1a.txt", "1b.txt"}) {
+    started.push_back({start_cli(rank_environment(3, 1, port),
+                                 arguments + " --dist-join-timeout 60", folder / log),
+                       folder / log});
+  }
+  started.push_back({start_cli(rank_environment(3, 0, port), arguments + " --dist-join-timeout 4",
+                               folder / "0.txt"),
+                     folder / "0.txt"});
+  const double served_at = seconds_until_served(port, start, deadline);
+  const std::vector<Ended> ended = wait_all(started, start, deadline);
+  const Ended& ended_a = ended[0];
+  const Ended& ended_b = ended[1];
+  const Ended& ended_zero = ended[2];
+  const double waited = ended_zero.seconds - served_at;
+  std::cout << "rank 0 ended after " << ended_zero.seconds << " s (" << waited
+            << " s after its store opened), the rank 1s after " << ended_a.seconds << " s and "
+            << ended_b.seconds << " s\n";
 
   EXPECT_EQ(ended_zero.exit_code, 1) << ended_zero.output;
   EXPECT_NE(ended_zero.output.find("rank 0 of 3: rank 2 has not joined the rendezvous"),
             std::string::npos)
       << ended_zero.output;
+  EXPECT_LT(waited, 4.0 + 5.0) << ended_zero.output;
   // One rank 1 joined and waits for rank 2 with rank 0; the other is refused.
   const bool a_refused = ended_a.output.find("another process") != std::string::npos;
   const Ended& refused = a_refused ? ended_a : ended_b;
@@ -154,12 +175,12 @@ TEST(LaunchTest, ARankGivenTwiceIsRefusedAndTheMissingRankNamed) {
                                 std::to_string(port) + " as rank 1 (RANK=1 given to two"),
             std::string::npos)
       << refused.output;
+  EXPECT_LT(refused.seconds, ended_zero.seconds) << "refused only when rank 0 gave up";
   EXPECT_EQ(joined.exit_code, 1) << joined.output;
-  EXPECT_NE(joined.output.find("rank 1 of 3: "), std::string::npos) << joined.output;
-  EXPECT_NE(joined.output.find("rank 2 has not joined"), std::string::npos) << joined.output;
-  for (const Ended* each : {&ended_zero, &ended_a, &ended_b}) {
-    EXPECT_LT(each->seconds, 8.0 + 10.0 + 10.0) << each->output;  // + the wait for rank 0
-  }
+  EXPECT_NE(joined.output.find("rank 1 of 3: rank 0 stopped waiting: rank 2 has not joined"),
+            std::string::npos)
+      << joined.output;
+  EXPECT_LT(joined.seconds, 4.0 + kStartSlack) << joined.output;
   fs::remove_all(folder);
 }
 
@@ -206,8 +227,8 @@ TEST(LaunchTest, AMasterPortOfAnotherServiceIsRefusedWithinSeconds) {
         << each->output;
     EXPECT_NE(each->output.find("is MASTER_PORT another service's port?"), std::string::npos)
         << each->output;
-    // Seconds, not the 60 s join timeout: 5 s for the store's answer, and the process's start.
-    EXPECT_LT(each->seconds, 5.0 + 10.0) << each->output;
+    // Seconds, not the 60 s join timeout: 0.5 s + 5 s of checks, and the process's start.
+    EXPECT_LT(each->seconds, 5.5 + kStartSlack) << each->output;
   }
   fs::remove_all(folder);
 }
