@@ -88,6 +88,12 @@ void add_run_options(CLI::App& train, TrainArguments& args) {
                      "stands still: it died, was stopped or hangs) before the others stop with "
                      "an error naming it",
                      CLI::Range(1.0, 86400.0));
+  train
+      .add_option("--dist-join-timeout", args.dist_join_timeout,
+                  "Seconds every rank of a data-parallel run has to start and join the others "
+                  "at rank 0's store before the ranks that came stop with an error naming those "
+                  "missing (default: --dist-timeout, at least 60)")
+      ->check(CLI::Range(1.0, 86400.0));
   train.add_flag("--quiet", args.quiet,
                  "No progress bar: a plain line every 10 updates (also when stdout is not a "
                  "terminal)");

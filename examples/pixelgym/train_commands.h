@@ -35,6 +35,7 @@ struct TrainArguments : EnvArguments {
   double eval_max_share = 0.1;
   int nproc = 1;
   double dist_timeout = 60.0;
+  double dist_join_timeout = 0.0;     // 0: max(dist_timeout, 60)
   const CLI::App* command = nullptr;  // the parsed subcommand: which flags were given
 };
 

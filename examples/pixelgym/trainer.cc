@@ -63,6 +63,79 @@ std::vector<std::string> command_line_without_nproc() {
   return kept;
 }
 
+// The flags of this rank's command line that decide the run, as given ({"--num-envs": ["4"],
+// "id": [...], ...}): all but --out and --quiet (only rank 0's matter) and --dist-join-timeout
+// (each rank's own wait).
+nlohmann::json run_flags(const TrainArguments& args) {
+  nlohmann::json flags = nlohmann::json::object();
+  for (const CLI::Option* option : args.command->get_options()) {
+    const std::string name = option->get_name();
+    if (option->count() == 0 || name == "--out" || name == "--quiet" ||
+        name == "--dist-join-timeout" || name == "--nproc" || name == "--help") {
+      continue;
+    }
+    flags[name] = option->results();
+  }
+  return flags;
+}
+
+// How rank `rank`'s run flags differ from rank 0's ("--num-envs: 3 on rank 1, 2 on rank 0; ..."),
+// or "" when they do not.
+std::string flag_differences(const nlohmann::json& theirs, int rank, const nlohmann::json& ours) {
+  const auto given = [](const nlohmann::json& flags, const std::string& name) {
+    if (!flags.contains(name)) return std::string("not given");
+    std::string text;
+    for (const auto& value : flags.at(name)) {
+      text += (text.empty() ? "" : " ") + value.get<std::string>();
+    }
+    return text;
+  };
+  std::vector<std::string> names;
+  for (const auto& [name, value] : theirs.items()) names.push_back(name);
+  for (const auto& [name, value] : ours.items()) {
+    if (!theirs.contains(name)) names.push_back(name);
+  }
+  std::sort(names.begin(), names.end());
+  std::string differences;
+  for (const std::string& name : names) {
+    if (theirs.value(name, nlohmann::json()) == ours.value(name, nlohmann::json())) continue;
+    differences += (differences.empty() ? "" : "; ") + name + ": " + given(theirs, name) +
+                   " on rank " + std::to_string(rank) + ", " + given(ours, name) + " on rank 0";
+  }
+  return differences;
+}
+
+// Every rank runs rank 0's settings and ignores its own command line, so one that differs from
+// rank 0's (but for --out, --quiet, --dist-join-timeout) is refused on every rank before the run
+// starts (UsageError naming each flag that differs), rather than ignored without a word.
+void check_same_command_line(const TrainArguments& args,
+                             distributed::GlooCommunicator& communicator) {
+  const nlohmann::json mine = run_flags(args);
+  const std::vector<std::string> lines =
+      communicator.gather_bytes(mine.dump(), "the ranks' command lines");
+  std::vector<std::string> verdicts;
+  std::string all;
+  if (communicator.rank() == 0) {
+    verdicts.emplace_back();
+    for (std::size_t r = 1; r < lines.size(); ++r) {
+      const std::string differences =
+          flag_differences(nlohmann::json::parse(lines[r]), static_cast<int>(r), mine);
+      verdicts.push_back(differences);
+      if (!differences.empty()) all += (all.empty() ? "" : "; ") + differences;
+    }
+  }
+  const std::string verdict =
+      communicator.scatter_bytes(verdicts, "the check of the ranks' command lines");
+  // Every rank has its verdict before any stops: rank 0's store may go with it.
+  communicator.all_gather(0, "the ranks' command lines read");
+  const std::string differences = communicator.rank() == 0 ? all : verdict;
+  if (differences.empty()) return;
+  throw UsageError("train: rank " + std::to_string(communicator.rank()) +
+                   ": the ranks' command lines differ (" + differences +
+                   "); every rank runs rank 0's settings, so give every rank the same command "
+                   "line (only --out, --quiet and --dist-join-timeout may differ)");
+}
+
 // The settings of a new run: the flags, over the --config file's settings of the algorithm.
 trainer::RunSettings new_run_settings(const TrainArguments& args,
                                       const trainer::AlgorithmFactory& algorithm) {
@@ -129,9 +202,16 @@ int run_train(const TrainArguments& args) {
         "torchrun or srun started this process as a rank already): give one or the other");
   }
   // A rank of a data-parallel run started by a launcher (torchrun, srun, train --nproc).
-  std::optional<distributed::DistributedSettings> ranks =
-      launcher ? std::nullopt
-               : distributed::DistributedSettings::from_environment(args.dist_timeout);
+  std::optional<distributed::DistributedSettings> ranks;
+  if (!launcher) {
+    try {
+      ranks = distributed::DistributedSettings::from_environment(
+          args.dist_timeout, args.dist_join_timeout > 0.0 ? args.dist_join_timeout
+                                                          : std::max(args.dist_timeout, 60.0));
+    } catch (const std::invalid_argument& error) {
+      throw UsageError(error.what());  // WORLD_SIZE, RANK, MASTER_PORT ... not numbers in range
+    }
+  }
   const bool joins = ranks && ranks->rank > 0;
   // Rank 0 takes the algorithm from the command line or the run folder; the others from it.
   const trainer::AlgorithmFactory& algorithm =
@@ -149,7 +229,12 @@ int run_train(const TrainArguments& args) {
   trainer::tune_process_for_training();
   std::unique_ptr<distributed::GlooCommunicator> communicator;
   if (ranks && ranks->world_size > 1) {
-    communicator = std::make_unique<distributed::GlooCommunicator>(*ranks);
+    try {
+      communicator = std::make_unique<distributed::GlooCommunicator>(*ranks);
+    } catch (const std::invalid_argument& error) {
+      throw UsageError(error.what());  // RANK given twice, WORLD_SIZE unlike rank 0's ...
+    }
+    check_same_command_line(args, *communicator);
   }
   const trainer::TrainBudget budget{args.steps, args.minutes};
   // Ranks other than 0 print errors only.

@@ -29,7 +29,7 @@ int main(int argc, char** argv) {
     }
   }
   try {
-    auto settings = pixelgym::distributed::DistributedSettings::from_environment(60.0);
+    auto settings = pixelgym::distributed::DistributedSettings::from_environment(60.0, 60.0);
     if (!settings) {
       std::vector<std::string> child{arguments[0]};
       child.insert(child.end(), rest.begin(), rest.end());

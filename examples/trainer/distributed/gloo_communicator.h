@@ -1,7 +1,7 @@
 // The trainer's Communicator on PyTorch's distributed package (c10d): a TCPStore for the
-// rendezvous, ProcessGroupGloo for the collectives, and a watchdog that names a rank that died or
-// stopped answering. Started the way torchrun starts workers: from the variables MASTER_ADDR,
-// MASTER_PORT, WORLD_SIZE, RANK and LOCAL_RANK.
+// rendezvous (a FileStore for train --nproc's local ranks), ProcessGroupGloo for the collectives,
+// and a watchdog that names a rank that died or stopped answering. Started the way torchrun starts
+// workers: from the variables MASTER_ADDR, MASTER_PORT, WORLD_SIZE, RANK and LOCAL_RANK.
 #pragma once
 
 #include <c10/util/intrusive_ptr.h>
@@ -22,7 +22,7 @@
 
 namespace c10d {
 class ProcessGroupGloo;
-class TCPStore;
+class Store;
 }  // namespace c10d
 
 namespace pixelgym::distributed {
@@ -35,20 +35,37 @@ struct DistributedSettings {
   int rank = 0;                              // RANK
   int local_rank = 0;                        // LOCAL_RANK (0 when unset)
   /// Seconds a rank may go without a sign of life (its heartbeat) before the others stop the
-  /// run naming it; also the limit on the rendezvous, at least 60 s.
+  /// run naming it.
   double timeout_s = 60.0;
+  /// Seconds every rank has to join the rendezvous (train --dist-join-timeout; by default
+  /// max(timeout_s, 60)): a rank missing then is named and every rank that came stops.
+  double join_timeout_s = 60.0;
+  /// PIXELGYM_RENDEZVOUS_FILE, which train --nproc sets: the file of a c10d::FileStore, in a
+  /// folder only this user may open, that the local ranks meet at instead of a TCPStore on
+  /// MASTER_PORT (then unused), so that nothing listens on a port for the rendezvous. Empty
+  /// otherwise.
+  std::string store_file;
 
-  /// The settings of the environment's WORLD_SIZE, RANK, MASTER_ADDR, MASTER_PORT and LOCAL_RANK;
-  /// nullopt when WORLD_SIZE is not set. Throws std::invalid_argument naming the variable and its
-  /// value when one is not a number in range or one that is needed is missing.
-  static std::optional<DistributedSettings> from_environment(double timeout_s);
+  /// The settings of the environment's WORLD_SIZE, RANK, MASTER_ADDR, MASTER_PORT, LOCAL_RANK and
+  /// PIXELGYM_RENDEZVOUS_FILE, with these timeouts; nullopt when WORLD_SIZE is not set. Throws
+  /// std::invalid_argument naming the variable and its value when one is not a number in range
+  /// or one that is needed is missing.
+  static std::optional<DistributedSettings> from_environment(double timeout_s,
+                                                             double join_timeout_s);
 };
 
 /// A rank of a run over Gloo. Construction is the rendezvous: rank 0 opens the TCPStore on
-/// MASTER_PORT, every rank connects to it, and the Gloo process group joins all world_size ranks
-/// (throws DistributedError when they do not all arrive within the rendezvous limit). Gloo's own
-/// socket goes on the interface named by GLOO_SOCKET_IFNAME (as in PyTorch) or else on the local
-/// address this host uses to reach MASTER_ADDR.
+/// MASTER_PORT (or every rank opens the FileStore of store_file), every rank connects to it,
+/// claims its rank there and waits for the others, and the Gloo process group joins all
+/// world_size ranks. Throws std::invalid_argument for a launch that cannot work: another process
+/// has claimed this rank already (RANK given twice), rank 0 was given another WORLD_SIZE, or
+/// MASTER_ADDR does not resolve. Throws DistributedError, naming the cause, when
+/// - a rank other than 0 finds at MASTER_ADDR:MASTER_PORT a program that does not answer as
+///   rank 0's store within 5 s (another service's port), or nothing there within join_timeout_s;
+/// - a rank has not joined within join_timeout_s (naming each missing rank);
+/// - rank 0 cannot serve the store on MASTER_PORT (a port in use).
+/// Gloo's own socket goes on the interface named by GLOO_SOCKET_IFNAME (as in PyTorch) or else on
+/// the local address this host uses to reach MASTER_ADDR (127.0.0.1 for train --nproc).
 ///
 /// Liveness: a thread of each rank adds to its heartbeat counter in the store twice a second
 /// and watches the others'. A rank whose counter stands still for timeout_s (dead, stopped or
@@ -95,11 +112,15 @@ class GlooCommunicator final : public trainer::Communicator {
   // A sum all-reduce of `count` values of T (float or double).
   template <typename T>
   void all_reduce(T* data, std::size_t count, const std::string& what);
+  // Claims this rank in the store and waits for every rank to claim its own (the rendezvous);
+  // `serves_store`: this rank's process serves the store (rank 0 over TCP).
+  void join(bool serves_store);
   void watch();
+  void stop_watchdog();
   std::string key(const std::string& what);
 
   DistributedSettings settings_;
-  c10::intrusive_ptr<c10d::TCPStore> store_;
+  c10::intrusive_ptr<c10d::Store> store_;
   c10::intrusive_ptr<c10d::ProcessGroupGloo> group_;
   std::int64_t sequence_ = 0;  // collectives through the store so far (unique keys)
 
@@ -114,11 +135,14 @@ class GlooCommunicator final : public trainer::Communicator {
 
 /// Runs `arguments` (a pixelgym command line without --nproc; arguments[0] is ignored: this
 /// executable runs) as `nproc` local ranks, as torchrun --standalone does: child processes with
-/// MASTER_ADDR 127.0.0.1, a free MASTER_PORT, WORLD_SIZE, RANK, LOCAL_RANK and LOCAL_WORLD_SIZE
-/// set, and OMP_NUM_THREADS set to the cores divided among them unless it is set. Waits for all;
-/// when one fails, gives the others timeout_s + 10 s to stop on their own, then kills them.
-/// Forwards SIGINT and SIGTERM. Reports each rank that failed to `errors` ("rank 1 (pid 123)
-/// was killed by signal 9 (Killed)"). Returns 0 when every rank exited 0, else 1.
+/// MASTER_ADDR 127.0.0.1, WORLD_SIZE, RANK, LOCAL_RANK and LOCAL_WORLD_SIZE set,
+/// PIXELGYM_RENDEZVOUS_FILE naming a store file in a new folder of $TMPDIR (or /tmp) that only
+/// this user may open (removed at the end), and OMP_NUM_THREADS set to the cores divided among
+/// them unless it is set. Each rank gets SIGTERM when the launcher dies (PR_SET_PDEATHSIG), so
+/// none is left training when it is killed. Waits for all; when one fails, gives the others
+/// timeout_s + 10 s to stop on their own, then kills them. Forwards SIGINT and SIGTERM. Reports
+/// each rank that failed to `errors` ("rank 1 (pid 123) was killed by signal 9 (Killed)").
+/// Returns 0 when every rank exited 0, else 1.
 int run_local_ranks(int nproc, const std::vector<std::string>& arguments, double timeout_s,
                     std::ostream& errors);
 

@@ -25,45 +25,13 @@
 #include "examples/trainer/run/checkpoint_file.h"
 #include "examples/trainer/run/progress_csv.h"
 #include "tests/examples/cli_run.h"
+#include "tests/examples/trainer/distributed/rank_processes.h"
 
 namespace pixelgym::testing {
 namespace {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
 using nlohmann::json;
-
-fs::path fresh_folder(const std::string& name) {
-  const fs::path folder = fs::temp_directory_path() /
-                          ("pixelgym_distributed_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(folder);
-  fs::create_directories(folder);
-  return folder;
-}
-
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-// A free port on 127.0.0.1 for a test's rendezvous, from the kernel (the launcher finds its
-// own the same way).
-int test_port() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t length = sizeof(address);
-  if (fd < 0 || ::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0 ||
-      ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) != 0) {
-    if (fd >= 0) ::close(fd);
-    return 29000 + static_cast<int>(::getpid() % 1000) * 2;
-  }
-  ::close(fd);
-  return ntohs(address.sin_port);
-}
 
 struct WorkerResult {
   int exit_code = -1;
@@ -138,17 +106,6 @@ TEST(DistributedTest, RanksWhoseParametersDifferAreStoppedByTheDigestCheck) {
 // identical.
 TEST(DistributedTest, AStragglersRolloutIsPreempted) { expect_both_ranks_pass("preemption"); }
 
-constexpr const char* kTinyConfig =
-    R"({"num_steps": 16, "num_minibatches": 2, "update_epochs": 2, "anneal_learning_rate": false})";
-
-std::string train_arguments(const fs::path& folder, const std::string& more) {
-  const fs::path config_file = folder / "tiny.json";
-  std::ofstream(config_file) << kTinyConfig;
-  return "train CartPoleBalance-v0 --set obs_mode=pixels+state --set width=32 --set height=32 "
-         "--set max_episode_steps=24 --num-envs 2 --threads 1 --config " +
-         config_file.string() + " --eval-episodes 1 --eval-every 0 --quiet " + more;
-}
-
 TEST(DistributedTest, TwoRanksTrainOneRunWithIdenticalParameters) {
   const fs::path folder = fresh_folder("run");
   const fs::path run = folder / "run";
@@ -208,25 +165,6 @@ TEST(DistributedTest, ADistributedRunResumesAsTheRunThatDidNotStop) {
             b.at("distributed").at("parameter_digests"));
   EXPECT_EQ(a.at("evaluation").at("returns"), b.at("evaluation").at("returns"));
   fs::remove_all(folder);
-}
-
-// The pid of the child of `parent` whose environment has RANK=`rank`, or -1.
-pid_t rank_pid(pid_t parent, int rank) {
-  for (const auto& entry : fs::directory_iterator("/proc")) {
-    const std::string name = entry.path().filename();
-    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
-    std::istringstream stat(read_text(entry.path() / "stat"));
-    std::string pid, comm, state;
-    pid_t ppid = 0;
-    stat >> pid >> comm >> state >> ppid;
-    if (ppid != parent) continue;
-    std::string environ = read_text(entry.path() / "environ");
-    std::replace(environ.begin(), environ.end(), '\0', '\n');
-    if (("\n" + environ).find("\nRANK=" + std::to_string(rank) + "\n") != std::string::npos) {
-      return static_cast<pid_t>(std::stol(name));
-    }
-  }
-  return -1;
 }
 
 struct Stopped {

@@ -253,7 +253,7 @@ int main(int argc, char** argv) {
   }
   torch::set_num_threads(1);
   try {
-    auto settings = distributed::DistributedSettings::from_environment(30.0);
+    auto settings = distributed::DistributedSettings::from_environment(30.0, 60.0);
     if (!settings) throw std::invalid_argument("WORLD_SIZE is not set");
     distributed::GlooCommunicator communicator(*settings);
     const std::string scenario = argv[1];
