@@ -1,11 +1,14 @@
 #include "wrappers/record_video.h"
 
 #include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -16,6 +19,7 @@
 #include <opencv2/videoio.hpp>
 #include <random>
 #include <stdexcept>
+#include <string_view>
 #include <system_error>
 #include <utility>
 #include <vector>
@@ -58,28 +62,123 @@ void check_name(const std::string& name, const char* what) {
   }
 }
 
+// A file descriptor kept open for the flock on it: closing it, or the process ending in any way
+// (SIGKILL included), releases the lock.
+class LockedFd {
+ public:
+  explicit LockedFd(int fd = -1) : fd_(fd) {}
+  LockedFd(LockedFd&& other) noexcept : fd_(std::exchange(other.fd_, -1)) {}
+  LockedFd& operator=(LockedFd&& other) noexcept {
+    reset();
+    fd_ = std::exchange(other.fd_, -1);
+    return *this;
+  }
+  LockedFd(const LockedFd&) = delete;
+  LockedFd& operator=(const LockedFd&) = delete;
+  ~LockedFd() { reset(); }
+
+  void reset() noexcept {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = -1;
+  }
+
+ private:
+  int fd_;
+};
+
+// A clip's temporary file and the exclusive flock its writer holds on it while it lives, which
+// tells remove_stale_temporaries that the file is in use.
+struct TemporaryFile {
+  fs::path path;  // empty once renamed or removed
+  LockedFd lock;
+};
+
+// The temporary files' names: ".{name}.partial-XXXXXX.mp4", X a letter or digit.
+constexpr std::string_view kTemporaryMark = ".partial-";
+constexpr std::size_t kTemporaryRandom = 6;
+constexpr std::string_view kTemporaryExtension = ".mp4";
+
+bool is_temporary_name(const std::string& file_name) {
+  const std::size_t tail = kTemporaryMark.size() + kTemporaryRandom + kTemporaryExtension.size();
+  if (file_name.size() < 2 + tail || file_name[0] != '.') return false;
+  const std::string_view end = std::string_view(file_name).substr(file_name.size() - tail);
+  return end.substr(0, kTemporaryMark.size()) == kTemporaryMark &&
+         end.substr(kTemporaryMark.size() + kTemporaryRandom) == kTemporaryExtension &&
+         std::all_of(end.begin() + kTemporaryMark.size(),
+                     end.begin() + kTemporaryMark.size() + kTemporaryRandom,
+                     [](char c) { return std::isalnum(static_cast<unsigned char>(c)) != 0; });
+}
+
+// Whether `path` still names the file open as `fd`.
+bool names_open_file(const fs::path& path, int fd) {
+  struct stat opened {};
+  struct stat named {};
+  return ::fstat(fd, &opened) == 0 && ::lstat(path.c_str(), &named) == 0 &&
+         opened.st_dev == named.st_dev && opened.st_ino == named.st_ino;
+}
+
 // Creates a unique empty file "{folder}/.{name}.partial-XXXXXX.mp4" (ending ".mp4", so that
 // FFmpeg picks the MP4 container), with the permissions a new file gets (0666 less the umask;
-// mkstemp's would be 0600). Throws std::runtime_error naming the folder.
-fs::path make_temporary(const fs::path& folder, const std::string& name) {
+// mkstemp's would be 0600), and takes an exclusive flock on it. Between the creation and the lock,
+// another recorder's remove_stale_temporaries may take the file for a dead writer's and remove it;
+// the path is checked once locked, and a new name drawn if it went. Throws std::runtime_error
+// naming the folder.
+TemporaryFile make_temporary(const fs::path& folder, const std::string& name) {
   static constexpr char kLetters[] =
       "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789";
   static thread_local std::mt19937_64 random{std::random_device{}()};
   int error = 0;
   for (int attempt = 0; attempt < 100; ++attempt) {
-    std::string suffix(6, ' ');
+    std::string suffix(kTemporaryRandom, ' ');
     for (char& letter : suffix) letter = kLetters[random() % (sizeof(kLetters) - 1)];
-    fs::path path = folder / ("." + name + ".partial-" + suffix + ".mp4");
+    fs::path path = folder / ("." + name + std::string(kTemporaryMark) + suffix +
+                              std::string(kTemporaryExtension));
     const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd >= 0) {
-      ::close(fd);
-      return path;
+    if (fd < 0) {
+      error = errno;
+      if (error != EEXIST) break;
+      continue;
     }
-    error = errno;
-    if (error != EEXIST) break;
+    LockedFd lock(fd);
+    // Blocks only while a remover holds the lock, which it does just to unlink the file.
+    int locked = 0;
+    while ((locked = ::flock(fd, LOCK_EX)) != 0 && errno == EINTR) {
+    }
+    if (locked != 0) {
+      error = errno;
+      ::unlink(path.c_str());
+      break;
+    }
+    if (names_open_file(path, fd)) return {std::move(path), std::move(lock)};
+    error = ENOENT;  // removed by another recorder before the lock: draw another name
   }
   throw std::runtime_error("RecordVideo: cannot create a file in the video folder " +
                            quoted(folder) + ": " + std::strerror(error));
+}
+
+// Removes the temporary files in `folder` that no writer holds: a writer locks its file until it
+// renames or removes it, and the kernel drops the lock when the writer's process dies (SIGKILL,
+// a crash, a power cut), so an unlocked one was left by a writer that is gone. Files of another
+// form, and files it cannot open or remove, are left as they are: this is housekeeping, and
+// recording goes on without it.
+void remove_stale_temporaries(const fs::path& folder) noexcept {
+  std::vector<fs::path> candidates;
+  std::error_code error;
+  for (fs::directory_iterator entry(folder, error), end; !error && entry != end;
+       entry.increment(error)) {
+    if (is_temporary_name(entry->path().filename().string())) candidates.push_back(entry->path());
+  }
+  for (const fs::path& path : candidates) {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
+    if (fd < 0) continue;
+    struct stat opened {};
+    // Locked: its writer is alive. Renamed or replaced since it was listed: not stale.
+    if (::flock(fd, LOCK_EX | LOCK_NB) == 0 && ::fstat(fd, &opened) == 0 &&
+        S_ISREG(opened.st_mode) && names_open_file(path, fd)) {
+      ::unlink(path.c_str());
+    }
+    ::close(fd);
+  }
 }
 
 }  // namespace
@@ -119,7 +218,7 @@ class RecordVideo::Clip {
   // The OS's reason why 64 kB (a video header and a first frame, or so) cannot be written to the
   // temporary file, or "" when they can.
   std::string probe_write() const {
-    const int fd = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    const int fd = ::open(temporary_.path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
     if (fd < 0) return std::strerror(errno);
     const std::string zeros(64 * 1024, '\0');
     std::size_t written = 0;
@@ -199,18 +298,19 @@ class RecordVideo::Clip {
     writer_.release();
     verify();
     std::error_code error;
-    fs::rename(temporary_, final_path_, error);
+    fs::rename(temporary_.path, final_path_, error);
     if (error) {
-      throw std::runtime_error("RecordVideo: cannot rename " + quoted(temporary_) + " to " +
+      throw std::runtime_error("RecordVideo: cannot rename " + quoted(temporary_.path) + " to " +
                                quoted(final_path_) + ": " + error.message());
     }
-    temporary_.clear();
+    temporary_.path.clear();
+    temporary_.lock.reset();
     return {final_path_, frames_, video_width_, video_height_, fourcc_};
   }
 
  private:
   bool open(const std::string& fourcc, double fps) {
-    if (!writer_.open(temporary_.string(), cv::CAP_FFMPEG, fourcc_code(fourcc), fps,
+    if (!writer_.open(temporary_.path.string(), cv::CAP_FFMPEG, fourcc_code(fourcc), fps,
                       cv::Size(video_width_, video_height_), true)) {
       return false;
     }
@@ -222,12 +322,12 @@ class RecordVideo::Clip {
   // opened again and its frame count, size and last frame checked.
   void verify() {
     std::error_code error;
-    const auto size = fs::file_size(temporary_, error);
+    const auto size = fs::file_size(temporary_.path, error);
     std::string problem;
     if (error) {
       problem = "it cannot be read: " + error.message();
     } else {
-      cv::VideoCapture capture(temporary_.string(), cv::CAP_FFMPEG);
+      cv::VideoCapture capture(temporary_.path.string(), cv::CAP_FFMPEG);
       const auto count =
           capture.isOpened() ? static_cast<std::int64_t>(capture.get(cv::CAP_PROP_FRAME_COUNT)) : 0;
       cv::Mat last;
@@ -246,7 +346,7 @@ class RecordVideo::Clip {
       }
     }
     if (problem.empty()) return;
-    const fs::path temporary = temporary_;
+    const fs::path temporary = temporary_.path;
     // Free space while the partial file still takes its room: what the encoder saw.
     const long long available = free_bytes(final_path_.parent_path());
     remove_temporary();
@@ -262,14 +362,15 @@ class RecordVideo::Clip {
 
   void remove_temporary() noexcept {
     if (writer_.isOpened()) writer_.release();
-    if (temporary_.empty()) return;
+    if (temporary_.path.empty()) return;
     std::error_code ignored;
-    fs::remove(temporary_, ignored);
-    temporary_.clear();
+    fs::remove(temporary_.path, ignored);  // then unlocked: no remover sees it unlocked first
+    temporary_.path.clear();
+    temporary_.lock.reset();
   }
 
   fs::path final_path_;
-  fs::path temporary_;  // empty once renamed or removed
+  TemporaryFile temporary_;  // locked until renamed or removed
   int width_;
   int height_;
   int video_width_;
@@ -321,8 +422,11 @@ RecordVideo::RecordVideo(std::unique_ptr<Env> env, const fs::path& video_folder,
     throw std::runtime_error("RecordVideo: cannot create the video folder " + quoted(folder_) +
                              ": " + (error ? error.message() : std::string("it exists as a file")));
   }
+  // Temporary files left by recorders that were killed (SIGKILL, a crash) before they could
+  // remove them; those of recorders writing into this folder now are kept.
+  remove_stale_temporaries(folder_);
   // A probe: fail now, not at the first clip, when no file can be created in the folder.
-  fs::remove(make_temporary(folder_, "write-check"), error);
+  fs::remove(make_temporary(folder_, "write-check").path, error);
   if (!episode_trigger_ && !step_trigger_) episode_trigger_ = capped_cubic_video_schedule;
 }
 

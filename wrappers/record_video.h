@@ -64,20 +64,28 @@ struct VideoClip {
 ///   here) and only then renamed to "{name}.mp4". When a clip fails (a write error, a frame of
 ///   another size), the temporary file is removed and std::runtime_error names what failed and
 ///   the path; the step or reset that ended the clip throws it.
+/// - A temporary file is locked (flock) by its writer while it lives, and the kernel drops the
+///   lock when the writer's process dies, SIGKILL included. The constructor removes the
+///   temporary files in `video_folder` that no writer holds (left by a killed recorder); those of
+///   recorders still writing there are kept.
 /// - `close()` finishes a clip in progress (as Gymnasium does) and throws if it cannot be
 ///   written; the destructor finishes it too, and when that fails it removes the temporary file
 ///   and prints the error to stderr (a destructor does not throw).
+///
+/// As Gymnasium's, it replaces a clip that exists under the same name (`pixelgym record` refuses
+/// to unless given --overwrite).
 ///
 /// The video's size is the first frame's of each clip, rounded up to even sides (4:2:0 video
 /// needs even sides; an odd frame gets its last row or column repeated). A later frame of
 /// another size is an error.
 class RecordVideo final : public Wrapper {
  public:
-  /// Creates `video_folder` (and its parents) if needed and checks that a file can be created in
-  /// it. Throws std::invalid_argument when the env's metadata().render_modes lacks "rgb_array",
-  /// `video_length` < 0, `fps` (given or from metadata) is not > 0 and finite, `video_folder` or
-  /// `name_prefix` is empty, or `name_prefix` contains '/'; std::runtime_error naming the folder
-  /// when it cannot be created or written.
+  /// Creates `video_folder` (and its parents) if needed, removes the temporary files that killed
+  /// recorders left in it, and checks that a file can be created in it. Throws
+  /// std::invalid_argument when the env's metadata().render_modes lacks "rgb_array", `video_length`
+  /// < 0, `fps` (given or from metadata) is not > 0 and finite, `video_folder` or `name_prefix` is
+  /// empty, or `name_prefix` contains '/'; std::runtime_error naming the folder when it cannot be
+  /// created or written.
   RecordVideo(std::unique_ptr<Env> env, const std::filesystem::path& video_folder,
               EpisodeTrigger episode_trigger = nullptr, StepTrigger step_trigger = nullptr,
               std::int64_t video_length = 0, const std::string& name_prefix = "rl-video",

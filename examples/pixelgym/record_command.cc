@@ -1,8 +1,12 @@
 // pixelgym record: episodes of a seeded policy written to .mp4 clips by RecordVideo.
+#include <algorithm>
+#include <charconv>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 #include <string>
+#include <system_error>
+#include <utility>
 #include <vector>
 
 #include "envs/rollout.h"
@@ -19,6 +23,7 @@ struct RecordArguments : EnvArguments {
   int episodes = 1;
   std::string out;
   std::string policy = "random";
+  bool overwrite = false;
 };
 
 void declare_record(CLI::App& record, RecordArguments& args) {
@@ -30,7 +35,8 @@ void declare_record(CLI::App& record, RecordArguments& args) {
       .add_option("--out", args.out,
                   "Folder for one FOLDER/ID-episode-N.mp4 per episode (created if missing), or a "
                   "FILE.mp4 for a single episode. Each file is complete or absent: written under "
-                  "a temporary name, checked and renamed")
+                  "a temporary name, checked and renamed. Clips already there are not replaced "
+                  "unless --overwrite is given")
       ->required()
       ->type_name("FOLDER|FILE.mp4");
   add_checked_option(record, "--episodes", args.episodes, "Episodes to record, one clip each",
@@ -41,6 +47,10 @@ void declare_record(CLI::App& record, RecordArguments& args) {
   add_checked_option(record, "--policy", args.policy,
                      "Policy choosing the actions: random (uniform over the action space)",
                      CLI::IsMember({"random"}));
+  record.add_flag("--overwrite", args.overwrite,
+                  "Replace the clips of this run that exist already (FOLDER/ID-episode-N.mp4 for "
+                  "N below --episodes, or FILE.mp4); without it, record refuses them before any "
+                  "episode runs (exit 2) and leaves every file as it was");
   add_env_options(record, args);
 }
 
@@ -52,6 +62,68 @@ std::unique_ptr<Env> make_recorded_env(const std::string& id, const std::vector<
 }
 
 bool is_mp4_file(const std::string& out) { return fs::path(out).extension() == ".mp4"; }
+
+// Whether something (a file, a folder, a link, even a dangling one) has the name `path`.
+bool name_taken(const fs::path& path) {
+  std::error_code error;
+  return fs::exists(fs::symlink_status(path, error));
+}
+
+// The clips "{id}-episode-{N}.mp4" for N below `episodes` that `folder` holds already, by episode.
+std::vector<std::string> existing_clips(const fs::path& folder, const std::string& id,
+                                        int episodes) {
+  std::vector<std::pair<long long, std::string>> found;
+  const std::string prefix = id + "-episode-";
+  const std::string suffix = ".mp4";
+  std::error_code error;
+  // Listed rather than probed one name per episode: --episodes may be in the millions.
+  for (fs::directory_iterator entry(folder, error), end; !error && entry != end;
+       entry.increment(error)) {
+    const std::string name = entry->path().filename().string();
+    if (name.size() <= prefix.size() + suffix.size() ||
+        name.compare(0, prefix.size(), prefix) != 0 ||
+        name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0) {
+      continue;
+    }
+    const std::string number =
+        name.substr(prefix.size(), name.size() - prefix.size() - suffix.size());
+    long long episode = 0;
+    const auto [stop, parse_error] =
+        std::from_chars(number.data(), number.data() + number.size(), episode);
+    if (parse_error == std::errc() && stop == number.data() + number.size() &&
+        std::to_string(episode) == number && episode < episodes) {
+      found.emplace_back(episode, name);
+    }
+  }
+  std::sort(found.begin(), found.end());
+  std::vector<std::string> names;
+  for (auto& clip : found) names.push_back(std::move(clip.second));
+  return names;
+}
+
+// Refuses, before any work, to replace clips that exist already unless --overwrite was given.
+void check_no_overwrite(const RecordArguments& args, bool one_file) {
+  if (args.overwrite) return;
+  if (one_file) {
+    if (name_taken(args.out)) {
+      throw UsageError("--out " + args.out +
+                       " exists already; pass --overwrite to replace it, or name another file");
+    }
+    return;
+  }
+  const std::vector<std::string> names = existing_clips(args.out, args.id, args.episodes);
+  if (names.empty()) return;
+  constexpr std::size_t kNamed = 5;
+  std::string listed;
+  for (std::size_t i = 0; i < names.size() && i < kNamed; ++i) {
+    listed += (i == 0 ? "" : ", ") + names[i];
+  }
+  if (names.size() > kNamed) listed += " and " + std::to_string(names.size() - kNamed) + " more";
+  throw UsageError("--out " + args.out + " already holds " + std::to_string(names.size()) +
+                   (names.size() == 1 ? " file" : " files") + " that this run would write (" +
+                   listed + "); pass --overwrite to replace " +
+                   (names.size() == 1 ? "it" : "them") + ", or give another folder");
+}
 
 int run_record(const RecordArguments& args) {
   const bool one_file = is_mp4_file(args.out);
@@ -65,6 +137,7 @@ int run_record(const RecordArguments& args) {
   }
   // Before any episode runs: a path that cannot take the clip is found now, not after them.
   if (one_file) check_video_file("--out", args.out);
+  check_no_overwrite(args, one_file);
   std::unique_ptr<Env> env = make_recorded_env(args.id, args.sets, args.wraps);
   // A folder: one clip per episode, "{folder}/{id}-episode-{N}.mp4". One file: the clip is
   // started by hand before the first reset, under the file's own name.

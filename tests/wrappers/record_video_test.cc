@@ -1,6 +1,7 @@
 // RecordVideo: clips reopened with OpenCV and ffprobe (frame count, size, fps, codec), triggers,
-// names, video_length, flat memory over a 10,000-frame clip, and every failure leaving no file
-// under a final name (a full tmpfs, a read-only folder, a frame of another size).
+// names, video_length, flat memory over a 10,000-frame clip, every failure leaving no file
+// under a final name (a full tmpfs, a read-only folder, a frame of another size), and temporary
+// files of killed recorders removed while those of live ones are kept.
 #include "wrappers/record_video.h"
 
 #include <gmock/gmock.h>
@@ -530,6 +531,70 @@ TEST(RecordVideoTest, EnvErrorMidClipLeavesNoFile) {
   }  // the destructor finishes it
   EXPECT_EQ(files_in(folder), std::set<std::string>{"rl-video-episode-1.mp4"});
   EXPECT_EQ(read_back(folder / "rl-video-episode-1.mp4").frames, 11);
+}
+
+// The names of the temporary files in `folder` (".{name}.partial-XXXXXX.mp4").
+std::set<std::string> temporary_files_in(const fs::path& folder) {
+  std::set<std::string> names;
+  for (const std::string& name : files_in(folder)) {
+    if (name[0] == '.' && name.find(".partial-") != std::string::npos) names.insert(name);
+  }
+  return names;
+}
+
+// A recorder killed mid-clip (SIGKILL) leaves its temporary file, which nothing locks any more:
+// the kernel dropped its writer's lock. The next recorder into the folder removes such files,
+// and only those: names of another form, and a folder of that form, are left (issue 42).
+TEST(RecordVideoTest, TemporaryFilesNoWriterHoldsAreRemovedByTheNextRecorder) {
+  const fs::path folder = fresh_folder();
+  fs::create_directories(folder);
+  const std::set<std::string> stale = {".rl-video-episode-0.partial-a1B2c3.mp4",
+                                       ".demo.partial-zzzzzz.mp4",
+                                       ".write-check.partial-Q9q9Q9.mp4"};
+  const std::set<std::string> others = {
+      "rl-video-episode-0.mp4",      ".notes.partial-abcde.mp4",  // five random letters
+      "rl-video.partial-abcdef.mp4",                              // no leading dot
+      ".x.partial-abcdef.mkv",       ".x.partial-ab-def.mp4",    ".partial-abcdef.mp4"};
+  for (const std::string& name : stale) std::ofstream(folder / name) << "half a video";
+  for (const std::string& name : others) std::ofstream(folder / name) << "not ours";
+  fs::create_directory(folder / ".dir.partial-abcdef.mp4");
+  std::set<std::string> left = others;
+  left.insert(".dir.partial-abcdef.mp4");
+
+  RecordVideo record(std::make_unique<FrameEnv>(16, 16, 3), folder, every_episode);
+  EXPECT_EQ(files_in(folder), left);
+  run_episode(record);
+  record.close();
+  EXPECT_EQ(files_in(folder), left);  // rl-video-episode-0.mp4 replaced, as Gymnasium's does
+  EXPECT_EQ(read_back(folder / "rl-video-episode-0.mp4").frames, 4);
+}
+
+// A recorder holds its temporary file locked while it writes: a second recorder started in the
+// same folder meanwhile keeps it, and both clips are written. (flock: the lock of another open
+// file in the same process counts too, so this holds for two recorders in one process as well as
+// in two.)
+TEST(RecordVideoTest, ASecondRecorderKeepsTheTemporaryFileOfOneWriting) {
+  const fs::path folder = fresh_folder();
+  RecordVideo first(std::make_unique<FrameEnv>(32, 32, 10), folder, every_episode);
+  first.reset();
+  const Value action = first.action_space().zeros();
+  for (int t = 0; t < 3; ++t) first.step(action);
+  const std::set<std::string> writing = temporary_files_in(folder);
+  ASSERT_EQ(writing.size(), 1U) << ::testing::PrintToString(files_in(folder));
+  {
+    RecordVideo second(std::make_unique<FrameEnv>(32, 32, 4), folder, every_episode, nullptr, 0,
+                       "second");
+    EXPECT_EQ(temporary_files_in(folder), writing);
+    run_episode(second);
+    second.close();
+  }
+  EXPECT_EQ(temporary_files_in(folder), writing);
+  for (int t = 3; t < 10; ++t) first.step(action);  // the episode ends at step 10
+  first.close();
+  EXPECT_EQ(files_in(folder),
+            (std::set<std::string>{"rl-video-episode-0.mp4", "second-episode-0.mp4"}));
+  EXPECT_EQ(read_back(folder / "rl-video-episode-0.mp4").frames, 11);
+  EXPECT_EQ(read_back(folder / "second-episode-0.mp4").frames, 5);
 }
 
 TEST(RecordVideoTest, FrameOfAnotherSizeFailsTheClip) {
