@@ -139,6 +139,23 @@ TEST(DrqV2InputTest, ReadsStacksAndRefusesWhatItCannotLearnFrom) {
       {"bounded"});
 }
 
+// Whether `shifted` is `images` (B, frames, H, W, C as `shape` gives them) shifted by `shifts`
+// as ppo::random_shift shifts their float (B, frames C, H, W) form.
+bool equals_ppo_random_shift(std::vector<std::uint8_t> images, std::vector<std::uint8_t> shifted,
+                             const std::vector<std::int64_t>& shifts,
+                             const std::vector<std::int64_t>& shape, std::int64_t pad) {
+  const std::int64_t batch = shape[0];
+  const auto as_chw = [&](std::vector<std::uint8_t>& bytes) {
+    return torch::from_blob(bytes.data(), shape, torch::kUInt8)
+        .permute({0, 1, 4, 2, 3})
+        .reshape({batch, shape[1] * shape[4], shape[2], shape[3]})
+        .to(torch::kFloat32);
+  };
+  const torch::Tensor expected =
+      ppo::random_shift(as_chw(images), torch::tensor(shifts, torch::kInt64).view({batch, 2}), pad);
+  return torch::equal(as_chw(shifted), expected);
+}
+
 TEST(DrqV2AugmentationTest, ShiftsMatchPpoRandomShiftAndStayInsideThePaddedWindow) {
   const std::int64_t batch = 6, frames = 2, h = 12, w = 10, c = 3, pad = 4;
   std::mt19937 rng(7);
@@ -147,17 +164,7 @@ TEST(DrqV2AugmentationTest, ShiftsMatchPpoRandomShiftAndStayInsideThePaddedWindo
   std::vector<std::int64_t> shifts = {0, 0, 8, 8, 4, 4, 0, 8, 8, 0, 3, 5};
   std::vector<std::uint8_t> shifted(images.size());
   shift_frames(images.data(), shifted.data(), batch, frames, h, w, c, pad, shifts.data());
-
-  // (B, frames, H, W, C) as float (B, frames C, H, W), shifted by ppo's float version.
-  const auto as_chw = [&](std::vector<std::uint8_t>& bytes) {
-    return torch::from_blob(bytes.data(), {batch, frames, h, w, c}, torch::kUInt8)
-        .permute({0, 1, 4, 2, 3})
-        .reshape({batch, frames * c, h, w})
-        .to(torch::kFloat32);
-  };
-  const torch::Tensor expected =
-      ppo::random_shift(as_chw(images), torch::tensor(shifts, torch::kInt64).view({batch, 2}), pad);
-  EXPECT_TRUE(torch::equal(as_chw(shifted), expected));
+  EXPECT_TRUE(equals_ppo_random_shift(images, shifted, shifts, {batch, frames, h, w, c}, pad));
   // Offset (pad, pad) is the identity.
   const std::size_t stack_bytes = static_cast<std::size_t>(frames * h * w * c);
   EXPECT_TRUE(std::equal(images.begin() + 2 * stack_bytes, images.begin() + 3 * stack_bytes,
@@ -191,15 +198,7 @@ TEST(DrqV2AugmentationTest, APadLargerThanTheImageRepeatsTheEdges) {
                                       pad + w, pad + w, pad - w, pad - 1, pad + 4, pad,     pad};
   std::vector<std::uint8_t> shifted(images.size(), 0);
   shift_frames(images.data(), shifted.data(), batch, frames, h, w, c, pad, shifts.data());
-  const auto as_chw = [&](std::vector<std::uint8_t>& bytes) {
-    return torch::from_blob(bytes.data(), {batch, frames, h, w, c}, torch::kUInt8)
-        .permute({0, 1, 4, 2, 3})
-        .reshape({batch, frames * c, h, w})
-        .to(torch::kFloat32);
-  };
-  const torch::Tensor expected =
-      ppo::random_shift(as_chw(images), torch::tensor(shifts, torch::kInt64).view({batch, 2}), pad);
-  EXPECT_TRUE(torch::equal(as_chw(shifted), expected));
+  EXPECT_TRUE(equals_ppo_random_shift(images, shifted, shifts, {batch, frames, h, w, c}, pad));
   // Offset (0, 0) reads from 13 rows above and columns left of the image: every pixel of the
   // first frame is the source's top-left one.
   const std::size_t frame = static_cast<std::size_t>(h * w * c);
