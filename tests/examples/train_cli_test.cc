@@ -585,7 +585,7 @@ TEST(TrainCliTest, SettingsTooLargeOrNotIntegersAreRefusedByName) {
     for (const std::string& text : named) {
       EXPECT_NE(run.output.find(text), std::string::npos) << text << "\n" << run.output;
     }
-    EXPECT_FALSE(fs::exists(folder / "run" / "progress.csv"));
+    EXPECT_FALSE(fs::exists(folder / "run")) << "a refused run left its folder";
   };
   const std::vector<std::string> memory = {"of memory, but ", " is available (", "Lower "};
   const auto with = [](std::vector<std::string> texts, const std::string& more) {

@@ -414,9 +414,21 @@ std::optional<json> TrainingRun::train() {
     }
     settings_.torch_threads = factory_->set_threads(settings_.torch_threads);
   }
+  const bool folder_existed = fs::exists(folder_);
   if (lead() && !lock_) lock_ = RunLock::acquire(folder_, "train");
-  env_ = make_training_env(settings_, parse_sets_);
-  algorithm_ = factory_->make(*env_, settings_.algorithm_config, communicator_);
+  try {
+    env_ = make_training_env(settings_, parse_sets_);
+    algorithm_ = factory_->make(*env_, settings_.algorithm_config, communicator_);
+  } catch (...) {
+    // Refused before anything was written (an env it cannot train on, settings that do not fit
+    // in memory): a new run leaves no folder behind, only the lock it took.
+    if (lead() && !checkpoint_ && !restart_) {
+      std::error_code ignored;
+      fs::remove(folder_ / ".lock", ignored);
+      if (!folder_existed) fs::remove(folder_, ignored);  // only when empty
+    }
+    throw;
+  }
   if (checkpoint_) {
     restore_from_checkpoint();
   } else if (lead() && restart_) {
