@@ -2,7 +2,7 @@
 // enforcement, TimeLimit), and GridWorld's render. Run: build/bench/envs_bench
 #include <benchmark/benchmark.h>
 
-#include "envs/registry.h"
+#include "pixelgym/envs/registry.h"
 
 namespace pixelgym {
 namespace {

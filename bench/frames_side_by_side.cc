@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "render/image_io.h"
+#include "pixelgym/render/image_io.h"
 
 namespace {
 

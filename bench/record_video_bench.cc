@@ -16,9 +16,9 @@
 #include <string>
 #include <vector>
 
-#include "envs/registry.h"
-#include "envs/rng.h"
-#include "wrappers/record_video.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/rng.h"
+#include "pixelgym/wrappers/record_video.h"
 
 namespace {
 

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "render/renderer.h"
+#include "pixelgym/render/renderer.h"
 #include "tests/envs/scene_fixtures.h"
 
 int main(int argc, char** argv) {

@@ -36,10 +36,10 @@
 #include <utility>
 #include <vector>
 
-#include "envs/registry.h"
-#include "envs/rng.h"
-#include "envs/vector/batch_space.h"
-#include "envs/vector/make_vec.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/rng.h"
+#include "pixelgym/envs/vector/batch_space.h"
+#include "pixelgym/envs/vector/make_vec.h"
 
 namespace {
 

@@ -17,9 +17,9 @@
 #include <string>
 #include <vector>
 
-#include "envs/registry.h"
-#include "envs/rollout.h"
-#include "wrappers/wrapper_spec.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/rollout.h"
+#include "pixelgym/wrappers/wrapper_spec.h"
 
 namespace {
 

@@ -13,8 +13,9 @@ endfunction()
 
 # pixelgym_add_library(NAME SOURCES ... DEPS ...): library pixelgym_NAME (shared unless
 # PIXELGYM_SHARED_LIBS is off) with alias pixelgym::NAME, exported as pixelgym::NAME by
-# `cmake --install` (cmake/PixelgymInstall.cmake); headers are included as "NAME/file.h" from the
-# project root, or from include/pixelgym/ once installed.
+# `cmake --install` (cmake/PixelgymInstall.cmake); headers are included as "pixelgym/NAME/file.h",
+# in the build tree through PIXELGYM_INCLUDE_DIR (a folder whose pixelgym/NAME links to the
+# source's NAME/), once installed from include/.
 function(pixelgym_add_library name)
   cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
   if(PIXELGYM_SHARED_LIBS)
@@ -24,8 +25,9 @@ function(pixelgym_add_library name)
   endif()
   add_library(pixelgym::${name} ALIAS pixelgym_${name})
   target_compile_features(pixelgym_${name} PUBLIC cxx_std_17)
-  target_include_directories(pixelgym_${name} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>
-                             $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/pixelgym>)
+  target_include_directories(pixelgym_${name} PUBLIC $<BUILD_INTERFACE:${PIXELGYM_INCLUDE_DIR}>
+                             $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>
+                             $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
   target_link_libraries(pixelgym_${name} PUBLIC ${ARG_DEPS})
   # Installed, the libraries find each other in their own folder.
   set_target_properties(pixelgym_${name} PROPERTIES POSITION_INDEPENDENT_CODE ON EXPORT_NAME ${name}

@@ -1,5 +1,5 @@
 # `cmake --install BUILD [--prefix PREFIX]`: pixelgym's shared libraries, their headers (under
-# include/pixelgym/, included as "envs/registry.h" as in the source tree), the CMake package
+# include/pixelgym/, included as <pixelgym/envs/registry.h> as in the source tree), the CMake package
 # (find_package(pixelgym) gives the pixelgym:: targets), the assets (share/pixelgym/assets, which
 # the engine finds from its own library's folder), and, from their own folders, the tool
 # (examples/) and the Python package (python/). `make deb` packs the same files into a Debian
@@ -15,7 +15,7 @@ get_property(pixelgym_libraries GLOBAL PROPERTY PIXELGYM_LIBRARIES)
 set_target_properties(pixelgym_testing_gtest PROPERTIES EXPORT_NAME testing_gtest)
 install(TARGETS ${pixelgym_libraries} pixelgym_testing_gtest EXPORT pixelgymTargets
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
-        INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/pixelgym)
+        INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 # The renderer's private headers (each says "Private" at its top: the OpenGL declarations and the
 # GL objects behind render/renderer.h) are for render/*.cc only; no installed header includes them.
 install(DIRECTORY engine envs render testing wrappers

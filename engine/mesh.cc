@@ -1,4 +1,4 @@
-#include "engine/mesh.h"
+#include "pixelgym/engine/mesh.h"
 
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/regular_file.h"
+#include "pixelgym/engine/regular_file.h"
 
 namespace pixelgym::engine {
 namespace {

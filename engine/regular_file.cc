@@ -1,4 +1,4 @@
-#include "engine/regular_file.h"
+#include "pixelgym/engine/regular_file.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>

@@ -1,4 +1,4 @@
-#include "engine/robot_model.h"
+#include "pixelgym/engine/robot_model.h"
 
 #include <console_bridge/console.h>
 #include <dlfcn.h>
@@ -16,8 +16,8 @@
 #include <set>
 #include <sstream>
 
-#include "engine/regular_file.h"
-#include "engine/xml_depth.h"
+#include "pixelgym/engine/regular_file.h"
+#include "pixelgym/engine/xml_depth.h"
 
 namespace pixelgym::engine {
 namespace fs = std::filesystem;

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/mesh.h"
+#include "pixelgym/engine/mesh.h"
 
 namespace pixelgym::engine {
 

@@ -1,4 +1,4 @@
-#include "engine/world.h"
+#include "pixelgym/engine/world.h"
 
 #include <BulletCollision/CollisionShapes/btShapeHull.h>
 #include <BulletDynamics/Featherstone/btMultiBody.h>

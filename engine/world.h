@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/robot_model.h"
+#include "pixelgym/engine/robot_model.h"
 
 namespace pixelgym::engine {
 

@@ -1,11 +1,11 @@
-#include "envs/checker.h"
+#include "pixelgym/envs/checker.h"
 
 #include <algorithm>
 #include <cmath>
 #include <functional>
 #include <sstream>
 
-#include "envs/rollout.h"
+#include "pixelgym/envs/rollout.h"
 
 namespace pixelgym {
 namespace {

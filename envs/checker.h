@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "envs/env.h"
+#include "pixelgym/envs/env.h"
 
 namespace pixelgym {
 

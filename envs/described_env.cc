@@ -1,4 +1,4 @@
-#include "envs/described_env.h"
+#include "pixelgym/envs/described_env.h"
 
 #include <stdexcept>
 #include <utility>

@@ -6,8 +6,8 @@
 #include <optional>
 #include <string>
 
-#include "envs/env.h"
-#include "envs/registry.h"
+#include "pixelgym/envs/env.h"
+#include "pixelgym/envs/registry.h"
 
 namespace pixelgym {
 

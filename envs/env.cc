@@ -1,6 +1,6 @@
-#include "envs/env.h"
+#include "pixelgym/envs/env.h"
 
-#include "envs/registry.h"
+#include "pixelgym/envs/registry.h"
 
 namespace pixelgym {
 

@@ -8,12 +8,12 @@
 #include <string>
 #include <vector>
 
-#include "envs/array.h"
-#include "envs/errors.h"
-#include "envs/params.h"
-#include "envs/rng.h"
-#include "envs/space.h"
-#include "envs/value.h"
+#include "pixelgym/envs/array.h"
+#include "pixelgym/envs/errors.h"
+#include "pixelgym/envs/params.h"
+#include "pixelgym/envs/rng.h"
+#include "pixelgym/envs/space.h"
+#include "pixelgym/envs/value.h"
 
 namespace pixelgym {
 

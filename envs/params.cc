@@ -1,4 +1,4 @@
-#include "envs/params.h"
+#include "pixelgym/envs/params.h"
 
 #include <algorithm>
 #include <cctype>

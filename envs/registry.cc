@@ -1,11 +1,11 @@
-#include "envs/registry.h"
+#include "pixelgym/envs/registry.h"
 
 #include <algorithm>
 #include <cctype>
 #include <regex>
 #include <stdexcept>
 
-#include "envs/time_limit.h"
+#include "pixelgym/envs/time_limit.h"
 
 namespace pixelgym {
 namespace {

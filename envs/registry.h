@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "envs/env.h"
-#include "envs/params.h"
-#include "envs/render_resources.h"
+#include "pixelgym/envs/env.h"
+#include "pixelgym/envs/params.h"
+#include "pixelgym/envs/render_resources.h"
 
 namespace pixelgym {
 

@@ -1,4 +1,4 @@
-#include "envs/render_resources.h"
+#include "pixelgym/envs/render_resources.h"
 
 namespace pixelgym {
 

@@ -1,4 +1,4 @@
-#include "envs/rollout.h"
+#include "pixelgym/envs/rollout.h"
 
 namespace pixelgym {
 

@@ -4,8 +4,8 @@
 
 #include <cstdint>
 
-#include "envs/env.h"
-#include "envs/rng.h"
+#include "pixelgym/envs/env.h"
+#include "pixelgym/envs/rng.h"
 
 namespace pixelgym {
 

@@ -1,4 +1,4 @@
-#include "envs/space.h"
+#include "pixelgym/envs/space.h"
 
 #include <stdexcept>
 

@@ -7,9 +7,9 @@
 #include <optional>
 #include <string>
 
-#include "envs/array.h"
-#include "envs/rng.h"
-#include "envs/value.h"
+#include "pixelgym/envs/array.h"
+#include "pixelgym/envs/rng.h"
+#include "pixelgym/envs/value.h"
 
 namespace pixelgym {
 

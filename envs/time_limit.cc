@@ -1,4 +1,4 @@
-#include "envs/time_limit.h"
+#include "pixelgym/envs/time_limit.h"
 
 #include <stdexcept>
 #include <string>

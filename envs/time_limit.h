@@ -3,7 +3,7 @@
 
 #include <cstdint>
 
-#include "envs/wrapper.h"
+#include "pixelgym/envs/wrapper.h"
 
 namespace pixelgym {
 

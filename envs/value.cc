@@ -1,4 +1,4 @@
-#include "envs/value.h"
+#include "pixelgym/envs/value.h"
 
 #include <algorithm>
 #include <stdexcept>

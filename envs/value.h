@@ -7,7 +7,7 @@
 #include <variant>
 #include <vector>
 
-#include "envs/array.h"
+#include "pixelgym/envs/array.h"
 
 namespace pixelgym {
 

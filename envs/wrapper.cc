@@ -1,4 +1,4 @@
-#include "envs/wrapper.h"
+#include "pixelgym/envs/wrapper.h"
 
 #include <stdexcept>
 #include <utility>

@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "envs/env.h"
+#include "pixelgym/envs/env.h"
 
 namespace pixelgym {
 

@@ -7,8 +7,8 @@
 #include <cstdlib>
 #include <string>
 
-#include "engine/mesh.h"
 #include "fuzz/fuzz_input.h"
+#include "pixelgym/engine/mesh.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   pixelgym::fuzz::FuzzInput input(data, size);

@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "envs/registry.h"
 #include "examples/pixelgym/cli.h"
 #include "fuzz/fuzz_input.h"
-#include "wrappers/wrapper_spec.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/wrappers/wrapper_spec.h"
 
 namespace {
 

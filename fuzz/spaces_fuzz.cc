@@ -14,15 +14,15 @@
 #include <utility>
 #include <vector>
 
-#include "envs/space.h"
-#include "envs/spaces/box.h"
-#include "envs/spaces/dict.h"
-#include "envs/spaces/discrete.h"
-#include "envs/spaces/multi_binary.h"
-#include "envs/spaces/multi_discrete.h"
-#include "envs/spaces/tuple.h"
-#include "envs/value.h"
 #include "fuzz/fuzz_input.h"
+#include "pixelgym/envs/space.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/dict.h"
+#include "pixelgym/envs/spaces/discrete.h"
+#include "pixelgym/envs/spaces/multi_binary.h"
+#include "pixelgym/envs/spaces/multi_discrete.h"
+#include "pixelgym/envs/spaces/tuple.h"
+#include "pixelgym/envs/value.h"
 
 namespace {
 

@@ -5,8 +5,8 @@
 #include <cstdlib>
 #include <string>
 
-#include "engine/robot_model.h"
 #include "fuzz/fuzz_input.h"
+#include "pixelgym/engine/robot_model.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string path = pixelgym::fuzz::write_input_file(

@@ -6,7 +6,7 @@
 #include <functional>
 #include <string>
 
-#include "envs/params.h"
+#include "pixelgym/envs/params.h"
 
 namespace pixelgym::python {
 

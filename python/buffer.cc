@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "envs/array.h"
-#include "envs/errors.h"
+#include "pixelgym/envs/array.h"
+#include "pixelgym/envs/errors.h"
 #include "python/bindings.h"
 #include "python/convert.h"
 

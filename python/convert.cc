@@ -4,12 +4,12 @@
 #include <limits>
 #include <stdexcept>
 
-#include "envs/spaces/box.h"
-#include "envs/spaces/dict.h"
-#include "envs/spaces/discrete.h"
-#include "envs/spaces/multi_binary.h"
-#include "envs/spaces/multi_discrete.h"
-#include "envs/spaces/tuple.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/dict.h"
+#include "pixelgym/envs/spaces/discrete.h"
+#include "pixelgym/envs/spaces/multi_binary.h"
+#include "pixelgym/envs/spaces/multi_discrete.h"
+#include "pixelgym/envs/spaces/tuple.h"
 
 namespace pixelgym::python {
 namespace {

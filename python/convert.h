@@ -8,10 +8,10 @@
 #include <optional>
 #include <string>
 
-#include "envs/array.h"
-#include "envs/params.h"
-#include "envs/space.h"
-#include "envs/value.h"
+#include "pixelgym/envs/array.h"
+#include "pixelgym/envs/params.h"
+#include "pixelgym/envs/space.h"
+#include "pixelgym/envs/value.h"
 
 namespace pixelgym::python {
 

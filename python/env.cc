@@ -1,5 +1,5 @@
 // Env: one env from the registry, stepped from Python with the GIL released; ids(), info().
-#include "envs/env.h"
+#include "pixelgym/envs/env.h"
 
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "envs/registry.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/wrappers/wrapper_spec.h"
 #include "python/bindings.h"
 #include "python/convert.h"
-#include "wrappers/wrapper_spec.h"
 
 namespace pixelgym::python {
 namespace {

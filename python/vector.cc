@@ -10,12 +10,12 @@
 #include <string>
 #include <vector>
 
-#include "envs/registry.h"
-#include "envs/vector/async_vector_env.h"
-#include "envs/vector/make_vec.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/vector/async_vector_env.h"
+#include "pixelgym/envs/vector/make_vec.h"
+#include "pixelgym/wrappers/wrapper_spec.h"
 #include "python/bindings.h"
 #include "python/convert.h"
-#include "wrappers/wrapper_spec.h"
 
 namespace pixelgym::python {
 namespace {

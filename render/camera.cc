@@ -1,4 +1,4 @@
-#include "render/camera.h"
+#include "pixelgym/render/camera.h"
 
 #include <cmath>
 #include <stdexcept>

@@ -1,12 +1,12 @@
-#include "render/context.h"
+#include "pixelgym/render/context.h"
 
 #include <cstdlib>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
-#include "render/gl.h"
-#include "render/gl_library.h"
+#include "pixelgym/render/gl.h"
+#include "pixelgym/render/gl_library.h"
 
 namespace pixelgym::render {
 

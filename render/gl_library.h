@@ -1,7 +1,7 @@
 // Private to render/: one loaded copy of libOSMesa and its entry points (see render/mesa_copy.h).
 #pragma once
 
-#include "render/gl.h"
+#include "pixelgym/render/gl.h"
 
 namespace pixelgym::render {
 

@@ -7,7 +7,7 @@
 
 #include <utility>
 
-#include "render/gl.h"
+#include "pixelgym/render/gl.h"
 
 namespace pixelgym::render {
 

@@ -1,4 +1,4 @@
-#include "render/image_io.h"
+#include "pixelgym/render/image_io.h"
 
 #include <fcntl.h>
 #include <png.h>

@@ -1,4 +1,4 @@
-#include "render/lod.h"
+#include "pixelgym/render/lod.h"
 
 #include <algorithm>
 #include <cmath>

@@ -4,9 +4,9 @@
 
 #include <memory>
 
-#include "render/camera.h"
-#include "render/mesh_data.h"
-#include "render/scene.h"
+#include "pixelgym/render/camera.h"
+#include "pixelgym/render/mesh_data.h"
+#include "pixelgym/render/scene.h"
 
 namespace pixelgym::render {
 

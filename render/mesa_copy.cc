@@ -1,4 +1,4 @@
-#include "render/mesa_copy.h"
+#include "pixelgym/render/mesa_copy.h"
 
 #include <dlfcn.h>
 #include <malloc.h>
@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "render/gl_library.h"
+#include "pixelgym/render/gl_library.h"
 
 namespace pixelgym::render {
 

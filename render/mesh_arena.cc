@@ -1,4 +1,4 @@
-#include "render/mesh_arena.h"
+#include "pixelgym/render/mesh_arena.h"
 
 #include <algorithm>
 

@@ -8,9 +8,9 @@
 #include <unordered_map>
 #include <vector>
 
-#include "render/gl.h"
-#include "render/gl_object.h"
-#include "render/mesh_data.h"
+#include "pixelgym/render/gl.h"
+#include "pixelgym/render/gl_object.h"
+#include "pixelgym/render/mesh_data.h"
 
 namespace pixelgym::render {
 

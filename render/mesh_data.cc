@@ -1,4 +1,4 @@
-#include "render/mesh_data.h"
+#include "pixelgym/render/mesh_data.h"
 
 #include <Eigen/Geometry>
 #include <algorithm>

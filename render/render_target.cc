@@ -1,9 +1,9 @@
-#include "render/render_target.h"
+#include "pixelgym/render/render_target.h"
 
 #include <stdexcept>
 #include <string>
 
-#include "render/transforms.h"
+#include "pixelgym/render/transforms.h"
 
 namespace pixelgym::render {
 

@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "render/gl.h"
-#include "render/gl_object.h"
+#include "pixelgym/render/gl.h"
+#include "pixelgym/render/gl_object.h"
 
 namespace pixelgym::render {
 

@@ -1,4 +1,4 @@
-#include "render/renderer.h"
+#include "pixelgym/render/renderer.h"
 
 #include <algorithm>
 #include <map>
@@ -8,15 +8,15 @@
 #include <utility>
 #include <vector>
 
-#include "render/gl.h"
-#include "render/lod.h"
-#include "render/mesh_arena.h"
-#include "render/render_target.h"
-#include "render/shader_programs.h"
-#include "render/shadow_fit.h"
-#include "render/shadow_pass.h"
-#include "render/texture_cache.h"
-#include "render/transforms.h"
+#include "pixelgym/render/gl.h"
+#include "pixelgym/render/lod.h"
+#include "pixelgym/render/mesh_arena.h"
+#include "pixelgym/render/render_target.h"
+#include "pixelgym/render/shader_programs.h"
+#include "pixelgym/render/shadow_fit.h"
+#include "pixelgym/render/shadow_pass.h"
+#include "pixelgym/render/texture_cache.h"
+#include "pixelgym/render/transforms.h"
 
 namespace pixelgym::render {
 namespace {

@@ -5,9 +5,9 @@
 #include <memory>
 #include <string>
 
-#include "render/camera.h"
-#include "render/context.h"
-#include "render/scene.h"
+#include "pixelgym/render/camera.h"
+#include "pixelgym/render/context.h"
+#include "pixelgym/render/scene.h"
 
 namespace pixelgym::render {
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "render/mesh_data.h"
+#include "pixelgym/render/mesh_data.h"
 
 namespace pixelgym::render {
 

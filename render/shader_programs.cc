@@ -1,4 +1,4 @@
-#include "render/shader_programs.h"
+#include "pixelgym/render/shader_programs.h"
 
 #include <stdexcept>
 #include <string>

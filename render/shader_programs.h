@@ -2,8 +2,8 @@
 // locations looked up once.
 #pragma once
 
-#include "render/gl.h"
-#include "render/gl_object.h"
+#include "pixelgym/render/gl.h"
+#include "pixelgym/render/gl_object.h"
 
 namespace pixelgym::render {
 

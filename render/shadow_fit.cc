@@ -1,8 +1,8 @@
-#include "render/shadow_fit.h"
+#include "pixelgym/render/shadow_fit.h"
 
 #include <algorithm>
 
-#include "render/transforms.h"
+#include "pixelgym/render/transforms.h"
 
 namespace pixelgym::render {
 

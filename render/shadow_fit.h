@@ -7,8 +7,8 @@
 #include <optional>
 #include <vector>
 
-#include "render/camera.h"
-#include "render/scene.h"
+#include "pixelgym/render/camera.h"
+#include "pixelgym/render/scene.h"
 
 namespace pixelgym::render {
 

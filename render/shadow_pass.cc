@@ -1,8 +1,8 @@
-#include "render/shadow_pass.h"
+#include "pixelgym/render/shadow_pass.h"
 
-#include "render/lod.h"
-#include "render/render_target.h"
-#include "render/transforms.h"
+#include "pixelgym/render/lod.h"
+#include "pixelgym/render/render_target.h"
+#include "pixelgym/render/transforms.h"
 
 namespace pixelgym::render {
 

@@ -7,11 +7,11 @@
 #include <cstdint>
 #include <vector>
 
-#include "render/gl.h"
-#include "render/gl_object.h"
-#include "render/mesh_arena.h"
-#include "render/scene.h"
-#include "render/shader_programs.h"
+#include "pixelgym/render/gl.h"
+#include "pixelgym/render/gl_object.h"
+#include "pixelgym/render/mesh_arena.h"
+#include "pixelgym/render/scene.h"
+#include "pixelgym/render/shader_programs.h"
 
 namespace pixelgym::render {
 

@@ -1,10 +1,10 @@
-#include "render/texture_cache.h"
+#include "pixelgym/render/texture_cache.h"
 
 #include <cstdint>
 #include <stdexcept>
 #include <vector>
 
-#include "render/image_io.h"
+#include "pixelgym/render/image_io.h"
 
 namespace pixelgym::render {
 

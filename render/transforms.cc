@@ -1,4 +1,4 @@
-#include "render/transforms.h"
+#include "pixelgym/render/transforms.h"
 
 #include <Eigen/Geometry>
 #include <cmath>

@@ -3,7 +3,7 @@
 
 #include <Eigen/Core>
 
-#include "render/scene.h"
+#include "pixelgym/render/scene.h"
 
 namespace pixelgym::render {
 

@@ -16,7 +16,7 @@
 #include <iostream>
 #include <string>
 
-#include "testing/snapshot.h"
+#include "pixelgym/testing/snapshot.h"
 
 namespace pixelgym::testing {
 

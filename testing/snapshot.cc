@@ -1,4 +1,4 @@
-#include "testing/snapshot.h"
+#include "pixelgym/testing/snapshot.h"
 
 #include <algorithm>
 #include <cmath>

@@ -54,8 +54,8 @@
 #include <string>
 #include <vector>
 
-#include "envs/array.h"
-#include "render/image_io.h"
+#include "pixelgym/envs/array.h"
+#include "pixelgym/render/image_io.h"
 
 namespace pixelgym::testing {
 

@@ -8,9 +8,9 @@
 
 #include <string>
 
-#include "envs/array.h"
-#include "testing/gtest.h"
-#include "testing/snapshot.h"
+#include "pixelgym/envs/array.h"
+#include "pixelgym/testing/gtest.h"
+#include "pixelgym/testing/snapshot.h"
 
 namespace pixelgym::testing {
 

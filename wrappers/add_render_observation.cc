@@ -1,17 +1,17 @@
-#include "wrappers/add_render_observation.h"
+#include "pixelgym/wrappers/add_render_observation.h"
 
 #include <algorithm>
 #include <stdexcept>
 #include <utility>
 #include <vector>
 
-#include "envs/spaces/box.h"
-#include "envs/spaces/dict.h"
-#include "envs/spaces/discrete.h"
-#include "envs/spaces/multi_binary.h"
-#include "envs/spaces/multi_discrete.h"
-#include "envs/spaces/tuple.h"
-#include "wrappers/image_key.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/dict.h"
+#include "pixelgym/envs/spaces/discrete.h"
+#include "pixelgym/envs/spaces/multi_binary.h"
+#include "pixelgym/envs/spaces/multi_discrete.h"
+#include "pixelgym/envs/spaces/tuple.h"
+#include "pixelgym/wrappers/image_key.h"
 
 namespace pixelgym::wrappers {
 namespace {

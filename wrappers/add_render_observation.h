@@ -5,7 +5,7 @@
 #include <memory>
 #include <string>
 
-#include "envs/wrapper.h"
+#include "pixelgym/envs/wrapper.h"
 
 namespace pixelgym::wrappers {
 

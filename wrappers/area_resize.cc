@@ -1,4 +1,4 @@
-#include "wrappers/area_resize.h"
+#include "pixelgym/wrappers/area_resize.h"
 
 // An AVX2 + FMA kernel, compiled for x86-64 with GCC or Clang (function target attributes) and
 // chosen at run time when the CPU has both; elsewhere the portable (SSE2 or plain) one runs.

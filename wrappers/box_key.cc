@@ -1,11 +1,11 @@
-#include "wrappers/box_key.h"
+#include "pixelgym/wrappers/box_key.h"
 
 #include <stdexcept>
 #include <utility>
 #include <vector>
 
-#include "envs/spaces/dict.h"
-#include "wrappers/image_key.h"
+#include "pixelgym/envs/spaces/dict.h"
+#include "pixelgym/wrappers/image_key.h"
 
 namespace pixelgym::wrappers {
 namespace {

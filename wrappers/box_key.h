@@ -5,10 +5,10 @@
 #include <cstddef>
 #include <string>
 
-#include "envs/array.h"
-#include "envs/space.h"
-#include "envs/spaces/box.h"
-#include "envs/value.h"
+#include "pixelgym/envs/array.h"
+#include "pixelgym/envs/space.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/value.h"
 
 namespace pixelgym::wrappers {
 

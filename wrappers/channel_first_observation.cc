@@ -1,4 +1,4 @@
-#include "wrappers/channel_first_observation.h"
+#include "pixelgym/wrappers/channel_first_observation.h"
 
 #include <cstdint>
 #include <utility>

@@ -5,8 +5,8 @@
 #include <memory>
 #include <string>
 
-#include "envs/wrapper.h"
-#include "wrappers/image_key.h"
+#include "pixelgym/envs/wrapper.h"
+#include "pixelgym/wrappers/image_key.h"
 
 namespace pixelgym::wrappers {
 

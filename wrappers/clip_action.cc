@@ -1,4 +1,4 @@
-#include "wrappers/clip_action.h"
+#include "pixelgym/wrappers/clip_action.h"
 
 #include <algorithm>
 #include <limits>

@@ -5,8 +5,8 @@
 #include <memory>
 #include <string>
 
-#include "envs/spaces/box.h"
-#include "envs/wrapper.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/wrapper.h"
 
 namespace pixelgym::wrappers {
 

@@ -1,4 +1,4 @@
-#include "wrappers/dtype_observation.h"
+#include "pixelgym/wrappers/dtype_observation.h"
 
 #include <cmath>
 #include <cstdint>

@@ -1,11 +1,11 @@
-#include "wrappers/filter_observation.h"
+#include "pixelgym/wrappers/filter_observation.h"
 
 #include <algorithm>
 #include <stdexcept>
 #include <utility>
 
-#include "envs/spaces/dict.h"
-#include "wrappers/image_key.h"
+#include "pixelgym/envs/spaces/dict.h"
+#include "pixelgym/wrappers/image_key.h"
 
 namespace pixelgym::wrappers {
 namespace {

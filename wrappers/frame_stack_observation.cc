@@ -1,4 +1,4 @@
-#include "wrappers/frame_stack_observation.h"
+#include "pixelgym/wrappers/frame_stack_observation.h"
 
 #include <atomic>
 #include <cstdlib>
@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <utility>
 
-#include "envs/spaces/dict.h"
+#include "pixelgym/envs/spaces/dict.h"
 
 namespace pixelgym::wrappers {
 namespace {

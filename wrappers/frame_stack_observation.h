@@ -40,8 +40,8 @@
 #include <optional>
 #include <string>
 
-#include "envs/wrapper.h"
-#include "wrappers/image_key.h"
+#include "pixelgym/envs/wrapper.h"
+#include "pixelgym/wrappers/image_key.h"
 
 namespace pixelgym::wrappers {
 

@@ -1,4 +1,4 @@
-#include "wrappers/grayscale_observation.h"
+#include "pixelgym/wrappers/grayscale_observation.h"
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>

@@ -1,12 +1,12 @@
-#include "wrappers/image_key.h"
+#include "pixelgym/wrappers/image_key.h"
 
 #include <algorithm>
 #include <memory>
 #include <stdexcept>
 #include <utility>
 
-#include "envs/spaces/box.h"
-#include "envs/spaces/dict.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/dict.h"
 
 namespace pixelgym::wrappers {
 namespace {

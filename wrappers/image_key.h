@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "envs/array.h"
-#include "envs/space.h"
-#include "envs/value.h"
+#include "pixelgym/envs/array.h"
+#include "pixelgym/envs/space.h"
+#include "pixelgym/envs/value.h"
 
 namespace pixelgym::wrappers {
 

@@ -1,4 +1,4 @@
-#include "wrappers/normalize_observation.h"
+#include "pixelgym/wrappers/normalize_observation.h"
 
 #include <cmath>
 #include <cstdint>

@@ -5,9 +5,9 @@
 #include <memory>
 #include <string>
 
-#include "envs/wrapper.h"
-#include "wrappers/box_key.h"
-#include "wrappers/running_statistics.h"
+#include "pixelgym/envs/wrapper.h"
+#include "pixelgym/wrappers/box_key.h"
+#include "pixelgym/wrappers/running_statistics.h"
 
 namespace pixelgym::wrappers {
 

@@ -1,4 +1,4 @@
-#include "wrappers/normalize_reward.h"
+#include "pixelgym/wrappers/normalize_reward.h"
 
 #include <cmath>
 #include <sstream>

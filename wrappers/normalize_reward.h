@@ -5,8 +5,8 @@
 #include <memory>
 #include <string>
 
-#include "envs/wrapper.h"
-#include "wrappers/running_statistics.h"
+#include "pixelgym/envs/wrapper.h"
+#include "pixelgym/wrappers/running_statistics.h"
 
 namespace pixelgym::wrappers {
 

@@ -1,4 +1,4 @@
-#include "wrappers/record_episode_statistics.h"
+#include "pixelgym/wrappers/record_episode_statistics.h"
 
 #include <stdexcept>
 #include <utility>

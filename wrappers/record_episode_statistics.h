@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "envs/wrapper.h"
+#include "pixelgym/envs/wrapper.h"
 
 namespace pixelgym::wrappers {
 

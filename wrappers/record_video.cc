@@ -1,4 +1,4 @@
-#include "wrappers/record_video.h"
+#include "pixelgym/wrappers/record_video.h"
 
 #include <fcntl.h>
 #include <sys/file.h>

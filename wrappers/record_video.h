@@ -9,7 +9,7 @@
 #include <optional>
 #include <string>
 
-#include "envs/wrapper.h"
+#include "pixelgym/envs/wrapper.h"
 
 namespace pixelgym::wrappers {
 

@@ -1,4 +1,4 @@
-#include "wrappers/rescale_action.h"
+#include "pixelgym/wrappers/rescale_action.h"
 
 #include <algorithm>
 #include <cmath>

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "envs/spaces/box.h"
-#include "envs/wrapper.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/wrapper.h"
 
 namespace pixelgym::wrappers {
 

@@ -1,4 +1,4 @@
-#include "wrappers/resize_observation.h"
+#include "pixelgym/wrappers/resize_observation.h"
 
 #include <algorithm>
 #include <opencv2/core.hpp>

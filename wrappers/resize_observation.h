@@ -7,9 +7,9 @@
 #include <optional>
 #include <string>
 
-#include "envs/wrapper.h"
-#include "wrappers/area_resize.h"
-#include "wrappers/image_key.h"
+#include "pixelgym/envs/wrapper.h"
+#include "pixelgym/wrappers/area_resize.h"
+#include "pixelgym/wrappers/image_key.h"
 
 namespace pixelgym::wrappers {
 

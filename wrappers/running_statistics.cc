@@ -1,4 +1,4 @@
-#include "wrappers/running_statistics.h"
+#include "pixelgym/wrappers/running_statistics.h"
 
 #include <cmath>
 #include <sstream>

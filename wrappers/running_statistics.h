@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "envs/value.h"
+#include "pixelgym/envs/value.h"
 
 namespace pixelgym::wrappers {
 

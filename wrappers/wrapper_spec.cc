@@ -1,4 +1,4 @@
-#include "wrappers/wrapper_spec.h"
+#include "pixelgym/wrappers/wrapper_spec.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -10,20 +10,20 @@
 #include <optional>
 #include <stdexcept>
 
-#include "envs/described_env.h"
-#include "envs/time_limit.h"
-#include "wrappers/add_render_observation.h"
-#include "wrappers/channel_first_observation.h"
-#include "wrappers/clip_action.h"
-#include "wrappers/dtype_observation.h"
-#include "wrappers/filter_observation.h"
-#include "wrappers/frame_stack_observation.h"
-#include "wrappers/grayscale_observation.h"
-#include "wrappers/normalize_observation.h"
-#include "wrappers/normalize_reward.h"
-#include "wrappers/record_episode_statistics.h"
-#include "wrappers/rescale_action.h"
-#include "wrappers/resize_observation.h"
+#include "pixelgym/envs/described_env.h"
+#include "pixelgym/envs/time_limit.h"
+#include "pixelgym/wrappers/add_render_observation.h"
+#include "pixelgym/wrappers/channel_first_observation.h"
+#include "pixelgym/wrappers/clip_action.h"
+#include "pixelgym/wrappers/dtype_observation.h"
+#include "pixelgym/wrappers/filter_observation.h"
+#include "pixelgym/wrappers/frame_stack_observation.h"
+#include "pixelgym/wrappers/grayscale_observation.h"
+#include "pixelgym/wrappers/normalize_observation.h"
+#include "pixelgym/wrappers/normalize_reward.h"
+#include "pixelgym/wrappers/record_episode_statistics.h"
+#include "pixelgym/wrappers/rescale_action.h"
+#include "pixelgym/wrappers/resize_observation.h"
 
 namespace pixelgym::wrappers {
 namespace {

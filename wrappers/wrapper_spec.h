@@ -7,9 +7,9 @@
 #include <utility>
 #include <vector>
 
-#include "envs/env.h"
-#include "envs/registry.h"
-#include "envs/wrapper.h"
+#include "pixelgym/envs/env.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/wrapper.h"
 
 namespace pixelgym::wrappers {
 

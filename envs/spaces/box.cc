@@ -1,4 +1,4 @@
-#include "envs/spaces/box.h"
+#include "pixelgym/envs/spaces/box.h"
 
 #include <algorithm>
 #include <cmath>

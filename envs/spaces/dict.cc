@@ -1,4 +1,4 @@
-#include "envs/spaces/dict.h"
+#include "pixelgym/envs/spaces/dict.h"
 
 #include <stdexcept>
 

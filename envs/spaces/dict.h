@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-#include "envs/space.h"
+#include "pixelgym/envs/space.h"
 
 namespace pixelgym::spaces {
 

@@ -1,7 +1,7 @@
 // spaces::Discrete: integers {start, ..., start + n - 1}, as gymnasium.spaces.Discrete.
 #pragma once
 
-#include "envs/space.h"
+#include "pixelgym/envs/space.h"
 
 namespace pixelgym::spaces {
 

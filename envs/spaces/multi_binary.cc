@@ -1,4 +1,4 @@
-#include "envs/spaces/multi_binary.h"
+#include "pixelgym/envs/spaces/multi_binary.h"
 
 #include <stdexcept>
 

@@ -1,7 +1,7 @@
 // spaces::MultiBinary: arrays of 0s and 1s, as gymnasium.spaces.MultiBinary.
 #pragma once
 
-#include "envs/space.h"
+#include "pixelgym/envs/space.h"
 
 namespace pixelgym::spaces {
 

@@ -1,4 +1,4 @@
-#include "envs/spaces/multi_discrete.h"
+#include "pixelgym/envs/spaces/multi_discrete.h"
 
 #include <limits>
 #include <stdexcept>

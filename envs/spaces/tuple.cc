@@ -1,4 +1,4 @@
-#include "envs/spaces/tuple.h"
+#include "pixelgym/envs/spaces/tuple.h"
 
 #include <stdexcept>
 

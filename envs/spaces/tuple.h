@@ -3,7 +3,7 @@
 
 #include <vector>
 
-#include "envs/space.h"
+#include "pixelgym/envs/space.h"
 
 namespace pixelgym::spaces {
 

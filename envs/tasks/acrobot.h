@@ -1,8 +1,8 @@
 // AcrobotSwingup-v0: swing a two-link arm with a passive shoulder up by its elbow.
 #pragma once
 
-#include "envs/registry.h"
-#include "envs/tasks/task.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/tasks/task.h"
 
 namespace pixelgym {
 

@@ -1,11 +1,11 @@
-#include "envs/tasks/arm_push.h"
+#include "pixelgym/envs/tasks/arm_push.h"
 
 #include <cmath>
 
-#include "engine/robot_model.h"
-#include "envs/spaces/box.h"
-#include "envs/tasks/pixel_env.h"
-#include "envs/tasks/reward.h"
+#include "pixelgym/engine/robot_model.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/tasks/pixel_env.h"
+#include "pixelgym/envs/tasks/reward.h"
 
 namespace pixelgym {
 namespace {

@@ -1,8 +1,8 @@
 // ArmPush-v0: the 7-DOF arm pushes a cube across a table to a goal.
 #pragma once
 
-#include "envs/registry.h"
-#include "envs/tasks/task.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/tasks/task.h"
 
 namespace pixelgym {
 

@@ -1,8 +1,8 @@
 // ArmReach-v0: the 7-DOF mesh arm brings its end effector to a random target.
 #pragma once
 
-#include "envs/registry.h"
-#include "envs/tasks/task.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/tasks/task.h"
 
 namespace pixelgym {
 

@@ -1,16 +1,16 @@
-#include "envs/tasks/builtin.h"
+#include "pixelgym/envs/tasks/builtin.h"
 
 #include <optional>
 
-#include "envs/tasks/acrobot.h"
-#include "envs/tasks/arm_push.h"
-#include "envs/tasks/arm_reach.h"
-#include "envs/tasks/cartpole.h"
-#include "envs/tasks/grid_world.h"
-#include "envs/tasks/pendulum.h"
-#include "envs/tasks/reacher.h"
-#include "envs/tasks/urdf_reach.h"
-#include "envs/vector/make_vec.h"
+#include "pixelgym/envs/tasks/acrobot.h"
+#include "pixelgym/envs/tasks/arm_push.h"
+#include "pixelgym/envs/tasks/arm_reach.h"
+#include "pixelgym/envs/tasks/cartpole.h"
+#include "pixelgym/envs/tasks/grid_world.h"
+#include "pixelgym/envs/tasks/pendulum.h"
+#include "pixelgym/envs/tasks/reacher.h"
+#include "pixelgym/envs/tasks/urdf_reach.h"
+#include "pixelgym/envs/vector/make_vec.h"
 
 namespace pixelgym {
 

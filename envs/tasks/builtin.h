@@ -1,7 +1,7 @@
 // The envs that ship with pixelgym.
 #pragma once
 
-#include "envs/registry.h"
+#include "pixelgym/envs/registry.h"
 
 namespace pixelgym {
 

@@ -1,13 +1,13 @@
-#include "envs/tasks/cartpole.h"
+#include "pixelgym/envs/tasks/cartpole.h"
 
 #include <cmath>
 
-#include "engine/robot_model.h"
-#include "envs/spaces/box.h"
-#include "envs/spaces/discrete.h"
-#include "envs/tasks/angles.h"
-#include "envs/tasks/pixel_env.h"
-#include "envs/tasks/reward.h"
+#include "pixelgym/engine/robot_model.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/discrete.h"
+#include "pixelgym/envs/tasks/angles.h"
+#include "pixelgym/envs/tasks/pixel_env.h"
+#include "pixelgym/envs/tasks/reward.h"
 
 namespace pixelgym {
 

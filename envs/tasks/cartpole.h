@@ -1,8 +1,8 @@
 // CartPoleBalance, CartPoleSwingup and their Discrete variants, -v0 and -v1.
 #pragma once
 
-#include "envs/registry.h"
-#include "envs/tasks/task.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/tasks/task.h"
 
 namespace pixelgym {
 

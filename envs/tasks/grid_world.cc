@@ -1,11 +1,11 @@
-#include "envs/tasks/grid_world.h"
+#include "pixelgym/envs/tasks/grid_world.h"
 
 #include <algorithm>
 #include <stdexcept>
 
-#include "envs/spaces/box.h"
-#include "envs/spaces/dict.h"
-#include "envs/spaces/discrete.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/dict.h"
+#include "pixelgym/envs/spaces/discrete.h"
 
 namespace pixelgym {
 namespace {

@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <memory>
 
-#include "envs/env.h"
-#include "envs/registry.h"
+#include "pixelgym/envs/env.h"
+#include "pixelgym/envs/registry.h"
 
 namespace pixelgym {
 

@@ -1,12 +1,12 @@
-#include "envs/tasks/pendulum.h"
+#include "pixelgym/envs/tasks/pendulum.h"
 
 #include <cmath>
 
-#include "engine/robot_model.h"
-#include "envs/spaces/box.h"
-#include "envs/tasks/angles.h"
-#include "envs/tasks/pixel_env.h"
-#include "envs/tasks/reward.h"
+#include "pixelgym/engine/robot_model.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/tasks/angles.h"
+#include "pixelgym/envs/tasks/pixel_env.h"
+#include "pixelgym/envs/tasks/reward.h"
 
 namespace pixelgym {
 

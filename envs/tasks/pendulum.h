@@ -1,8 +1,8 @@
 // PendulumSwingup-v0: swing a torque-limited pendulum up and hold it.
 #pragma once
 
-#include "envs/registry.h"
-#include "envs/tasks/task.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/tasks/task.h"
 
 namespace pixelgym {
 

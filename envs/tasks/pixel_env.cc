@@ -1,4 +1,4 @@
-#include "envs/tasks/pixel_env.h"
+#include "pixelgym/envs/tasks/pixel_env.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,9 +6,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "envs/errors.h"
-#include "envs/spaces/box.h"
-#include "envs/spaces/dict.h"
+#include "pixelgym/envs/errors.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/dict.h"
 
 namespace pixelgym {
 namespace {

@@ -7,13 +7,13 @@
 #include <string>
 #include <vector>
 
-#include "engine/world.h"
-#include "envs/env.h"
-#include "envs/registry.h"
-#include "envs/render_resources.h"
-#include "envs/tasks/task.h"
-#include "envs/tasks/world_scene.h"
-#include "render/renderer.h"
+#include "pixelgym/engine/world.h"
+#include "pixelgym/envs/env.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/render_resources.h"
+#include "pixelgym/envs/tasks/task.h"
+#include "pixelgym/envs/tasks/world_scene.h"
+#include "pixelgym/render/renderer.h"
 
 namespace pixelgym {
 

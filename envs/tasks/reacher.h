@@ -1,8 +1,8 @@
 // ReacherEasy-v0 and ReacherHard-v0: a two-link planar arm reaches a random target.
 #pragma once
 
-#include "envs/registry.h"
-#include "envs/tasks/task.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/tasks/task.h"
 
 namespace pixelgym {
 

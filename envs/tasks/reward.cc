@@ -1,4 +1,4 @@
-#include "envs/tasks/reward.h"
+#include "pixelgym/envs/tasks/reward.h"
 
 #include <cmath>
 #include <stdexcept>

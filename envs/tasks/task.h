@@ -9,12 +9,12 @@
 #include <utility>
 #include <vector>
 
-#include "engine/world.h"
-#include "envs/params.h"
-#include "envs/rng.h"
-#include "envs/space.h"
-#include "envs/value.h"
-#include "render/camera.h"
+#include "pixelgym/engine/world.h"
+#include "pixelgym/envs/params.h"
+#include "pixelgym/envs/rng.h"
+#include "pixelgym/envs/space.h"
+#include "pixelgym/envs/value.h"
+#include "pixelgym/render/camera.h"
 
 namespace pixelgym {
 

@@ -1,14 +1,14 @@
-#include "envs/tasks/urdf_reach.h"
+#include "pixelgym/envs/tasks/urdf_reach.h"
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <stdexcept>
 
-#include "envs/spaces/box.h"
-#include "envs/tasks/angles.h"
-#include "envs/tasks/pixel_env.h"
-#include "envs/tasks/reward.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/tasks/angles.h"
+#include "pixelgym/envs/tasks/pixel_env.h"
+#include "pixelgym/envs/tasks/reward.h"
 
 namespace pixelgym {
 namespace {

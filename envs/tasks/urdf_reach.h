@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "engine/robot_model.h"
-#include "envs/registry.h"
-#include "envs/tasks/task.h"
+#include "pixelgym/engine/robot_model.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/tasks/task.h"
 
 namespace pixelgym {
 

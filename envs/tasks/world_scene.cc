@@ -1,4 +1,4 @@
-#include "envs/tasks/world_scene.h"
+#include "pixelgym/envs/tasks/world_scene.h"
 
 #include <cmath>
 #include <map>

@@ -4,9 +4,9 @@
 #include <Eigen/Geometry>
 #include <vector>
 
-#include "engine/world.h"
-#include "render/camera.h"
-#include "render/scene.h"
+#include "pixelgym/engine/world.h"
+#include "pixelgym/render/camera.h"
+#include "pixelgym/render/scene.h"
 
 namespace pixelgym {
 

@@ -1,4 +1,4 @@
-#include "envs/vector/async_vector_env.h"
+#include "pixelgym/envs/vector/async_vector_env.h"
 
 #include <algorithm>
 #include <chrono>
@@ -9,7 +9,7 @@
 #include <immintrin.h>
 #endif
 
-#include "envs/vector/worker_threads.h"
+#include "pixelgym/envs/vector/worker_threads.h"
 
 namespace pixelgym::vector {
 namespace {

@@ -10,7 +10,7 @@
 #include <thread>
 #include <vector>
 
-#include "envs/vector/batch_runner.h"
+#include "pixelgym/envs/vector/batch_runner.h"
 
 namespace pixelgym::vector {
 

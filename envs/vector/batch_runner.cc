@@ -1,12 +1,12 @@
-#include "envs/vector/batch_runner.h"
+#include "pixelgym/envs/vector/batch_runner.h"
 
 #include <algorithm>
 #include <cctype>
 #include <stdexcept>
 #include <utility>
 
-#include "envs/registry.h"
-#include "envs/vector/batch_space.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/vector/batch_space.h"
 
 namespace pixelgym::vector {
 namespace {

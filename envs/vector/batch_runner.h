@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "envs/env.h"
-#include "envs/vector/vector_env.h"
+#include "pixelgym/envs/env.h"
+#include "pixelgym/envs/vector/vector_env.h"
 
 namespace pixelgym::vector {
 

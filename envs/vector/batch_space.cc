@@ -1,4 +1,4 @@
-#include "envs/vector/batch_space.h"
+#include "pixelgym/envs/vector/batch_space.h"
 
 #include <cstring>
 #include <memory>
@@ -6,12 +6,12 @@
 #include <utility>
 #include <vector>
 
-#include "envs/spaces/box.h"
-#include "envs/spaces/dict.h"
-#include "envs/spaces/discrete.h"
-#include "envs/spaces/multi_binary.h"
-#include "envs/spaces/multi_discrete.h"
-#include "envs/spaces/tuple.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/dict.h"
+#include "pixelgym/envs/spaces/discrete.h"
+#include "pixelgym/envs/spaces/multi_binary.h"
+#include "pixelgym/envs/spaces/multi_discrete.h"
+#include "pixelgym/envs/spaces/tuple.h"
 
 namespace pixelgym::vector {
 namespace {

@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <string>
 
-#include "envs/space.h"
-#include "envs/value.h"
+#include "pixelgym/envs/space.h"
+#include "pixelgym/envs/value.h"
 
 namespace pixelgym::vector {
 

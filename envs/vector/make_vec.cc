@@ -1,13 +1,13 @@
-#include "envs/vector/make_vec.h"
+#include "pixelgym/envs/vector/make_vec.h"
 
 #include <utility>
 #include <vector>
 
-#include "envs/described_env.h"
-#include "envs/registry.h"
-#include "envs/vector/async_vector_env.h"
-#include "envs/vector/memory_check.h"
-#include "envs/vector/sync_vector_env.h"
+#include "pixelgym/envs/described_env.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/vector/async_vector_env.h"
+#include "pixelgym/envs/vector/memory_check.h"
+#include "pixelgym/envs/vector/sync_vector_env.h"
 
 namespace pixelgym::vector {
 

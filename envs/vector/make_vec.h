@@ -5,10 +5,10 @@
 #include <memory>
 #include <string>
 
-#include "envs/params.h"
-#include "envs/registry.h"
-#include "envs/vector/vector_env.h"
-#include "envs/wrapper.h"
+#include "pixelgym/envs/params.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/vector/vector_env.h"
+#include "pixelgym/envs/wrapper.h"
 
 namespace pixelgym::vector {
 

@@ -1,4 +1,4 @@
-#include "envs/vector/memory_check.h"
+#include "pixelgym/envs/vector/memory_check.h"
 
 #include <algorithm>
 #include <cstdio>

@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "envs/space.h"
+#include "pixelgym/envs/space.h"
 
 namespace pixelgym::vector {
 

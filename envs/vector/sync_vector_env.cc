@@ -1,4 +1,4 @@
-#include "envs/vector/sync_vector_env.h"
+#include "pixelgym/envs/vector/sync_vector_env.h"
 
 #include <utility>
 

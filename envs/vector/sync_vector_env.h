@@ -5,7 +5,7 @@
 #include <memory>
 #include <vector>
 
-#include "envs/vector/batch_runner.h"
+#include "pixelgym/envs/vector/batch_runner.h"
 
 namespace pixelgym::vector {
 

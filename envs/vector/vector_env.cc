@@ -1,4 +1,4 @@
-#include "envs/vector/vector_env.h"
+#include "pixelgym/envs/vector/vector_env.h"
 
 #include <cctype>
 #include <stdexcept>

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "envs/env.h"
+#include "pixelgym/envs/env.h"
 
 namespace pixelgym::vector {
 

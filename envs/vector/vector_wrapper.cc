@@ -1,9 +1,9 @@
-#include "envs/vector/vector_wrapper.h"
+#include "pixelgym/envs/vector/vector_wrapper.h"
 
 #include <stdexcept>
 #include <utility>
 
-#include "envs/vector/batch_space.h"
+#include "pixelgym/envs/vector/batch_space.h"
 
 namespace pixelgym::vector {
 namespace {

@@ -16,7 +16,7 @@
 #include <optional>
 #include <string>
 
-#include "envs/vector/vector_env.h"
+#include "pixelgym/envs/vector/vector_env.h"
 
 namespace pixelgym::vector {
 

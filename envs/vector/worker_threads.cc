@@ -1,4 +1,4 @@
-#include "envs/vector/worker_threads.h"
+#include "pixelgym/envs/vector/worker_threads.h"
 
 #include <pthread.h>
 

@@ -13,15 +13,15 @@
 #include <cmath>
 #include <memory>
 
-#include "engine/robot_model.h"
-#include "envs/registry.h"
-#include "envs/spaces/box.h"
-#include "envs/tasks/angles.h"
-#include "envs/tasks/pixel_env.h"
-#include "envs/tasks/reward.h"
-#include "envs/tasks/task.h"
 #include "examples/pixelgym/cli.h"
 #include "examples/pixelgym/train_commands.h"
+#include "pixelgym/engine/robot_model.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/tasks/angles.h"
+#include "pixelgym/envs/tasks/pixel_env.h"
+#include "pixelgym/envs/tasks/reward.h"
+#include "pixelgym/envs/tasks/task.h"
 
 namespace {
 

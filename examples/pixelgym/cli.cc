@@ -11,9 +11,9 @@
 #include <filesystem>
 #include <limits>
 
-#include "envs/registry.h"
-#include "render/image_io.h"
-#include "wrappers/wrapper_spec.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/render/image_io.h"
+#include "pixelgym/wrappers/wrapper_spec.h"
 
 namespace pixelgym::cli {
 

@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "envs/array.h"
-#include "envs/env.h"
-#include "envs/params.h"
+#include "pixelgym/envs/array.h"
+#include "pixelgym/envs/env.h"
+#include "pixelgym/envs/params.h"
 
 namespace pixelgym::cli {
 

@@ -5,9 +5,9 @@
 #include <set>
 #include <sstream>
 
-#include "engine/robot_model.h"
-#include "engine/world.h"
 #include "examples/pixelgym/cli.h"
+#include "pixelgym/engine/robot_model.h"
+#include "pixelgym/engine/world.h"
 
 namespace pixelgym::cli {
 namespace {

@@ -7,17 +7,17 @@
 #include <memory>
 #include <sstream>
 
-#include "envs/checker.h"
-#include "envs/registry.h"
-#include "envs/rollout.h"
-#include "envs/spaces/box.h"
-#include "envs/spaces/dict.h"
-#include "envs/spaces/discrete.h"
-#include "envs/vector/async_vector_env.h"
-#include "envs/vector/make_vec.h"
 #include "examples/pixelgym/cli.h"
-#include "testing/snapshot.h"
-#include "wrappers/wrapper_spec.h"
+#include "pixelgym/envs/checker.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/rollout.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/dict.h"
+#include "pixelgym/envs/spaces/discrete.h"
+#include "pixelgym/envs/vector/async_vector_env.h"
+#include "pixelgym/envs/vector/make_vec.h"
+#include "pixelgym/testing/snapshot.h"
+#include "pixelgym/wrappers/wrapper_spec.h"
 
 namespace pixelgym::cli {
 namespace {

@@ -9,9 +9,9 @@
 #include <utility>
 #include <vector>
 
-#include "envs/rollout.h"
 #include "examples/pixelgym/cli.h"
-#include "wrappers/record_video.h"
+#include "pixelgym/envs/rollout.h"
+#include "pixelgym/wrappers/record_video.h"
 
 namespace pixelgym::cli {
 namespace {

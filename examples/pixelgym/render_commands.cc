@@ -4,12 +4,12 @@
 #include <iostream>
 #include <map>
 
-#include "engine/robot_model.h"
-#include "engine/world.h"
-#include "envs/tasks/world_scene.h"
 #include "examples/pixelgym/cli.h"
-#include "render/context.h"
-#include "render/renderer.h"
+#include "pixelgym/engine/robot_model.h"
+#include "pixelgym/engine/world.h"
+#include "pixelgym/envs/tasks/world_scene.h"
+#include "pixelgym/render/context.h"
+#include "pixelgym/render/renderer.h"
 
 namespace pixelgym::cli {
 namespace {

@@ -18,7 +18,7 @@
 #include "examples/trainer/run/curve_plot.h"
 #include "examples/trainer/run/progress_csv.h"
 #include "examples/trainer/run/training_run.h"
-#include "render/image_io.h"
+#include "pixelgym/render/image_io.h"
 
 namespace pixelgym::cli {
 namespace {

@@ -1,9 +1,9 @@
-#include "engine/mesh.h"
+#include "pixelgym/engine/mesh.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "engine/robot_model.h"
+#include "pixelgym/engine/robot_model.h"
 
 namespace pixelgym::engine {
 namespace {

@@ -1,4 +1,4 @@
-#include "engine/robot_model.h"
+#include "pixelgym/engine/robot_model.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

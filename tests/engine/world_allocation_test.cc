@@ -12,7 +12,7 @@
 #include <cstdlib>
 #include <utility>
 
-#include "engine/world.h"
+#include "pixelgym/engine/world.h"
 #include "tests/alloc_counter.h"
 
 namespace pixelgym::engine {

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <iostream>
 
-#include "engine/world.h"
+#include "pixelgym/engine/world.h"
 
 namespace pixelgym::engine {
 namespace {

@@ -1,4 +1,4 @@
-#include "engine/world.h"
+#include "pixelgym/engine/world.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-#include "engine/xml_depth.h"
+#include "pixelgym/engine/xml_depth.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

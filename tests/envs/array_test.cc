@@ -1,4 +1,4 @@
-#include "envs/array.h"
+#include "pixelgym/envs/array.h"
 
 #include <gtest/gtest.h>
 

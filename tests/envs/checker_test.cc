@@ -1,4 +1,4 @@
-#include "envs/checker.h"
+#include "pixelgym/envs/checker.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

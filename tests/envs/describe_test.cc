@@ -14,10 +14,10 @@
 #include <atomic>
 #include <cstddef>
 
-#include "envs/registry.h"
-#include "envs/spaces/box.h"
-#include "envs/spaces/dict.h"
-#include "envs/tasks/pixel_env.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/dict.h"
+#include "pixelgym/envs/tasks/pixel_env.h"
 #include "tests/envs/env_ids.h"
 
 namespace {

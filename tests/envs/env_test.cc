@@ -1,4 +1,4 @@
-#include "envs/env.h"
+#include "pixelgym/envs/env.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -11,7 +11,7 @@
 #include <thread>
 #include <vector>
 
-#include "envs/registry.h"
+#include "pixelgym/envs/registry.h"
 #include "tests/worker_thread.h"
 
 namespace pixelgym {

@@ -6,8 +6,8 @@
 #include <random>
 #include <stdexcept>
 
-#include "envs/env.h"
-#include "envs/spaces/box.h"
+#include "pixelgym/envs/env.h"
+#include "pixelgym/envs/spaces/box.h"
 
 namespace pixelgym::testing {
 

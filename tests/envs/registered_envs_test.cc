@@ -6,9 +6,9 @@
 #include <cmath>
 #include <map>
 
-#include "envs/checker.h"
-#include "envs/registry.h"
-#include "envs/tasks/pixel_env.h"
+#include "pixelgym/envs/checker.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/tasks/pixel_env.h"
 #include "tests/envs/env_ids.h"
 #include "tests/golden.h"
 

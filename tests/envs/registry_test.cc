@@ -1,9 +1,9 @@
-#include "envs/registry.h"
+#include "pixelgym/envs/registry.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "envs/time_limit.h"
+#include "pixelgym/envs/time_limit.h"
 #include "tests/envs/probe_env.h"
 
 namespace pixelgym {

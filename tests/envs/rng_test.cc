@@ -1,4 +1,4 @@
-#include "envs/rng.h"
+#include "pixelgym/envs/rng.h"
 
 #include <gtest/gtest.h>
 

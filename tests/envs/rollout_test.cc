@@ -1,11 +1,11 @@
-#include "envs/rollout.h"
+#include "pixelgym/envs/rollout.h"
 
 #include <gtest/gtest.h>
 
 #include <memory>
 #include <vector>
 
-#include "envs/time_limit.h"
+#include "pixelgym/envs/time_limit.h"
 #include "tests/envs/probe_env.h"
 
 namespace pixelgym {

@@ -3,8 +3,8 @@
 
 #include <memory>
 
-#include "engine/world.h"
-#include "envs/tasks/world_scene.h"
+#include "pixelgym/engine/world.h"
+#include "pixelgym/envs/tasks/world_scene.h"
 
 namespace pixelgym::testing {
 

@@ -19,10 +19,10 @@
 #include <string>
 #include <vector>
 
-#include "envs/registry.h"
-#include "envs/rng.h"
-#include "envs/tasks/pixel_env.h"
-#include "render/renderer.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/rng.h"
+#include "pixelgym/envs/tasks/pixel_env.h"
+#include "pixelgym/render/renderer.h"
 #include "tests/envs/env_ids.h"
 
 namespace pixelgym {

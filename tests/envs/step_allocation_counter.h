@@ -6,7 +6,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "envs/env.h"
+#include "pixelgym/envs/env.h"
 #include "tests/alloc_counter.h"
 
 namespace pixelgym::testing {

@@ -14,8 +14,8 @@
 #include <memory>
 #include <vector>
 
-#include "envs/registry.h"
-#include "envs/tasks/pixel_env.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/tasks/pixel_env.h"
 #include "tests/envs/env_ids.h"
 #include "tests/envs/step_allocation_counter.h"
 

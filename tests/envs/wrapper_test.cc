@@ -1,11 +1,11 @@
-#include "envs/wrapper.h"
+#include "pixelgym/envs/wrapper.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <vector>
 
-#include "envs/spaces/box.h"
+#include "pixelgym/envs/spaces/box.h"
 #include "tests/envs/probe_env.h"
 
 namespace pixelgym {

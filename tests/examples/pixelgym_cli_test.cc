@@ -17,14 +17,14 @@
 #include <string>
 #include <vector>
 
-#include "engine/robot_model.h"
-#include "engine/world.h"
-#include "envs/registry.h"
-#include "envs/tasks/world_scene.h"
-#include "render/image_io.h"
-#include "render/renderer.h"
+#include "pixelgym/engine/robot_model.h"
+#include "pixelgym/engine/world.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/tasks/world_scene.h"
+#include "pixelgym/render/image_io.h"
+#include "pixelgym/render/renderer.h"
+#include "pixelgym/wrappers/wrapper_spec.h"
 #include "tests/examples/cli_run.h"
-#include "wrappers/wrapper_spec.h"
 
 namespace pixelgym {
 namespace {

@@ -27,8 +27,8 @@
 #include <thread>
 #include <vector>
 
-#include "envs/registry.h"
-#include "envs/rollout.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/rollout.h"
 #include "tests/examples/cli_run.h"
 
 namespace pixelgym {

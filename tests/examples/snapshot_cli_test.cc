@@ -10,8 +10,8 @@
 #include <filesystem>
 #include <string>
 
-#include "envs/registry.h"
-#include "render/image_io.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/render/image_io.h"
 #include "tests/examples/cli_run.h"
 
 namespace pixelgym {

@@ -22,7 +22,8 @@ foreach(installed include/pixelgym/envs/registry.h share/pixelgym/assets/cartpol
     message(FATAL_ERROR "cmake --install did not install ${installed} under ${prefix}")
   endif()
 endforeach()
-# Every header installed includes only installed headers, and the renderer's private ones (the
+# Every header installed includes only installed headers, each by the project's prefix
+# (pixelgym/envs/registry.h, as an outside project includes it), and the renderer's private ones (the
 # OpenGL declarations) are not installed.
 if(EXISTS ${prefix}/include/pixelgym/render/gl.h)
   message(FATAL_ERROR "cmake --install installed the private render/gl.h")
@@ -32,7 +33,11 @@ foreach(header ${headers})
   file(STRINGS ${prefix}/include/pixelgym/${header} includes REGEX "^#include \"")
   foreach(line ${includes})
     string(REGEX REPLACE "^#include \"([^\"]+)\".*" "\\1" included "${line}")
-    if(NOT EXISTS ${prefix}/include/pixelgym/${included})
+    if(NOT included MATCHES "^pixelgym/")
+      message(FATAL_ERROR "the installed ${header} includes \"${included}\", not by the "
+                          "project's prefix (\"pixelgym/${included}\")")
+    endif()
+    if(NOT EXISTS ${prefix}/include/${included})
       message(FATAL_ERROR "the installed ${header} includes ${included}, which is not installed")
     endif()
   endforeach()
@@ -42,8 +47,13 @@ if(NOT config)
   message(FATAL_ERROR "cmake --install did not install pixelgymConfig.cmake under ${prefix}")
 endif()
 
+set(every_header ${WORK_DIR}/every_header.cc)
+file(WRITE ${every_header} "// Every installed header, included as an outside project does.\n")
+foreach(header ${headers})
+  file(APPEND ${every_header} "#include <pixelgym/${header}>\n")
+endforeach()
 step("configuring the consumer" ${CMAKE_COMMAND} -S ${CONSUMER_DIR} -B ${WORK_DIR}/build
-     -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${prefix})
+     -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${prefix} -DEVERY_HEADER=${every_header})
 step("building the consumer" ${CMAKE_COMMAND} --build ${WORK_DIR}/build)
 step("running the consumer" ${WORK_DIR}/build/consumer)
 message(STATUS "consumer:\n${step_output}")

@@ -4,8 +4,8 @@
 
 #include <Eigen/Geometry>
 
-#include "render/mesh_data.h"
-#include "render/renderer.h"
+#include "pixelgym/render/mesh_data.h"
+#include "pixelgym/render/renderer.h"
 
 namespace pixelgym::render::testing {
 

@@ -8,8 +8,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "render/mesh_data.h"
-#include "render/renderer.h"
+#include "pixelgym/render/mesh_data.h"
+#include "pixelgym/render/renderer.h"
 #include "tests/render/box_and_ball_scene.h"
 #include "tests/worker_thread.h"
 

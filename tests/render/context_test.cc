@@ -1,5 +1,5 @@
 // A GL context that cannot be created is a clear error, never a crash.
-#include "render/context.h"
+#include "pixelgym/render/context.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

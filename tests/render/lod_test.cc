@@ -1,5 +1,5 @@
 // Level of detail and face culling, without a GL context.
-#include "render/lod.h"
+#include "pixelgym/render/lod.h"
 
 #include <gtest/gtest.h>
 

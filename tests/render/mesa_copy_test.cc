@@ -1,7 +1,7 @@
 // Private copies of Mesa (render::MesaCopy): contexts in the copy selected on their thread, the
 // same bytes from every copy, threads drawing with different copies at once (threads that did
 // not load the copy included), and the selection rules.
-#include "render/mesa_copy.h"
+#include "pixelgym/render/mesa_copy.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -13,9 +13,9 @@
 #include <thread>
 #include <vector>
 
-#include "render/context.h"
-#include "render/mesh_data.h"
-#include "render/renderer.h"
+#include "pixelgym/render/context.h"
+#include "pixelgym/render/mesh_data.h"
+#include "pixelgym/render/renderer.h"
 #include "tests/render/box_and_ball_scene.h"
 
 namespace pixelgym::render {

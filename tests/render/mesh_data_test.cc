@@ -1,4 +1,4 @@
-#include "render/mesh_data.h"
+#include "pixelgym/render/mesh_data.h"
 
 #include <gtest/gtest.h>
 

@@ -10,7 +10,7 @@
 #include <new>
 #include <vector>
 
-#include "render/renderer.h"
+#include "pixelgym/render/renderer.h"
 
 namespace {
 std::atomic<long> allocations{0};

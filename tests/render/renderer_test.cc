@@ -1,4 +1,4 @@
-#include "render/renderer.h"
+#include "pixelgym/render/renderer.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -1,9 +1,9 @@
 // Where the shadow map looks and where shadows can fall, without a GL context.
-#include "render/shadow_fit.h"
+#include "pixelgym/render/shadow_fit.h"
 
 #include <gtest/gtest.h>
 
-#include "render/transforms.h"
+#include "pixelgym/render/transforms.h"
 
 namespace pixelgym::render {
 namespace {

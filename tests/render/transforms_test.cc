@@ -1,9 +1,9 @@
 // The renderer's matrices, without a GL context.
-#include "render/transforms.h"
+#include "pixelgym/render/transforms.h"
 
 #include <gtest/gtest.h>
 
-#include "render/camera.h"
+#include "pixelgym/render/camera.h"
 
 namespace pixelgym::render {
 namespace {

@@ -45,9 +45,9 @@
 #include <string>
 #include <vector>
 
-#include "envs/vector/make_vec.h"
-#include "wrappers/record_video.h"
-#include "wrappers/wrapper_spec.h"
+#include "pixelgym/envs/vector/make_vec.h"
+#include "pixelgym/wrappers/record_video.h"
+#include "pixelgym/wrappers/wrapper_spec.h"
 
 namespace {
 

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "testing/snapshot.h"
+#include "pixelgym/testing/snapshot.h"
 
 namespace pixelgym::testing {
 namespace {

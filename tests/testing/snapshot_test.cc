@@ -1,6 +1,6 @@
 // compare_to_golden as a user meets it: the files it writes and reads, its messages, the update
 // switch, segmentation goldens, and EXPECT_MATCHES_GOLDEN.
-#include "testing/snapshot.h"
+#include "pixelgym/testing/snapshot.h"
 
 #include <gtest/gtest-spi.h>
 #include <gtest/gtest.h>
@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "envs/array.h"
-#include "render/image_io.h"
-#include "testing/gtest.h"
+#include "pixelgym/envs/array.h"
+#include "pixelgym/render/image_io.h"
+#include "pixelgym/testing/gtest.h"
 
 namespace pixelgym::testing {
 namespace {

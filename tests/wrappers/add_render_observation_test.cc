@@ -1,14 +1,14 @@
 // AddRenderObservation: the three layouts, the frame's space from metadata().render_shape before
 // any reset, frame values equal to render(), errors.
-#include "wrappers/add_render_observation.h"
+#include "pixelgym/wrappers/add_render_observation.h"
 
 #include <gtest/gtest.h>
 
 #include <memory>
 
-#include "envs/registry.h"
-#include "envs/spaces/dict.h"
-#include "envs/spaces/discrete.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/spaces/dict.h"
+#include "pixelgym/envs/spaces/discrete.h"
 #include "tests/wrappers/scripted_env.h"
 #include "tests/wrappers/test_util.h"
 

@@ -1,5 +1,5 @@
 // AreaResize against cv::resize's INTER_AREA over many size pairs and channel counts.
-#include "wrappers/area_resize.h"
+#include "pixelgym/wrappers/area_resize.h"
 
 #include <gtest/gtest.h>
 

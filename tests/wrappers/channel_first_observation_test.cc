@@ -1,11 +1,11 @@
-#include "wrappers/channel_first_observation.h"
+#include "pixelgym/wrappers/channel_first_observation.h"
 
 #include <gtest/gtest.h>
 
 #include <memory>
 
-#include "envs/spaces/box.h"
-#include "envs/spaces/dict.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/dict.h"
 #include "tests/wrappers/image_env.h"
 #include "tests/wrappers/test_util.h"
 

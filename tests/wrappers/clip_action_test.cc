@@ -1,5 +1,5 @@
 // ClipAction: the action space becomes Box(-inf, inf); actions are clipped into the inner bounds.
-#include "wrappers/clip_action.h"
+#include "pixelgym/wrappers/clip_action.h"
 
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 #include <limits>
 #include <memory>
 
-#include "envs/spaces/discrete.h"
+#include "pixelgym/envs/spaces/discrete.h"
 #include "tests/wrappers/scripted_env.h"
 #include "tests/wrappers/test_util.h"
 

@@ -1,13 +1,13 @@
 // DtypeObservation: spaces and values for each kind of cast, saturation, Dict keys, errors.
-#include "wrappers/dtype_observation.h"
+#include "pixelgym/wrappers/dtype_observation.h"
 
 #include <gtest/gtest.h>
 
 #include <limits>
 #include <memory>
 
-#include "envs/spaces/dict.h"
-#include "envs/spaces/discrete.h"
+#include "pixelgym/envs/spaces/dict.h"
+#include "pixelgym/envs/spaces/discrete.h"
 #include "tests/wrappers/image_env.h"
 #include "tests/wrappers/scripted_env.h"
 #include "tests/wrappers/test_util.h"

@@ -1,11 +1,11 @@
 // FilterObservation: keeps the listed keys in the listed order, values copied; errors.
-#include "wrappers/filter_observation.h"
+#include "pixelgym/wrappers/filter_observation.h"
 
 #include <gtest/gtest.h>
 
 #include <memory>
 
-#include "envs/spaces/dict.h"
+#include "pixelgym/envs/spaces/dict.h"
 #include "tests/wrappers/image_env.h"
 #include "tests/wrappers/test_util.h"
 

@@ -12,10 +12,10 @@
 #include <unordered_set>
 #include <vector>
 
-#include "envs/registry.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/wrappers/frame_stack_observation.h"
 #include "tests/envs/step_allocation_counter.h"
 #include "tests/wrappers/image_env.h"
-#include "wrappers/frame_stack_observation.h"
 
 namespace pixelgym::wrappers {
 namespace {

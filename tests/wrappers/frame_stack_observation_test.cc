@@ -1,4 +1,4 @@
-#include "wrappers/frame_stack_observation.h"
+#include "pixelgym/wrappers/frame_stack_observation.h"
 
 #include <gtest/gtest.h>
 
@@ -8,11 +8,11 @@
 #include <utility>
 #include <vector>
 
-#include "envs/checker.h"
-#include "envs/registry.h"
-#include "envs/spaces/box.h"
-#include "envs/spaces/dict.h"
-#include "envs/time_limit.h"
+#include "pixelgym/envs/checker.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/dict.h"
+#include "pixelgym/envs/time_limit.h"
 #include "tests/wrappers/image_env.h"
 #include "tests/wrappers/test_util.h"
 

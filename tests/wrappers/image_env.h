@@ -7,9 +7,9 @@
 #include <string>
 #include <utility>
 
-#include "envs/env.h"
-#include "envs/spaces/box.h"
-#include "envs/spaces/dict.h"
+#include "pixelgym/envs/env.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/dict.h"
 
 namespace pixelgym::testing {
 

@@ -1,12 +1,12 @@
-#include "wrappers/image_key.h"
+#include "pixelgym/wrappers/image_key.h"
 
 #include <gtest/gtest.h>
 
 #include <memory>
 
-#include "envs/spaces/box.h"
-#include "envs/spaces/dict.h"
-#include "envs/spaces/discrete.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/dict.h"
+#include "pixelgym/envs/spaces/discrete.h"
 #include "tests/wrappers/image_env.h"
 #include "tests/wrappers/test_util.h"
 

@@ -4,12 +4,12 @@
 #include <memory>
 #include <string>
 
-#include "envs/checker.h"
-#include "envs/registry.h"
-#include "envs/spaces/dict.h"
-#include "wrappers/channel_first_observation.h"
-#include "wrappers/grayscale_observation.h"
-#include "wrappers/resize_observation.h"
+#include "pixelgym/envs/checker.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/spaces/dict.h"
+#include "pixelgym/wrappers/channel_first_observation.h"
+#include "pixelgym/wrappers/grayscale_observation.h"
+#include "pixelgym/wrappers/resize_observation.h"
 
 namespace pixelgym::wrappers {
 namespace {

@@ -7,18 +7,18 @@
 #include <string>
 #include <vector>
 
-#include "envs/checker.h"
-#include "envs/registry.h"
+#include "pixelgym/envs/checker.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/wrappers/add_render_observation.h"
+#include "pixelgym/wrappers/clip_action.h"
+#include "pixelgym/wrappers/dtype_observation.h"
+#include "pixelgym/wrappers/filter_observation.h"
+#include "pixelgym/wrappers/normalize_observation.h"
+#include "pixelgym/wrappers/normalize_reward.h"
+#include "pixelgym/wrappers/record_episode_statistics.h"
+#include "pixelgym/wrappers/rescale_action.h"
 #include "tests/envs/step_allocation_counter.h"
 #include "tests/wrappers/scripted_env.h"
-#include "wrappers/add_render_observation.h"
-#include "wrappers/clip_action.h"
-#include "wrappers/dtype_observation.h"
-#include "wrappers/filter_observation.h"
-#include "wrappers/normalize_observation.h"
-#include "wrappers/normalize_reward.h"
-#include "wrappers/record_episode_statistics.h"
-#include "wrappers/rescale_action.h"
 
 namespace pixelgym::wrappers {
 namespace {

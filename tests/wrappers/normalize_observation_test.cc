@@ -1,6 +1,6 @@
 // NormalizeObservation: running statistics against a direct computation, output, freeze,
 // checkpoint round trip, Dict keys, errors. Also RunningStatistics' checkpoint form.
-#include "wrappers/normalize_observation.h"
+#include "pixelgym/wrappers/normalize_observation.h"
 
 #include <gtest/gtest.h>
 
@@ -9,8 +9,8 @@
 #include <memory>
 #include <vector>
 
-#include "envs/spaces/dict.h"
-#include "envs/spaces/discrete.h"
+#include "pixelgym/envs/spaces/dict.h"
+#include "pixelgym/envs/spaces/discrete.h"
 #include "tests/wrappers/scripted_env.h"
 #include "tests/wrappers/test_util.h"
 

@@ -1,6 +1,6 @@
 // NormalizeReward: the discounted return's running variance against a direct computation, the
 // scaled rewards, the return reset at both episode ends, freeze, checkpoint round trip, errors.
-#include "wrappers/normalize_reward.h"
+#include "pixelgym/wrappers/normalize_reward.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // RecordEpisodeStatistics: info["episode"] only at an episode's last step, for terminated and
 // truncated episodes; return, length, time; the queues; errors.
-#include "wrappers/record_episode_statistics.h"
+#include "pixelgym/wrappers/record_episode_statistics.h"
 
 #include <gtest/gtest.h>
 

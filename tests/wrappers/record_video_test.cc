@@ -2,7 +2,7 @@
 // names, video_length, flat memory over a 10,000-frame clip, every failure leaving no file
 // under a final name (a full tmpfs, a read-only folder, a frame of another size), and temporary
 // files of killed recorders removed while those of live ones are kept.
-#include "wrappers/record_video.h"
+#include "pixelgym/wrappers/record_video.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -27,9 +27,9 @@
 #include <string>
 #include <vector>
 
-#include "envs/registry.h"
-#include "envs/spaces/box.h"
-#include "render/image_io.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/render/image_io.h"
 
 namespace pixelgym::wrappers {
 namespace {

@@ -1,12 +1,12 @@
 // RescaleAction: [min, max] maps affinely onto the inner bounds, ends exactly, outside clipped.
-#include "wrappers/rescale_action.h"
+#include "pixelgym/wrappers/rescale_action.h"
 
 #include <gtest/gtest.h>
 
 #include <limits>
 #include <memory>
 
-#include "envs/spaces/discrete.h"
+#include "pixelgym/envs/spaces/discrete.h"
 #include "tests/wrappers/scripted_env.h"
 #include "tests/wrappers/test_util.h"
 

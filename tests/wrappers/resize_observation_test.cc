@@ -1,4 +1,4 @@
-#include "wrappers/resize_observation.h"
+#include "pixelgym/wrappers/resize_observation.h"
 
 #include <gtest/gtest.h>
 
@@ -8,8 +8,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "envs/spaces/box.h"
-#include "envs/spaces/dict.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/dict.h"
 #include "tests/wrappers/image_env.h"
 #include "tests/wrappers/test_util.h"
 

@@ -1,6 +1,6 @@
 // RunningStatistics::update_batch: a batch of one row is `update` bit for bit; a batch of n rows
 // is n updates up to rounding, and the pooled mean and variance of the samples with the prior.
-#include "wrappers/running_statistics.h"
+#include "pixelgym/wrappers/running_statistics.h"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "envs/rng.h"
+#include "pixelgym/envs/rng.h"
 
 namespace pixelgym::wrappers {
 namespace {

@@ -10,8 +10,8 @@
 #include <utility>
 #include <vector>
 
-#include "envs/env.h"
-#include "envs/spaces/box.h"
+#include "pixelgym/envs/env.h"
+#include "pixelgym/envs/spaces/box.h"
 
 namespace pixelgym::testing {
 

@@ -14,12 +14,12 @@
 #include <memory>
 #include <vector>
 
-#include "envs/registry.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/wrappers/channel_first_observation.h"
+#include "pixelgym/wrappers/grayscale_observation.h"
+#include "pixelgym/wrappers/resize_observation.h"
 #include "tests/envs/step_allocation_counter.h"
 #include "tests/wrappers/image_env.h"
-#include "wrappers/channel_first_observation.h"
-#include "wrappers/grayscale_observation.h"
-#include "wrappers/resize_observation.h"
 
 namespace pixelgym::wrappers {
 namespace {

@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "envs/env.h"
+#include "pixelgym/envs/env.h"
 
 namespace pixelgym::testing {
 

@@ -1,5 +1,5 @@
 // The text form of wrapper stacks (`--wrap resize=64x64`): parsing, applying, and its errors.
-#include "wrappers/wrapper_spec.h"
+#include "pixelgym/wrappers/wrapper_spec.h"
 
 #include <gtest/gtest.h>
 
@@ -8,12 +8,12 @@
 #include <string>
 #include <vector>
 
-#include "envs/registry.h"
-#include "envs/spaces/box.h"
-#include "envs/spaces/dict.h"
-#include "envs/time_limit.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/dict.h"
+#include "pixelgym/envs/time_limit.h"
+#include "pixelgym/wrappers/resize_observation.h"
 #include "tests/wrappers/image_env.h"
-#include "wrappers/resize_observation.h"
 
 namespace pixelgym::wrappers {
 namespace {

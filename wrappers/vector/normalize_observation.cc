@@ -1,4 +1,4 @@
-#include "wrappers/vector/normalize_observation.h"
+#include "pixelgym/wrappers/vector/normalize_observation.h"
 
 #include <cmath>
 #include <cstdint>
@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <utility>
 
-#include "envs/spaces/box.h"
+#include "pixelgym/envs/spaces/box.h"
 
 namespace pixelgym::vector {
 namespace {

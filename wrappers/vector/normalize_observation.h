@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "envs/vector/vector_wrapper.h"
-#include "wrappers/box_key.h"
-#include "wrappers/running_statistics.h"
+#include "pixelgym/envs/vector/vector_wrapper.h"
+#include "pixelgym/wrappers/box_key.h"
+#include "pixelgym/wrappers/running_statistics.h"
 
 namespace pixelgym::vector {
 

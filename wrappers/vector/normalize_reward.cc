@@ -1,4 +1,4 @@
-#include "wrappers/vector/normalize_reward.h"
+#include "pixelgym/wrappers/vector/normalize_reward.h"
 
 #include <cmath>
 #include <sstream>

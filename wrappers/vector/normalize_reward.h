@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "envs/vector/vector_wrapper.h"
-#include "wrappers/running_statistics.h"
+#include "pixelgym/envs/vector/vector_wrapper.h"
+#include "pixelgym/wrappers/running_statistics.h"
 
 namespace pixelgym::vector {
 

@@ -1,4 +1,4 @@
-#include "wrappers/vector/record_episode_statistics.h"
+#include "pixelgym/wrappers/vector/record_episode_statistics.h"
 
 #include <optional>
 #include <stdexcept>

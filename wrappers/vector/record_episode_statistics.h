@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "envs/vector/vector_wrapper.h"
+#include "pixelgym/envs/vector/vector_wrapper.h"
 
 namespace pixelgym::vector {
 

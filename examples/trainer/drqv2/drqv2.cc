@@ -12,10 +12,10 @@
 #include <stdexcept>
 #include <utility>
 
-#include "envs/spaces/box.h"
-#include "envs/spaces/dict.h"
 #include "examples/trainer/ppo/policy.h"
 #include "examples/trainer/run/config_members.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/dict.h"
 
 namespace pixelgym::drqv2 {
 namespace {

@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "envs/space.h"
 #include "examples/trainer/drqv2/replay_buffer.h"
 #include "examples/trainer/run/memory_budget.h"
+#include "pixelgym/envs/space.h"
 
 namespace pixelgym::drqv2 {
 

@@ -10,9 +10,9 @@
 #include <stdexcept>
 #include <utility>
 
-#include "envs/vector/vector_wrapper.h"
 #include "examples/trainer/ppo/policy.h"
 #include "examples/trainer/ppo/ppo_algorithm.h"
+#include "pixelgym/envs/vector/vector_wrapper.h"
 
 namespace pixelgym::drqv2 {
 

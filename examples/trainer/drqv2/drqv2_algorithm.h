@@ -17,7 +17,7 @@
 #include "examples/trainer/drqv2/drqv2.h"
 #include "examples/trainer/drqv2/replay_buffer.h"
 #include "examples/trainer/run/algorithm.h"
-#include "wrappers/vector/record_episode_statistics.h"
+#include "pixelgym/wrappers/vector/record_episode_statistics.h"
 
 namespace pixelgym::drqv2 {
 

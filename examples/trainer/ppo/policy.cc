@@ -6,9 +6,9 @@
 #include <tuple>
 #include <utility>
 
-#include "envs/spaces/box.h"
-#include "envs/spaces/dict.h"
-#include "envs/spaces/discrete.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/dict.h"
+#include "pixelgym/envs/spaces/discrete.h"
 
 namespace pixelgym::ppo {
 namespace {

@@ -12,9 +12,9 @@
 #include <utility>
 #include <vector>
 
-#include "envs/space.h"
-#include "envs/value.h"
-#include "wrappers/running_statistics.h"
+#include "pixelgym/envs/space.h"
+#include "pixelgym/envs/value.h"
+#include "pixelgym/wrappers/running_statistics.h"
 
 namespace pixelgym::ppo {
 

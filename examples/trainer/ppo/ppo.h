@@ -12,13 +12,13 @@
 #include <string>
 #include <vector>
 
-#include "envs/vector/vector_env.h"
 #include "examples/trainer/ppo/policy.h"
 #include "examples/trainer/run/communicator.h"
 #include "examples/trainer/run/memory_budget.h"
-#include "wrappers/running_statistics.h"
-#include "wrappers/vector/normalize_reward.h"
-#include "wrappers/vector/record_episode_statistics.h"
+#include "pixelgym/envs/vector/vector_env.h"
+#include "pixelgym/wrappers/running_statistics.h"
+#include "pixelgym/wrappers/vector/normalize_reward.h"
+#include "pixelgym/wrappers/vector/record_episode_statistics.h"
 
 namespace pixelgym::ppo {
 

@@ -19,9 +19,9 @@
 #include <functional>
 #include <string>
 
-#include "envs/spaces/box.h"
 #include "examples/trainer/ppo/policy.h"
 #include "examples/trainer/run/process_tuning.h"
+#include "pixelgym/envs/spaces/box.h"
 
 namespace {
 

@@ -10,12 +10,12 @@
 #include <string>
 #include <vector>
 
-#include "envs/space.h"
-#include "envs/value.h"
-#include "envs/vector/vector_env.h"
 #include "examples/trainer/run/checkpoint_file.h"
 #include "examples/trainer/run/communicator.h"
 #include "examples/trainer/run/progress_csv.h"
+#include "pixelgym/envs/space.h"
+#include "pixelgym/envs/value.h"
+#include "pixelgym/envs/vector/vector_env.h"
 
 namespace pixelgym::trainer {
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "wrappers/running_statistics.h"
+#include "pixelgym/wrappers/running_statistics.h"
 
 namespace pixelgym::trainer {
 

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "examples/trainer/run/progress_csv.h"
-#include "render/image_io.h"
+#include "pixelgym/render/image_io.h"
 
 namespace pixelgym::trainer {
 

@@ -5,8 +5,8 @@
 #include <stdexcept>
 #include <utility>
 
-#include "envs/vector/sync_vector_env.h"
-#include "wrappers/record_video.h"
+#include "pixelgym/envs/vector/sync_vector_env.h"
+#include "pixelgym/wrappers/record_video.h"
 
 namespace pixelgym::trainer {
 namespace {

@@ -6,7 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "envs/vector/memory_check.h"
+#include "pixelgym/envs/vector/memory_check.h"
 
 namespace pixelgym::trainer {
 

@@ -3,9 +3,9 @@
 #include <fstream>
 #include <stdexcept>
 
-#include "envs/registry.h"
-#include "envs/vector/make_vec.h"
-#include "wrappers/wrapper_spec.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/vector/make_vec.h"
+#include "pixelgym/wrappers/wrapper_spec.h"
 
 namespace pixelgym::trainer {
 

@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "envs/env.h"
-#include "envs/params.h"
-#include "envs/vector/vector_env.h"
 #include "examples/trainer/run/algorithm.h"
+#include "pixelgym/envs/env.h"
+#include "pixelgym/envs/params.h"
+#include "pixelgym/envs/vector/vector_env.h"
 
 namespace pixelgym::trainer {
 

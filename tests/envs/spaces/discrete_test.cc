@@ -1,4 +1,4 @@
-#include "envs/spaces/discrete.h"
+#include "pixelgym/envs/spaces/discrete.h"
 
 #include <gtest/gtest.h>
 

@@ -1,11 +1,11 @@
-#include "envs/spaces/tuple.h"
+#include "pixelgym/envs/spaces/tuple.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "envs/spaces/box.h"
-#include "envs/spaces/discrete.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/discrete.h"
 
 namespace pixelgym::spaces {
 namespace {

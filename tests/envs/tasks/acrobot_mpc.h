@@ -20,8 +20,8 @@
 #include <utility>
 #include <vector>
 
-#include "envs/tasks/acrobot.h"
-#include "envs/tasks/angles.h"
+#include "pixelgym/envs/tasks/acrobot.h"
+#include "pixelgym/envs/tasks/angles.h"
 
 namespace pixelgym::testing {
 

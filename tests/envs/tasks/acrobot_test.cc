@@ -1,4 +1,4 @@
-#include "envs/tasks/acrobot.h"
+#include "pixelgym/envs/tasks/acrobot.h"
 
 #include <gtest/gtest.h>
 
@@ -6,9 +6,9 @@
 #include <cmath>
 #include <iostream>
 
-#include "envs/registry.h"
-#include "envs/tasks/angles.h"
-#include "envs/tasks/pixel_env.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/tasks/angles.h"
+#include "pixelgym/envs/tasks/pixel_env.h"
 #include "tests/envs/tasks/acrobot_mpc.h"
 #include "tests/envs/tasks/scripted.h"
 

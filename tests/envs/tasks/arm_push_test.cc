@@ -1,4 +1,4 @@
-#include "envs/tasks/arm_push.h"
+#include "pixelgym/envs/tasks/arm_push.h"
 
 #include <gtest/gtest.h>
 
@@ -6,9 +6,9 @@
 #include <iostream>
 #include <optional>
 
-#include "engine/robot_model.h"
-#include "envs/registry.h"
-#include "envs/tasks/pixel_env.h"
+#include "pixelgym/engine/robot_model.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/tasks/pixel_env.h"
 #include "tests/envs/tasks/scripted.h"
 
 namespace pixelgym {

@@ -1,13 +1,13 @@
-#include "envs/tasks/arm_reach.h"
+#include "pixelgym/envs/tasks/arm_reach.h"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
 #include <iostream>
 
-#include "engine/robot_model.h"
-#include "envs/registry.h"
-#include "envs/tasks/pixel_env.h"
+#include "pixelgym/engine/robot_model.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/tasks/pixel_env.h"
 #include "tests/envs/tasks/scripted.h"
 
 namespace pixelgym {

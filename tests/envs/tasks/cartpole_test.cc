@@ -1,4 +1,4 @@
-#include "envs/tasks/cartpole.h"
+#include "pixelgym/envs/tasks/cartpole.h"
 
 #include <gtest/gtest.h>
 
@@ -10,9 +10,9 @@
 #include <iostream>
 #include <vector>
 
-#include "envs/registry.h"
-#include "envs/rng.h"
-#include "envs/tasks/pixel_env.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/rng.h"
+#include "pixelgym/envs/tasks/pixel_env.h"
 #include "tests/envs/tasks/scripted.h"
 
 namespace pixelgym {

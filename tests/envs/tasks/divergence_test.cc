@@ -9,9 +9,9 @@
 #include <memory>
 #include <string>
 
-#include "envs/errors.h"
-#include "envs/tasks/cartpole.h"
-#include "envs/tasks/pixel_env.h"
+#include "pixelgym/envs/errors.h"
+#include "pixelgym/envs/tasks/cartpole.h"
+#include "pixelgym/envs/tasks/pixel_env.h"
 
 namespace pixelgym {
 namespace {

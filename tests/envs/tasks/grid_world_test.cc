@@ -1,9 +1,9 @@
-#include "envs/tasks/grid_world.h"
+#include "pixelgym/envs/tasks/grid_world.h"
 
 #include <gtest/gtest.h>
 
-#include "envs/registry.h"
-#include "envs/spaces/discrete.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/spaces/discrete.h"
 
 namespace pixelgym {
 namespace {

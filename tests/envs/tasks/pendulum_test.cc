@@ -1,12 +1,12 @@
-#include "envs/tasks/pendulum.h"
+#include "pixelgym/envs/tasks/pendulum.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <iostream>
 
-#include "engine/world.h"
-#include "envs/registry.h"
+#include "pixelgym/engine/world.h"
+#include "pixelgym/envs/registry.h"
 #include "tests/envs/tasks/scripted.h"
 
 namespace pixelgym {

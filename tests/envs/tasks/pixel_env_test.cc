@@ -1,12 +1,12 @@
 // PixelEnv builds its renderer from the render resources it is given: at construction when it
 // observes pixels, on the first render() when it observes state alone (no GL context until then).
-#include "envs/tasks/pixel_env.h"
+#include "pixelgym/envs/tasks/pixel_env.h"
 
 #include <gtest/gtest.h>
 
 #include <memory>
 
-#include "envs/registry.h"
+#include "pixelgym/envs/registry.h"
 
 namespace pixelgym {
 namespace {

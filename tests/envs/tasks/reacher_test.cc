@@ -1,12 +1,12 @@
-#include "envs/tasks/reacher.h"
+#include "pixelgym/envs/tasks/reacher.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <iostream>
 
-#include "envs/registry.h"
-#include "envs/tasks/pixel_env.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/tasks/pixel_env.h"
 #include "tests/envs/tasks/scripted.h"
 
 namespace pixelgym {

@@ -3,7 +3,7 @@
 
 #include <functional>
 
-#include "envs/env.h"
+#include "pixelgym/envs/env.h"
 
 namespace pixelgym::testing {
 

@@ -2,7 +2,7 @@
 // this test (tests/data/urdf_good/telescope_arm.urdf: revolute and prismatic joints, primitives).
 // On each, every target can be reached (joint positions found for it are driven to), and a bad URDF
 // or a wrong link name is an error naming the problem.
-#include "envs/tasks/urdf_reach.h"
+#include "pixelgym/envs/tasks/urdf_reach.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -14,9 +14,9 @@
 #include <string>
 #include <vector>
 
-#include "engine/robot_model.h"
-#include "envs/registry.h"
-#include "envs/tasks/pixel_env.h"
+#include "pixelgym/engine/robot_model.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/tasks/pixel_env.h"
 #include "tests/envs/tasks/scripted.h"
 
 namespace pixelgym {

@@ -13,8 +13,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "envs/registry.h"
-#include "envs/rng.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/rng.h"
 
 namespace pixelgym {
 namespace {

@@ -1,9 +1,9 @@
-#include "envs/tasks/world_scene.h"
+#include "pixelgym/envs/tasks/world_scene.h"
 
 #include <gtest/gtest.h>
 
-#include "envs/array.h"
-#include "render/renderer.h"
+#include "pixelgym/envs/array.h"
+#include "pixelgym/render/renderer.h"
 #include "tests/envs/scene_fixtures.h"
 #include "tests/golden.h"
 

@@ -15,11 +15,11 @@
 #include <thread>
 #include <vector>
 
-#include "envs/registry.h"
-#include "envs/vector/make_vec.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/vector/make_vec.h"
+#include "pixelgym/wrappers/wrapper_spec.h"
 #include "tests/alloc_counter.h"
 #include "tests/envs/env_ids.h"
-#include "wrappers/wrapper_spec.h"
 
 namespace pixelgym::vector {
 namespace {

@@ -15,12 +15,12 @@
 #include <utility>
 #include <vector>
 
-#include "envs/registry.h"
-#include "envs/vector/async_vector_env.h"
-#include "envs/vector/batch_space.h"
-#include "envs/vector/make_vec.h"
-#include "render/mesa_copy.h"
-#include "wrappers/wrapper_spec.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/vector/async_vector_env.h"
+#include "pixelgym/envs/vector/batch_space.h"
+#include "pixelgym/envs/vector/make_vec.h"
+#include "pixelgym/render/mesa_copy.h"
+#include "pixelgym/wrappers/wrapper_spec.h"
 
 namespace pixelgym::vector {
 namespace {

@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "envs/spaces/dict.h"
-#include "envs/vector/make_vec.h"
+#include "pixelgym/envs/spaces/dict.h"
+#include "pixelgym/envs/vector/make_vec.h"
+#include "pixelgym/wrappers/wrapper_spec.h"
 #include "tests/envs/vector/vector_test_util.h"
-#include "wrappers/wrapper_spec.h"
 
 namespace pixelgym::vector {
 namespace {

@@ -1,7 +1,7 @@
 // make_vec owns what its envs share to render: one PixelRenderResources per thread that runs
 // envs (copy w of Mesa for worker w), handed to each env of that thread; a single env made alone
 // draws with a context of its own.
-#include "envs/vector/make_vec.h"
+#include "pixelgym/envs/vector/make_vec.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -11,12 +11,12 @@
 #include <memory>
 #include <set>
 
-#include "envs/described_env.h"
-#include "envs/registry.h"
-#include "envs/tasks/pixel_env.h"
-#include "envs/vector/memory_check.h"
-#include "render/mesa_copy.h"
-#include "wrappers/wrapper_spec.h"
+#include "pixelgym/envs/described_env.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/tasks/pixel_env.h"
+#include "pixelgym/envs/vector/memory_check.h"
+#include "pixelgym/render/mesa_copy.h"
+#include "pixelgym/wrappers/wrapper_spec.h"
 
 namespace pixelgym::vector {
 namespace {

@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "envs/registry.h"
-#include "envs/rng.h"
-#include "envs/tasks/pixel_env.h"
-#include "render/mesa_copy.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/rng.h"
+#include "pixelgym/envs/tasks/pixel_env.h"
+#include "pixelgym/render/mesa_copy.h"
 
 namespace pixelgym {
 namespace {

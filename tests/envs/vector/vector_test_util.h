@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "envs/vector/async_vector_env.h"
-#include "envs/vector/sync_vector_env.h"
-#include "envs/wrapper.h"
+#include "pixelgym/envs/vector/async_vector_env.h"
+#include "pixelgym/envs/vector/sync_vector_env.h"
+#include "pixelgym/envs/wrapper.h"
 #include "tests/wrappers/scripted_env.h"
 
 namespace pixelgym::testing {

@@ -1,6 +1,6 @@
 // VectorWrapper forwards every call to the vector env it wraps (or to the wrapper it wraps):
 // the same results, spaces, metadata and errors, in SyncVectorEnv and AsyncVectorEnv (2 threads).
-#include "envs/vector/vector_wrapper.h"
+#include "pixelgym/envs/vector/vector_wrapper.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

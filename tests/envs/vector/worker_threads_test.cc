@@ -1,6 +1,6 @@
 // WorkerThreads: tasks run on threads that are parked and reused, a slot's task on the thread
 // that last ran that slot.
-#include "envs/vector/worker_threads.h"
+#include "pixelgym/envs/vector/worker_threads.h"
 
 #include <gtest/gtest.h>
 

@@ -2,15 +2,15 @@
 // read from the installed assets, a wrapper, the env checker and a rollout whose frames are drawn.
 // Prints the assets folder in use, then "consumer ran to the end"; exits 1 with the reason on any
 // failure.
+#include <pixelgym/engine/robot_model.h>
+#include <pixelgym/envs/checker.h>
+#include <pixelgym/envs/registry.h>
+#include <pixelgym/wrappers/wrapper_spec.h>
+
 #include <cstdint>
 #include <exception>
 #include <iostream>
 #include <memory>
-
-#include "engine/robot_model.h"
-#include "envs/checker.h"
-#include "envs/registry.h"
-#include "wrappers/wrapper_spec.h"
 
 namespace {
 

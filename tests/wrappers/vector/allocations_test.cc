@@ -15,13 +15,13 @@
 #include <tuple>
 #include <vector>
 
-#include "envs/vector/make_vec.h"
+#include "pixelgym/envs/vector/make_vec.h"
+#include "pixelgym/wrappers/vector/normalize_observation.h"
+#include "pixelgym/wrappers/vector/normalize_reward.h"
+#include "pixelgym/wrappers/vector/record_episode_statistics.h"
+#include "pixelgym/wrappers/wrapper_spec.h"
 #include "tests/alloc_counter.h"
 #include "tests/envs/vector/vector_test_util.h"
-#include "wrappers/vector/normalize_observation.h"
-#include "wrappers/vector/normalize_reward.h"
-#include "wrappers/vector/record_episode_statistics.h"
-#include "wrappers/wrapper_spec.h"
 
 namespace pixelgym::vector {
 namespace {

@@ -14,9 +14,9 @@
 #include <tuple>
 #include <vector>
 
-#include "envs/spaces/box.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/wrappers/wrapper_spec.h"
 #include "tests/envs/vector/vector_test_util.h"
-#include "wrappers/wrapper_spec.h"
 
 namespace pixelgym::vector {
 namespace {

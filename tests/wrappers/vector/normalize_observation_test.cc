@@ -3,7 +3,7 @@
 // prior), and every row it returns is that row normalized with them, in each autoreset mode
 // (SameStep's final_obs included, Disabled's masked resets included), in SyncVectorEnv and
 // AsyncVectorEnv (2 threads). A batch of one env is the per-env wrapper bit for bit.
-#include "wrappers/vector/normalize_observation.h"
+#include "pixelgym/wrappers/vector/normalize_observation.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -15,12 +15,12 @@
 #include <tuple>
 #include <vector>
 
-#include "envs/spaces/box.h"
-#include "envs/spaces/dict.h"
-#include "envs/vector/batch_space.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/dict.h"
+#include "pixelgym/envs/vector/batch_space.h"
+#include "pixelgym/wrappers/normalize_observation.h"
 #include "tests/envs/vector/vector_test_util.h"
 #include "tests/wrappers/test_util.h"
-#include "wrappers/normalize_observation.h"
 
 namespace pixelgym::vector {
 namespace {

@@ -5,7 +5,7 @@
 // its standard deviation. In each autoreset mode, for terminated and truncated episodes, in
 // SyncVectorEnv and AsyncVectorEnv (2 threads). A batch of one env is the per-env wrapper bit for
 // bit.
-#include "wrappers/vector/normalize_reward.h"
+#include "pixelgym/wrappers/vector/normalize_reward.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -16,9 +16,9 @@
 #include <tuple>
 #include <vector>
 
+#include "pixelgym/wrappers/normalize_reward.h"
 #include "tests/envs/vector/vector_test_util.h"
 #include "tests/wrappers/test_util.h"
-#include "wrappers/normalize_reward.h"
 
 namespace pixelgym::vector {
 namespace {

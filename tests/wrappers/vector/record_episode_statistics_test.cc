@@ -2,7 +2,7 @@
 // steps with rewards 0.5, 0.25, 0.125, ... by step, so every episode it reports must have that
 // length and that return, at the steps each autoreset mode ends episodes on, and no other. In
 // SyncVectorEnv and AsyncVectorEnv (2 threads), for terminated and for truncated episodes.
-#include "wrappers/vector/record_episode_statistics.h"
+#include "pixelgym/wrappers/vector/record_episode_statistics.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -13,8 +13,8 @@
 #include <tuple>
 #include <vector>
 
+#include "pixelgym/wrappers/record_episode_statistics.h"
 #include "tests/envs/vector/vector_test_util.h"
-#include "wrappers/record_episode_statistics.h"
 
 namespace pixelgym::vector {
 namespace {

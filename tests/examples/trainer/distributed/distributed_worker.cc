@@ -21,11 +21,11 @@
 #include <thread>
 #include <vector>
 
-#include "envs/vector/make_vec.h"
-#include "envs/vector/vector_wrapper.h"
 #include "examples/trainer/distributed/gloo_communicator.h"
 #include "examples/trainer/ppo/ppo.h"
-#include "wrappers/running_statistics.h"
+#include "pixelgym/envs/vector/make_vec.h"
+#include "pixelgym/envs/vector/vector_wrapper.h"
+#include "pixelgym/wrappers/running_statistics.h"
 
 namespace {
 

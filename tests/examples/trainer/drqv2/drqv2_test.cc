@@ -15,10 +15,10 @@
 #include <string>
 #include <vector>
 
-#include "envs/spaces/box.h"
-#include "envs/spaces/dict.h"
-#include "envs/spaces/discrete.h"
 #include "examples/trainer/ppo/policy.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/dict.h"
+#include "pixelgym/envs/spaces/discrete.h"
 
 namespace pixelgym::drqv2 {
 namespace {

@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "envs/spaces/box.h"
-#include "envs/spaces/dict.h"
-#include "envs/spaces/discrete.h"
-#include "envs/spaces/multi_discrete.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/dict.h"
+#include "pixelgym/envs/spaces/discrete.h"
+#include "pixelgym/envs/spaces/multi_discrete.h"
 
 namespace pixelgym::ppo {
 namespace {

@@ -19,13 +19,13 @@
 #include <string>
 #include <vector>
 
-#include "envs/env.h"
-#include "envs/spaces/box.h"
-#include "envs/spaces/discrete.h"
-#include "envs/vector/sync_vector_env.h"
+#include "pixelgym/envs/env.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/discrete.h"
+#include "pixelgym/envs/vector/sync_vector_env.h"
+#include "pixelgym/wrappers/vector/normalize_reward.h"
+#include "pixelgym/wrappers/vector/record_episode_statistics.h"
 #include "tests/wrappers/scripted_env.h"
-#include "wrappers/vector/normalize_reward.h"
-#include "wrappers/vector/record_episode_statistics.h"
 
 namespace pixelgym::ppo {
 namespace {

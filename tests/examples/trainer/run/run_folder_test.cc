@@ -13,7 +13,7 @@
 
 #include "examples/trainer/run/atomic_file.h"
 #include "examples/trainer/run/checkpoint_file.h"
-#include "render/image_io.h"
+#include "pixelgym/render/image_io.h"
 #include "tests/examples/trainer/run/test_folders.h"
 
 namespace pixelgym::trainer {

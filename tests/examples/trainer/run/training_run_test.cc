@@ -13,9 +13,9 @@
 #include <thread>
 #include <vector>
 
-#include "envs/tasks/grid_world.h"
 #include "examples/trainer/run/checkpoint_file.h"
 #include "examples/trainer/run/progress_csv.h"
+#include "pixelgym/envs/tasks/grid_world.h"
 #include "tests/examples/trainer/run/test_folders.h"
 
 namespace pixelgym::trainer {
