@@ -14,8 +14,7 @@ endif()
 get_property(pixelgym_libraries GLOBAL PROPERTY PIXELGYM_LIBRARIES)
 set_target_properties(pixelgym_testing_gtest PROPERTIES EXPORT_NAME testing_gtest)
 install(TARGETS ${pixelgym_libraries} pixelgym_testing_gtest EXPORT pixelgymTargets
-        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
-        INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
 # The renderer's private headers (each says "Private" at its top: the OpenGL declarations and the
 # GL objects behind render/renderer.h) are for render/*.cc only; no installed header includes them.
 install(DIRECTORY engine envs render testing wrappers
