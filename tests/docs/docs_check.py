@@ -18,10 +18,11 @@ Rules (each names the page, the line and what it found):
   outside docs/experiments/ a date such as 2026-11-26 that is not part of a path (a record's file
   name may hold its date).
 - out-of-date id: an id NAME-vN of a registered env when NAME-vM with M > N is registered (what
-  `pixelgym list` prints). Allowed where a page explains versions (between `<!-- versions -->` and
-  `<!-- /versions -->`), in the README's headline figures (written by bench/report.py between its
-  markers: they name the ids that were measured), and in docs/experiments/ (a record names the id
-  it ran).
+  `pixelgym list` prints). Allowed between `<!-- older ids: REASON -->` and `<!-- /older ids -->`
+  (a table of every registered id, a page that explains versions, a measurement that names the id
+  it measured: the REASON says which), in the README's headline figures (written by
+  bench/report.py between its markers from the ids measured), and in docs/experiments/ (a record
+  names the id it ran).
 - broken link: a relative link or image whose file does not exist, or whose #anchor is no heading
   of the page it names.
 
@@ -69,7 +70,7 @@ def anchors(path, cache={}):
     if path not in cache:
         found, fenced = set(), False
         for line in path.read_text(encoding="utf-8").splitlines():
-            if line.startswith("```"):
+            if line.lstrip().startswith("```"):
                 fenced = not fenced
             elif not fenced and line.startswith("#"):
                 found.add(slug(line.lstrip("#")))
@@ -88,12 +89,12 @@ def check_page(root, page, newest):
         def report(rule, found):
             problems.append(f"{relative}:{number}: {rule}: {found!r} in: {line.strip()[:160]}")
 
-        if line.startswith("```"):
+        if line.lstrip().startswith("```"):
             fenced = not fenced
             continue
-        if "<!-- versions -->" in line:
+        if re.search(r"<!-- older ids: \S", line):
             versions = True
-        if "<!-- /versions -->" in line:
+        if "<!-- /older ids -->" in line:
             versions = False
         if "<!-- headline figures" in line:
             headline = True
