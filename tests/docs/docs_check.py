@@ -85,12 +85,14 @@ def check_page(root, page, newest):
     fenced = False
     versions = False
     headline = False
+    previous = ""
     for number, line in enumerate(page.read_text(encoding="utf-8").splitlines(), start=1):
         def report(rule, found):
             problems.append(f"{relative}:{number}: {rule}: {found!r} in: {line.strip()[:160]}")
 
         if line.lstrip().startswith("```"):
             fenced = not fenced
+            previous = ""
             continue
         if re.search(r"<!-- older ids: \S", line):
             versions = True
@@ -115,6 +117,13 @@ def check_page(root, page, newest):
             report("issue number", match.group(0))
         for match in LAB_NOTE.finditer(line):
             report("lab note (who measured when)", match.group(0))
+        # The same words wrapped over two lines ("this 2-core" / "VM", "issue" / "12").
+        joined = previous + " " + line.lstrip()
+        for pattern, rule in ((LAB_NOTE, "lab note (who measured when)"), (ISSUE, "issue number")):
+            for match in pattern.finditer(joined):
+                if match.start() < len(previous) < match.end():
+                    report(rule + ", over two lines", match.group(0))
+        previous = "" if fenced else line.rstrip()
         if not is_record:
             for match in DATE.finditer(line):
                 report("date of a measurement (records go to docs/experiments/)", match.group(0))
