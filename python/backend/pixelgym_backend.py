@@ -78,7 +78,8 @@ def build_sdist(sdist_directory, config_settings=None):
     version = _version()
     base = f"{NAME}-{version}"
     name = f"{base}.tar.gz"
-    with tarfile.open(os.path.join(sdist_directory, name), "w:gz", format=tarfile.PAX_FORMAT) as tar:
+    path = os.path.join(sdist_directory, name)
+    with tarfile.open(path, "w:gz", format=tarfile.PAX_FORMAT) as tar:
         for relative in _source_files():
             tar.add(os.path.join(SOURCE_DIR, relative), arcname=f"{base}/{relative}",
                     recursive=False)
@@ -145,8 +146,8 @@ def _cmake_cache(build_dir):
 
 def _configure(build_dir):
     if shutil.which("cmake") is None:
-        raise BuildError("CMake (>= 3.22) is not on PATH: `apt install cmake` (Debian), and the other "
-                         "packages of scripts/install-deps.sh")
+        raise BuildError("CMake (>= 3.22) is not on PATH: `apt install cmake` (Debian), and the "
+                         "other packages of scripts/install-deps.sh")
     header = os.path.join(sysconfig.get_paths()["include"], "Python.h")
     if not os.path.exists(header):
         raise BuildError(
@@ -176,7 +177,8 @@ def _version():
     with open(os.path.join(SOURCE_DIR, "CMakeLists.txt"), encoding="utf-8") as file:
         match = re.search(r"project\(\s*pixelgym\s+VERSION\s+([0-9.]+)", file.read())
     if not match:
-        raise BuildError("CMakeLists.txt: no `project(pixelgym VERSION X.Y.Z` to take the version from")
+        raise BuildError("CMakeLists.txt: no `project(pixelgym VERSION X.Y.Z` to take the "
+                         "version from")
     return match.group(1)
 
 

@@ -10,6 +10,7 @@ import glob
 import os
 import subprocess
 import sys
+import tarfile
 import zipfile
 
 import pytest
@@ -75,8 +76,8 @@ def test_a_wheel_for_debians_python_runs_the_readme_tour_in_a_venv(tmp_path):
     # --system-site-packages: Debian's numpy (python3-numpy) meets the wheel's requirement, offline.
     python = install_into_venv("/usr/bin/python3", tmp_path / "venv", wheel,
                                venv_options=["--system-site-packages"])
-    where = run([python, "-W", "ignore", "-c",
-                 "import pixelgym; print(pixelgym.__file__); print(pixelgym._core.assets_folder())"],
+    where = run([python, "-W", "ignore", "-c", "import pixelgym; print(pixelgym.__file__); "
+                 "print(pixelgym._core.assets_folder())"],
                 cwd=str(tmp_path), env=outside_the_tree()).split("\n")
     package = os.path.join(str(tmp_path / "venv"), "lib", f"python3.{sys.version_info.minor}",
                            "site-packages", "pixelgym")
@@ -113,3 +114,44 @@ def test_a_wheel_for_a_pyenv_python_installs_into_its_venv(tmp_path):
         message = result.stderr.strip().splitlines()[-1]
         assert message.startswith("ImportError: pixelgym needs numpy"), result.stderr
         assert "pip install" in message and python in message, message
+
+
+def backend():
+    """python/backend/pixelgym_backend.py, imported as pip imports it (backend-path)."""
+    sys.path.insert(0, os.path.join(ROOT, "python", "backend"))
+    try:
+        import pixelgym_backend
+    finally:
+        sys.path.pop(0)
+    return pixelgym_backend
+
+
+def test_the_backend_asks_pip_for_nothing_to_install():
+    assert backend().get_requires_for_build_wheel() == []
+    assert backend().get_requires_for_build_sdist() == []
+
+
+def test_a_build_folder_of_another_python_or_without_shared_libraries_is_refused(tmp_path):
+    module = backend()
+    (tmp_path / "CMakeCache.txt").write_text(
+        "PIXELGYM_PYTHON_EXECUTABLE:FILEPATH=/opt/other/bin/python3\n")
+    with pytest.raises(module.BuildError, match=r"configured for the Python "
+                       rf"/opt/other/bin/python3, not for {sys.executable}"):
+        module._build_dir({"build-dir": str(tmp_path)}, "tag")
+    (tmp_path / "CMakeCache.txt").write_text(
+        f"PIXELGYM_PYTHON_EXECUTABLE:FILEPATH={sys.executable}\nPIXELGYM_SHARED_LIBS:BOOL=OFF\n")
+    with pytest.raises(module.BuildError,
+                       match="has PIXELGYM_SHARED_LIBS=OFF: a wheel needs it ON"):
+        module._build_dir({"build-dir": str(tmp_path)}, "tag")
+
+
+def test_the_sdist_holds_the_tracked_sources_and_no_build_output(tmp_path):
+    name = backend().build_sdist(str(tmp_path))
+    with tarfile.open(tmp_path / name) as archive:
+        names = archive.getnames()
+    base = name[:-len(".tar.gz")]
+    for needed in ("PKG-INFO", "pyproject.toml", "CMakeLists.txt",
+                   "python/backend/pixelgym_backend.py", "python/pixelgym/__init__.py",
+                   "assets/cartpole/cartpole.urdf"):
+        assert f"{base}/{needed}" in names, needed
+    assert not [n for n in names if n.startswith((f"{base}/build/", f"{base}/build-wheel/"))]
