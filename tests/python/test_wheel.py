@@ -77,11 +77,16 @@ def test_a_wheel_for_debians_python_runs_the_readme_tour_in_a_venv(tmp_path):
     python = install_into_venv("/usr/bin/python3", tmp_path / "venv", wheel,
                                venv_options=["--system-site-packages"])
     where = run([python, "-W", "ignore", "-c", "import pixelgym; print(pixelgym.__file__); "
-                 "print(pixelgym._core.assets_folder())"],
+                 "print(pixelgym._core.assets_folder()); "
+                 "print(sorted({line.split()[-1] for line in open('/proc/self/maps') "
+                 "if 'libpixelgym_' in line}))"],
                 cwd=str(tmp_path), env=outside_the_tree()).split("\n")
     package = os.path.join(str(tmp_path / "venv"), "lib", f"python3.{sys.version_info.minor}",
                            "site-packages", "pixelgym")
     assert where[0] == os.path.join(package, "__init__.py")
+    # The module loads the wheel's libraries (RPATH $ORIGIN/lib), not the build tree's.
+    assert where[2] == str(sorted(os.path.join(package, "lib", f"libpixelgym_{name}.so.0.1")
+                                  for name in ("engine", "envs", "render", "tasks", "wrappers")))
     # The engine finds the wheel's assets from its library's folder (not the source tree's).
     assert where[1] == os.path.join(package, "share", "pixelgym", "assets")
 
