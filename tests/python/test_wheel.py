@@ -42,8 +42,9 @@ def outside_the_tree():
 
 def build_wheel(python, build_dir, wheel_dir, *pip_options):
     """pip wheel of the source tree for `python` (offline), reusing build_dir; the wheel's path."""
-    run([python, "-m", "pip", "wheel", ROOT, "--no-deps", "--no-index", "--wheel-dir",
-         str(wheel_dir), "--config-settings", f"build-dir={build_dir}", *pip_options],
+    run([python, "-m", "pip", "wheel", ROOT, "--no-deps", "--no-index", "--no-cache-dir",
+         "--wheel-dir", str(wheel_dir), "--config-settings", f"build-dir={build_dir}",
+         *pip_options],
         env=outside_the_tree())
     (wheel,) = glob.glob(str(wheel_dir / "pixelgym-*.whl"))
     return wheel
@@ -53,7 +54,7 @@ def install_into_venv(python, venv, wheel, venv_options=(), pip_options=()):
     """A fresh venv of `python` with the wheel installed (pip --no-index); its interpreter."""
     run([python, "-m", "venv", *venv_options, str(venv)])
     venv_python = str(venv / "bin" / "python")
-    run([venv_python, "-m", "pip", "install", "--no-index", *pip_options, wheel],
+    run([venv_python, "-m", "pip", "install", "--no-index", "--no-cache-dir", *pip_options, wheel],
         env=outside_the_tree())
     return venv_python
 
