@@ -123,6 +123,7 @@ def _build_dir(config_settings, tag):
                     f"for {sys.executable} (which runs this build): give a build folder of its own "
                     "(--config-settings build-dir=FOLDER, or PIXELGYM_WHEEL_BUILD_DIR) or none")
             os.remove(os.path.join(build_dir, "CMakeCache.txt"))  # ours: configure it afresh
+            return build_dir
         for option in ("PIXELGYM_SHARED_LIBS", "PIXELGYM_BUILD_PYTHON"):
             if cache.get(option, "ON").upper() not in ("ON", "1", "TRUE", "YES"):
                 raise BuildError(f"the build folder {build_dir} has {option}={cache[option]}: a "
@@ -167,7 +168,7 @@ def _configure(build_dir):
 def _run(command):
     # pip shows this output with -v, and all of it when the build fails.
     print("pixelgym_backend:", " ".join(command), flush=True)
-    result = subprocess.run(command, stdout=sys.stdout, stderr=subprocess.STDOUT)
+    result = subprocess.run(command, stderr=subprocess.STDOUT)
     if result.returncode != 0:
         raise BuildError(f"`{' '.join(command)}` failed (exit status {result.returncode}); its "
                          "output is above (pip shows it with -v)")
