@@ -10,6 +10,10 @@
 #                    FUZZ_TARGET=urdf FUZZ_SECONDS=600 (docs/reliability.md)
 #   make install     installs the Release build (cmake --install build; PREFIX=/usr/local unless
 #                    given): libraries, headers, CMake package, tool, assets, Python package
+#   make wheel       builds a wheel of the Python package into dist/ (pixelgym-VERSION-TAG.whl), for
+#                    Debian's /usr/bin/python3 from the Release build in build/, or for another
+#                    Python with PYTHON=/path/to/python3 (in build-wheel/TAG/): for
+#                    `pip install dist/pixelgym-*.whl` into that Python's venv (docs/python.md)
 #   make deb         builds the Debian package in build-deb/ (prefix /usr, tests off):
 #                    build-deb/pixelgym_VERSION_ARCH.deb, for `apt install ./build-deb/pixelgym_*.deb`
 #   make bench-report   builds, then runs the benchmarks beside the reference programs of
@@ -22,7 +26,7 @@ BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 PIXELGYM := $(BUILD_DIR)/examples/pixelgym
 
-.PHONY: all deps configure build demo test test-asan test-tsan fuzz install deb format-check format goldens bench bench-report clean
+.PHONY: all deps configure build demo test test-asan test-tsan fuzz install wheel deb format-check format goldens bench bench-report clean
 
 all: build
 
@@ -107,6 +111,14 @@ fuzz: deps
 PREFIX ?= /usr/local
 install: build
 	cmake --install $(BUILD_DIR) --prefix $(PREFIX)
+
+# pip runs the in-tree backend (pyproject.toml, python/backend/) offline: it builds the module and
+# the libraries it loads, and packs them with the assets. Debian's Python reuses build/ (configured
+# for it); another Python gets a build folder of its own, build-wheel/TAG.
+PYTHON ?= /usr/bin/python3
+wheel: configure
+	$(PYTHON) -m pip wheel . --no-deps --no-build-isolation --no-index --wheel-dir dist \
+	  $(if $(filter /usr/bin/python3,$(PYTHON)),--config-settings build-dir=$(BUILD_DIR))
 
 DEB_BUILD_DIR ?= build-deb
 deb: deps

@@ -28,6 +28,8 @@ PACKAGES=(
   libcli11-dev nlohmann-json3-dev
   # the Python binding (python/) and its pytest suite (tests/python/), for Debian's python3
   python3-dev pybind11-dev python3-numpy python3-pytest
+  # pip install . and make wheel (pip), and the wheel test's venv (python3 -m venv)
+  python3-pip python3-venv
   # tests and benchmarks; ffmpeg for ffprobe, which the RecordVideo tests read clips back with
   libgtest-dev libgmock-dev libbenchmark-dev ffmpeg
 )

@@ -22,7 +22,18 @@ Rewards, flags and infos are always copies.
 """
 
 import os as _os
+import sys as _sys
 import warnings as _warnings
+
+try:
+    import numpy as _numpy  # noqa: F401
+except ImportError as _error:
+    raise ImportError(
+        f"pixelgym needs numpy, which this Python ({_sys.executable}) cannot import: install it "
+        "into the same environment with `python -m pip install \"numpy<2\"` (the wheel lists it; "
+        "pip installs it unless given --no-deps or no index), or, for Debian's /usr/bin/python3, "
+        "`apt install python3-numpy` (a venv made with `python3 -m venv --system-site-packages` "
+        "sees it)", name="numpy") from _error
 
 from . import _core
 from ._core import Buffer

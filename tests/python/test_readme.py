@@ -18,9 +18,16 @@ PAGES = ["README.md"] + sorted(
     for path in glob.glob(os.path.join(ROOT, pattern)))
 
 
-def python_blocks(page):
+def python_blocks(page, section=None):
+    """The ```python blocks of a page, or of its `## section` alone (test_wheel runs the README's
+    tour in a venv)."""
     with open(os.path.join(ROOT, page), encoding="utf-8") as file:
-        return re.findall(r"```python\n(.*?)\n```", file.read(), re.S)
+        text = file.read()
+    if section is not None:
+        match = re.search(rf"^## {re.escape(section)}\n(.*?)(?=^## |\Z)", text, re.S | re.M)
+        assert match, f"{page}: no section \"## {section}\""
+        text = match.group(1)
+    return re.findall(r"```python\n(.*?)\n```", text, re.S)
 
 
 # (page, block number from 1, block text) for every block of every page.
