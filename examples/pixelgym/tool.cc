@@ -27,7 +27,7 @@ int usage_error(const CLI::App& app, const std::string& message) {
 }
 
 // Words other tools and the library's own API use for a subcommand (describe() gives what info
-// prints), suggested for an unknown subcommand that is no typo of one.
+// prints), suggested for an unknown subcommand before the subcommands it is a typo of.
 const std::vector<std::pair<std::string, std::string>> kSubcommandSynonyms = {
     {"describe", "info"},   {"show", "info"},           {"spec", "info"},
     {"ls", "list"},         {"envs", "list"},           {"evaluate", "eval"},
@@ -39,10 +39,13 @@ const std::vector<std::pair<std::string, std::string>> kSubcommandSynonyms = {
 std::string unknown_subcommand(const std::string& word, const std::vector<Command>& commands) {
   std::vector<std::string> names;
   for (const Command& command : commands) names.push_back(command.app->get_name());
-  std::string suggestion = did_you_mean(word, names);
+  // A word of another tool is that tool's subcommand, though it may be a typo's distance from
+  // another of ours ("test" from list, "video" from view).
+  std::string suggestion;
   for (const auto& [synonym, name] : kSubcommandSynonyms) {
-    if (suggestion.empty() && synonym == word) suggestion = "did you mean " + name + "?";
+    if (synonym == word) suggestion = "did you mean " + name + "?";
   }
+  if (suggestion.empty()) suggestion = did_you_mean(word, names);
   return "unknown subcommand \"" + word + "\"; " + (suggestion.empty() ? "" : suggestion + " ") +
          "(subcommands: " + join_names(names) + ")";
 }

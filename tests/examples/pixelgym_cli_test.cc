@@ -298,6 +298,8 @@ TEST(PixelgymCliTest, MistypedNamesAreAnsweredWithDidYouMean) {
        "unknown parameter \"paddin\"; did you mean padding?"},
       {"describe CartPoleSwingup-v0", "unknown subcommand \"describe\"; did you mean info?"},
       {"lsit", "unknown subcommand \"lsit\"; did you mean list?"},
+      {"test GridWorld-v0", "unknown subcommand \"test\"; did you mean check?"},
+      {"video CartPoleSwingup-v0", "unknown subcommand \"video\"; did you mean record?"},
       {"help describe", "help: unknown subcommand \"describe\"; did you mean info?"},
       {"train CartPoleSwingup-v0 --algo drqv3",
        "--algo: unknown algorithm \"drqv3\"; did you mean drqv2? (the algorithms: ppo, drqv2)"},
