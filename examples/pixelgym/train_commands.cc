@@ -41,8 +41,9 @@ void add_run_options(CLI::App& train, TrainArguments& args) {
   train.add_option(
       "--config", args.config_file,
       "The algorithm's settings as JSON (any subset of the fields; the rest keep "
-      "their defaults): a recipe's name (e.g. swingup: a file of the algorithm's recipes, which "
-      "--list-configs shows), a FILE.json (or any path with a '/'), or the JSON itself, e.g. "
+      "their defaults): a recipe's name (e.g. swingup: the configs installed with the tool for "
+      "--algo's algorithm, which --list-configs shows), a FILE.json (or any path with a '/'), or "
+      "the JSON itself, e.g. "
       "'{\"gamma\": 0.95}'. ppo: examples/trainer/ppo/ppo.h, PpoConfig. drqv2: "
       "examples/trainer/drqv2/drqv2.h, DrqV2Config: seed, num_envs (1), "
       "total_env_steps (100,000), iteration_env_steps (500, one progress.csv row), "
