@@ -50,6 +50,28 @@ std::string unknown_subcommand(const std::string& word, const std::vector<Comman
          "(subcommands: " + join_names(names) + ")";
 }
 
+// CLI11's "Could not convert: --steps = x" said as the other option errors are: "--steps:
+// expected an integer, got "x"" (the option's type from its type name: INT, FLOAT, UINT64).
+std::string conversion_message(const CLI::App& app, const CLI::ConversionError& error) {
+  const std::string what = error.what();
+  std::vector<const CLI::App*> apps = {&app};
+  for (const CLI::App* chosen : app.get_subcommands()) apps.push_back(chosen);
+  for (const CLI::App* in : apps) {
+    for (const CLI::Option* option : in->get_options()) {
+      const std::string prefix = "Could not convert: " + option->get_name() + " = ";
+      if (what.rfind(prefix, 0) != 0) continue;
+      std::string type = option->get_type_name();
+      type = type.substr(0, type.find(':'));
+      const std::string expected = type == "INT" || type == "UINT64" ? "an integer"
+                                   : type == "FLOAT"                 ? "a number"
+                                                                     : type;
+      return option->get_name() + ": expected " + expected + ", got \"" +
+             what.substr(prefix.size()) + "\"";
+    }
+  }
+  return what;
+}
+
 // The whole tool's help, even while a subcommand (`help`) is chosen.
 std::string tool_help(const CLI::App& app) {
   return app.get_formatter()->make_help(&app, app.get_name(), CLI::AppFormatMode::Normal);
@@ -105,6 +127,8 @@ int run_tool(int argc, char** argv, const Trainer& trainer) {
     }
   } catch (const CLI::Success& success) {  // --help, --help-all, --version
     return app.exit(success);
+  } catch (const CLI::ConversionError& error) {
+    return usage_error(app, conversion_message(app, error));
   } catch (const CLI::ParseError& error) {
     return usage_error(app, error.what());
   } catch (const UsageError& error) {
