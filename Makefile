@@ -47,7 +47,7 @@ build: configure
 # 0.9987: a horizon of 8 s, whose values the CNN learned too poorly).
 DEMO_TRAIN := train CartPoleBalance-v1 --set obs_mode=pixels --set width=64 --set height=64 \
   --set msaa=4 --set action_repeat=8 --wrap grayscale --wrap frame_stack=3 \
-  --config examples/trainer/ppo/configs/action_repeat_8.json --minutes 10 --out runs/demo
+  --config action_repeat_8 --minutes 10 --out runs/demo
 demo: build
 	rm -rf runs/demo
 	$(PIXELGYM) $(DEMO_TRAIN)

@@ -7,6 +7,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "pixelgym/envs/suggestions.h"
+
 namespace pixelgym {
 namespace {
 
@@ -128,8 +130,12 @@ Params resolve_params(const std::vector<ParamSpec>& specs, const Params& given,
     const auto spec = std::find_if(specs.begin(), specs.end(),
                                    [&](const ParamSpec& s) { return s.name == name; });
     if (spec == specs.end()) {
-      throw std::invalid_argument(context + ": unknown kwarg \"" + key +
-                                  "\"; valid kwargs: " + describe_params(specs));
+      std::vector<std::string> names;
+      for (const ParamSpec& s : specs) names.push_back(s.name);
+      const std::string suggestion = did_you_mean(key, names);
+      throw std::invalid_argument(context + ": unknown kwarg \"" + key + "\"; " +
+                                  (suggestion.empty() ? "" : suggestion + " ") +
+                                  "valid kwargs: " + describe_params(specs));
     }
     if (value.type() == spec->type()) {
       resolved.at(key) = value;

@@ -1,37 +1,16 @@
 #include "pixelgym/envs/registry.h"
 
 #include <algorithm>
-#include <cctype>
 #include <regex>
 #include <stdexcept>
 
+#include "pixelgym/envs/suggestions.h"
 #include "pixelgym/envs/time_limit.h"
 
 namespace pixelgym {
 namespace {
 
 constexpr const char* kMaxEpisodeStepsKey = "max_episode_steps";
-
-std::string lowercase(std::string text) {
-  std::transform(text.begin(), text.end(), text.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return text;
-}
-
-std::size_t edit_distance(const std::string& a, const std::string& b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t above = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = above;
-    }
-  }
-  return row[b.size()];
-}
 
 }  // namespace
 
@@ -69,22 +48,15 @@ std::shared_ptr<const EnvSpec> Registry::spec(const std::string& id) const {
     }
   }
   std::string message = "unknown env id \"" + id + "\"";
-  const std::vector<std::string> closest = closest_ids(id);
   const std::vector<std::string> all = registered_ids();
-  const auto list = [](const std::vector<std::string>& ids, const char* last_separator) {
-    std::string text;
-    for (std::size_t i = 0; i < ids.size(); ++i) {
-      text += (i == 0 ? "" : i + 1 == ids.size() ? last_separator : ", ") + ids[i];
-    }
-    return text;
-  };
+  const std::string suggestion = did_you_mean(id, all);
   if (all.empty()) {
     message += "; no envs are registered";
-  } else if (!closest.empty()) {
-    message += "; did you mean " + list(closest, " or ") + "? (`pixelgym list` shows all " +
-               std::to_string(all.size()) + ")";
+  } else if (!suggestion.empty()) {
+    message +=
+        "; " + suggestion + " (`pixelgym list` shows all " + std::to_string(all.size()) + ")";
   } else {
-    message += "; registered ids: " + list(all, ", ");
+    message += "; registered ids: " + join_names(all);
   }
   throw std::invalid_argument(message);
 }
@@ -159,17 +131,7 @@ std::vector<std::string> Registry::registered_ids() const {
 }
 
 std::vector<std::string> Registry::closest_ids(const std::string& id, std::size_t count) const {
-  // Close enough to be a typo: an edit distance of at most a third of the id (and at least 2).
-  const std::size_t limit = std::max<std::size_t>(2, id.size() / 3);
-  std::vector<std::pair<std::size_t, std::string>> ranked;
-  for (const std::string& candidate : registered_ids()) {
-    const std::size_t distance = edit_distance(lowercase(id), lowercase(candidate));
-    if (distance <= limit) ranked.emplace_back(distance, candidate);
-  }
-  std::sort(ranked.begin(), ranked.end());
-  std::vector<std::string> closest;
-  for (std::size_t i = 0; i < ranked.size() && i < count; ++i) closest.push_back(ranked[i].second);
-  return closest;
+  return closest_names(id, registered_ids(), count);
 }
 
 }  // namespace pixelgym

@@ -421,4 +421,6 @@ void Renderer::render(const Scene& scene, const Camera& camera, const RenderTarg
 
 std::string Renderer::description() { return impl_->state->context.description(); }
 
+int Renderer::max_samples() const { return impl_->state->max_samples; }
+
 }  // namespace pixelgym::render

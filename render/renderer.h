@@ -101,6 +101,10 @@ class Renderer {
   /// The GL implementation in use (Context::description).
   std::string description();
 
+  /// The most MSAA samples a camera may ask of this renderer (Context::max_samples, GL_MAX_SAMPLES
+  /// of its context): 4 on llvmpipe.
+  int max_samples() const;
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "pixelgym/envs/described_env.h"
+#include "pixelgym/envs/suggestions.h"
 #include "pixelgym/envs/time_limit.h"
 #include "pixelgym/wrappers/add_render_observation.h"
 #include "pixelgym/wrappers/channel_first_observation.h"
@@ -294,22 +295,59 @@ const std::vector<Entry>& entries() {
   return table;
 }
 
+// Other names of wrappers (alias, wrapper): the words the docs use for them ("grey", "channels
+// first"), so that a spec written as the docs read works.
+const std::vector<std::pair<std::string, std::string>>& aliases() {
+  static const std::vector<std::pair<std::string, std::string>> table = {
+      {"greyscale", "grayscale"},
+      {"grey", "grayscale"},
+      {"gray", "grayscale"},
+      {"channels_first", "channel_first"},
+  };
+  return table;
+}
+
 const Entry& find_entry(const std::string& name, const std::string& text) {
+  std::string wanted = name;
+  for (const auto& [alias, wrapper] : aliases()) {
+    if (alias == name) wanted = wrapper;
+  }
   const auto& table = entries();
   const auto found =
-      std::find_if(table.begin(), table.end(), [&](const Entry& e) { return e.name == name; });
+      std::find_if(table.begin(), table.end(), [&](const Entry& e) { return e.name == wanted; });
   if (found != table.end()) return *found;
-  std::string names;
-  for (const Entry& entry : table) names += (names.empty() ? "" : ", ") + entry.name;
+  std::vector<std::string> names;
+  for (const Entry& entry : table) names.push_back(entry.name);
+  // The closest of the names and aliases, one per wrapper ("grayscal": grayscale, not greyscale
+  // too).
+  std::vector<std::string> known = names;
+  for (const auto& [alias, wrapper] : aliases()) known.push_back(alias);
+  std::vector<std::string> closest;
+  std::vector<std::string> suggested;
+  for (const std::string& candidate : closest_names(name, known)) {
+    std::string wrapper = candidate;
+    for (const auto& [alias, aliased] : aliases()) {
+      if (alias == candidate) wrapper = aliased;
+    }
+    if (std::find(suggested.begin(), suggested.end(), wrapper) != suggested.end()) continue;
+    suggested.push_back(wrapper);
+    closest.push_back(candidate);
+  }
+  const std::string suggestion = did_you_mean(name, closest);
   throw std::invalid_argument("wrapper spec " + quoted(text) + ": unknown wrapper " + quoted(name) +
-                              "; the wrappers are: " + names);
+                              "; " + (suggestion.empty() ? "" : suggestion + " ") +
+                              "the wrappers are: " + join_names(names));
+}
+
+std::vector<std::string> parameter_names(const Entry& entry) {
+  std::vector<std::string> names;
+  for (const Param& param : entry.params) names.push_back(param.name);
+  return names;
 }
 
 std::string param_names(const Entry& entry) {
   if (entry.params.empty()) return entry.name + " takes no arguments";
-  std::string names;
-  for (const Param& param : entry.params) names += (names.empty() ? "" : ", ") + param.name;
-  return entry.name + "'s parameters are: " + names;
+  return entry.name + "'s parameters are: " + join_names(parameter_names(entry));
 }
 
 // "resize=HxW[,key=pixels]": the form of a spec, for messages and help.
@@ -345,6 +383,7 @@ WrapperSpec parse_wrapper_spec(const std::string& text) {
                                 "), got a ',' in the name " + quoted(spec.name));
   }
   const Entry& entry = find_entry(spec.name, text);
+  spec.name = entry.name;  // an alias ("greyscale") as the wrapper it names
   if (equals == std::string::npos) {
     // No arguments: fine unless a parameter is required (checked below).
   } else {
@@ -369,7 +408,9 @@ WrapperSpec parse_wrapper_spec(const std::string& text) {
         name = item.substr(0, item_equals);
         value = item.substr(item_equals + 1);
         if (param_named(name) == entry.params.end()) {
+          const std::string suggestion = did_you_mean(name, parameter_names(entry));
           throw std::invalid_argument(prefix(spec) + "unknown parameter " + quoted(name) + "; " +
+                                      (suggestion.empty() ? "" : suggestion + " ") +
                                       param_names(entry));
         }
       } else if (const auto flag = param_named(item);
@@ -380,6 +421,17 @@ WrapperSpec parse_wrapper_spec(const std::string& text) {
         if (next_positional >= entry.params.size()) {
           throw std::invalid_argument(prefix(spec) + "too many values: " + param_names(entry) +
                                       ", got " + quoted(item) + " after them");
+        }
+        // "resize=64,48": a second number where the size's form is HEIGHTxWIDTH, not a key.
+        if (next_positional > 0 && entry.params[next_positional - 1].kind == Kind::kSize &&
+            entry.params[next_positional].kind == Kind::kText &&
+            item.find_first_not_of("0123456789") == std::string::npos) {
+          const std::string size = spec.arguments.empty() ? "" : spec.arguments.back().second;
+          throw std::invalid_argument(prefix(spec) + entry.name + "'s " +
+                                      entry.params[next_positional - 1].name + ": expected " +
+                                      expected(Kind::kSize) + ", as " + entry.name + "=" + size +
+                                      "x" + item + " for " + size + " high and " + item +
+                                      " wide; got " + quoted(size + "," + item));
         }
         name = entry.params[next_positional].name;
         value = item;
@@ -464,7 +516,12 @@ EnvDescription describe_wrapped(EnvDescription description, const std::vector<st
 
 std::vector<WrapperSpecHelp> wrapper_spec_help() {
   std::vector<WrapperSpecHelp> help;
-  for (const Entry& entry : entries()) help.push_back({entry.name, usage(entry), entry.summary});
+  for (const Entry& entry : entries()) {
+    help.push_back({entry.name, usage(entry), entry.summary, {}});
+    for (const auto& [alias, wrapper] : aliases()) {
+      if (wrapper == entry.name) help.back().aliases.push_back(alias);
+    }
+  }
   return help;
 }
 

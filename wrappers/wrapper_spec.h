@@ -25,10 +25,13 @@ struct WrapperSpec {
   std::vector<std::pair<std::string, std::string>> arguments;
 };
 
-/// Parses `text`. Throws std::invalid_argument naming the spec and what is wrong in it: an
-/// unknown wrapper (listing the known ones), an unknown parameter (listing the wrapper's), a
-/// parameter given twice, more bare values than the wrapper has parameters, an empty item, or a
-/// missing required argument. Values are checked when the wrapper is applied.
+/// Parses `text`; a name may be an alias (WrapperSpecHelp::aliases: "greyscale"), which the
+/// result names by the wrapper's name ("grayscale"). Throws std::invalid_argument naming the spec
+/// and what is wrong in it: an unknown wrapper (the closest names as "did you mean", then the
+/// known ones), an unknown parameter (likewise, the wrapper's), a parameter given twice, more bare
+/// values than the wrapper has parameters, a bare number after a size ("resize=64,48": the form
+/// HEIGHTxWIDTH is named), an empty item, or a missing required argument. Values are checked when
+/// the wrapper is applied.
 WrapperSpec parse_wrapper_spec(const std::string& text);
 
 /// Wraps `env` as `spec` says. Throws std::invalid_argument naming the spec, the wrapper, the
@@ -61,6 +64,8 @@ struct WrapperSpecHelp {
   std::string usage;
   /// The wrapper class and what it does: "ResizeObservation: ...".
   std::string summary;
+  /// Other names a spec may start with for this wrapper, the docs' words for it ("greyscale").
+  std::vector<std::string> aliases;
 };
 
 /// Every wrapper the text form knows, in the order `--help` lists them.

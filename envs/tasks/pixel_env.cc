@@ -62,7 +62,8 @@ std::vector<ParamSpec> TaskConfig::params() {
           {"action_repeat", d.action_repeat, "control steps per env step (rewards are summed)"},
           {"shadows", d.shadows, "draw shadows in observations and render()"},
           {"msaa", d.msaa,
-           "anti-aliasing samples per observation pixel: 0 (off), 2, 4 or 8 (render() uses 4)"}};
+           "anti-aliasing samples per observation pixel: 0 (off), 2, 4, or 8 where the OpenGL "
+           "offers it (llvmpipe: at most 4; render() uses 4)"}};
 }
 
 TaskConfig TaskConfig::from_params(const Params& params, const std::vector<std::string>& cameras,
@@ -159,7 +160,20 @@ PixelEnv::PixelEnv(std::unique_ptr<Task> task, TaskConfig config, std::string na
   task_->build(*world_);
   scene_ = std::make_unique<WorldScene>(*world_);
   scene_->scene().shadows = config_.shadows;
-  if (config_.has_pixels()) renderer();
+  if (config_.has_pixels()) {
+    // More samples than this OpenGL offers would fail at the first reset: refuse them now, with
+    // what it offers (llvmpipe: 0, 2 and 4; a GPU through EGL: 8 too).
+    render::Renderer& drawing = renderer();
+    if (config_.msaa > drawing.max_samples()) {
+      std::string offered = "0";
+      for (int samples = 2; samples <= std::min(drawing.max_samples(), 8); samples *= 2) {
+        offered += ", " + std::to_string(samples);
+      }
+      throw std::invalid_argument(name_ + ": msaa=" + std::to_string(config_.msaa) +
+                                  " is more than this OpenGL offers (" + drawing.description() +
+                                  "): it takes msaa " + offered);
+    }
+  }
 }
 
 PixelEnv::~PixelEnv() = default;

@@ -34,9 +34,10 @@ class PixelEnv final : public Env {
  public:
   /// Builds the world (Task::build) and, when observations hold pixels, the renderer. `config`
   /// is taken as given (TaskConfig::from_params checks kwargs). `name` is how messages name the
-  /// env before the registry sets its id. Throws std::invalid_argument for a null task or when
-  /// `render` is not null and not PixelRenderResources, std::runtime_error when the GL context
-  /// cannot be created, and what the task's build throws.
+  /// env before the registry sets its id. Throws std::invalid_argument for a null task, when
+  /// `render` is not null and not PixelRenderResources, or when observations hold pixels and
+  /// config.msaa is more than the renderer's OpenGL offers (naming the counts it offers);
+  /// std::runtime_error when the GL context cannot be created, and what the task's build throws.
   PixelEnv(std::unique_ptr<Task> task, TaskConfig config, std::string name,
            std::shared_ptr<RenderResources> render = nullptr);
   ~PixelEnv() override;

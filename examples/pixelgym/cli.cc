@@ -12,6 +12,7 @@
 #include <limits>
 
 #include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/suggestions.h"
 #include "pixelgym/render/image_io.h"
 #include "pixelgym/wrappers/wrapper_spec.h"
 
@@ -40,6 +41,20 @@ CLI::Validator integer_in(int min, int max) {
                ", got \"" + text + "\"";
       },
       unbounded ? ">= " + std::to_string(min) : std::to_string(min) + " to " + std::to_string(max));
+}
+
+CLI::Validator name_in(const std::vector<std::string>& names, const std::string& what) {
+  std::string shown;
+  for (const std::string& name : names) shown += (shown.empty() ? "{" : ",") + name;
+  return CLI::Validator(
+      [names, what](std::string& text) -> std::string {
+        if (std::find(names.begin(), names.end(), text) != names.end()) return "";
+        const std::string suggestion = did_you_mean(text, names);
+        return "unknown " + what + " \"" + text + "\"; " +
+               (suggestion.empty() ? "" : suggestion + " ") + "(the " + what +
+               "s: " + join_names(names) + ")";
+      },
+      shown + "}");
 }
 
 CLI::Option* add_seed_option(CLI::App& command, std::uint64_t& seed,

@@ -23,7 +23,8 @@ constexpr int kExitFailure = 1;
 constexpr int kExitUsage = 2;
 
 /// Thrown for a command line that parses but cannot be used (an unknown env id, a --set without
-/// '=', a kwarg the env refuses): main prints it with the subcommand's usage and exits 2.
+/// '=', a kwarg the env refuses): main prints it with a line naming the subcommand's --help, and
+/// exits 2.
 class UsageError : public std::invalid_argument {
  public:
   using std::invalid_argument::invalid_argument;
@@ -32,6 +33,10 @@ class UsageError : public std::invalid_argument {
 /// Accepts a whole decimal integer in [min, max] (for an int option); otherwise the option fails
 /// with "must be an integer from MIN to MAX, got "TEXT"". Help shows the range.
 CLI::Validator integer_in(int min, int max = std::numeric_limits<int>::max());
+
+/// Accepts one of `names` (help shows {a,b}); otherwise the option fails with "unknown {what}
+/// \"TEXT\"; did you mean NAME? (the {what}s: a, b)", "did you mean" only when one is close.
+CLI::Validator name_in(const std::vector<std::string>& names, const std::string& what);
 
 /// Adds `--seed N` (default 0, any unsigned 64-bit integer; "-1" is refused, not wrapped around).
 CLI::Option* add_seed_option(CLI::App& command, std::uint64_t& seed,

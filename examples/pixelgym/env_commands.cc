@@ -14,6 +14,7 @@
 #include "pixelgym/envs/spaces/box.h"
 #include "pixelgym/envs/spaces/dict.h"
 #include "pixelgym/envs/spaces/discrete.h"
+#include "pixelgym/envs/suggestions.h"
 #include "pixelgym/envs/vector/async_vector_env.h"
 #include "pixelgym/envs/vector/make_vec.h"
 #include "pixelgym/testing/snapshot.h"
@@ -78,7 +79,9 @@ void declare_wrappers(CLI::App& command, NoArguments& /*args*/) {
 int run_wrappers(const NoArguments& /*args*/) {
   std::vector<std::vector<std::string>> rows;
   for (const wrappers::WrapperSpecHelp& help : wrappers::wrapper_spec_help()) {
-    rows.push_back({help.usage, help.summary});
+    std::string summary = help.summary;
+    if (!help.aliases.empty()) summary += " (also: " + join_names(help.aliases) + ")";
+    rows.push_back({help.usage, summary});
   }
   print_table(std::cout, rows, "");
   return 0;

@@ -2,18 +2,74 @@
 #include <exception>
 #include <iostream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "examples/pixelgym/cli.h"
 #include "examples/pixelgym/train_commands.h"
+#include "pixelgym/envs/suggestions.h"
 
 namespace pixelgym::cli {
 namespace {
 
-// An error message, then the usage of the subcommand it is about (CLI11's help() shows the chosen
-// subcommand's, or the whole tool's when none was chosen); exit code 2.
+// An error message, then one line naming where the usage of the subcommand it is about is (the
+// chosen subcommand's --help, or the whole tool's when none was chosen); exit code 2. The help
+// itself (40 lines for train) would bury the message.
 int usage_error(const CLI::App& app, const std::string& message) {
-  std::cerr << "pixelgym: " << message << "\n\n" << app.help();
+  const auto chosen = app.get_subcommands();
+  const bool subcommand = !chosen.empty() && chosen.front()->get_name() != "help";
+  std::cerr << "pixelgym: " << message << "\n"
+            << (subcommand
+                    ? "Run 'pixelgym " + chosen.front()->get_name() + " --help' for the options."
+                    : std::string("Run 'pixelgym --help' for the subcommands."))
+            << "\n";
   return kExitUsage;
+}
+
+// Words other tools and the library's own API use for a subcommand (describe() gives what info
+// prints), suggested for an unknown subcommand before the subcommands it is a typo of.
+const std::vector<std::pair<std::string, std::string>> kSubcommandSynonyms = {
+    {"describe", "info"},   {"show", "info"},           {"spec", "info"},
+    {"ls", "list"},         {"envs", "list"},           {"evaluate", "eval"},
+    {"test", "check"},      {"validate", "check"},      {"benchmark", "bench"},
+    {"render", "snapshot"}, {"screenshot", "snapshot"}, {"video", "record"},
+    {"learn", "train"},     {"fit", "train"},           {"plot", "compare"}};
+
+// "unknown subcommand "WORD"; did you mean NAME? (subcommands: ...)".
+std::string unknown_subcommand(const std::string& word, const std::vector<Command>& commands) {
+  std::vector<std::string> names;
+  for (const Command& command : commands) names.push_back(command.app->get_name());
+  // A word of another tool is that tool's subcommand, though it may be a typo's distance from
+  // another of ours ("test" from list, "video" from view).
+  std::string suggestion;
+  for (const auto& [synonym, name] : kSubcommandSynonyms) {
+    if (synonym == word) suggestion = "did you mean " + name + "?";
+  }
+  if (suggestion.empty()) suggestion = did_you_mean(word, names);
+  return "unknown subcommand \"" + word + "\"; " + (suggestion.empty() ? "" : suggestion + " ") +
+         "(subcommands: " + join_names(names) + ")";
+}
+
+// CLI11's "Could not convert: --steps = x" said as the other option errors are: "--steps:
+// expected an integer, got "x"" (the option's type from its type name: INT, FLOAT, UINT64).
+std::string conversion_message(const CLI::App& app, const CLI::ConversionError& error) {
+  const std::string what = error.what();
+  std::vector<const CLI::App*> apps = {&app};
+  for (const CLI::App* chosen : app.get_subcommands()) apps.push_back(chosen);
+  for (const CLI::App* in : apps) {
+    for (const CLI::Option* option : in->get_options()) {
+      const std::string prefix = "Could not convert: " + option->get_name() + " = ";
+      if (what.rfind(prefix, 0) != 0) continue;
+      std::string type = option->get_type_name();
+      type = type.substr(0, type.find(':'));
+      const std::string expected = type == "INT" || type == "UINT64" ? "an integer"
+                                   : type == "FLOAT"                 ? "a number"
+                                                                     : type;
+      return option->get_name() + ": expected " + expected + ", got \"" +
+             what.substr(prefix.size()) + "\"";
+    }
+  }
+  return what;
 }
 
 // The whole tool's help, even while a subcommand (`help`) is chosen.
@@ -53,24 +109,15 @@ int run_tool(int argc, char** argv, const Trainer& trainer) {
                             return 0;
                           }
                         }
-                        std::cerr << "pixelgym: help: unknown subcommand \"" << help_topic
-                                  << "\"\n\n"
-                                  << tool_help(app);
-                        return kExitUsage;
+                        return usage_error(app,
+                                           "help: " + unknown_subcommand(help_topic, commands));
                       }});
 
   // CLI11 reports an unknown first word only as "a subcommand is required"; name it instead.
   if (argc > 1 && argv[1][0] != '-') {
     bool known = false;
-    std::string names;
-    for (const auto& command : commands) {
-      known = known || command.app->get_name() == argv[1];
-      names += (names.empty() ? "" : ", ") + command.app->get_name();
-    }
-    if (!known) {
-      return usage_error(
-          app, std::string("unknown subcommand \"") + argv[1] + "\" (subcommands: " + names + ")");
-    }
+    for (const auto& command : commands) known = known || command.app->get_name() == argv[1];
+    if (!known) return usage_error(app, unknown_subcommand(argv[1], commands));
   }
 
   try {
@@ -80,6 +127,8 @@ int run_tool(int argc, char** argv, const Trainer& trainer) {
     }
   } catch (const CLI::Success& success) {  // --help, --help-all, --version
     return app.exit(success);
+  } catch (const CLI::ConversionError& error) {
+    return usage_error(app, conversion_message(app, error));
   } catch (const CLI::ParseError& error) {
     return usage_error(app, error.what());
   } catch (const UsageError& error) {

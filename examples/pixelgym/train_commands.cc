@@ -36,12 +36,15 @@ void add_run_options(CLI::App& train, TrainArguments& args) {
                   "random-shift augmentation and scheduled exploration noise; Box actions only, "
                   "and images as --wrap frame_stack=3 stacks). The run's config.json names it; "
                   "--resume and eval read it from there")
-      ->check(CLI::IsMember({"ppo", "drqv2"}))
+      ->check(name_in({"ppo", "drqv2"}, "algorithm"))
       ->each([&args](const std::string&) { args.algo_given = true; });
   train.add_option(
       "--config", args.config_file,
       "The algorithm's settings as JSON (any subset of the fields; the rest keep "
-      "their defaults). ppo: examples/trainer/ppo/ppo.h, PpoConfig. drqv2: "
+      "their defaults): a recipe's name (e.g. swingup: the configs installed with the tool for "
+      "--algo's algorithm, which --list-configs shows), a FILE.json (or any path with a '/'), or "
+      "the JSON itself, e.g. "
+      "'{\"gamma\": 0.95}'. ppo: examples/trainer/ppo/ppo.h, PpoConfig. drqv2: "
       "examples/trainer/drqv2/drqv2.h, DrqV2Config: seed, num_envs (1), "
       "total_env_steps (100,000), iteration_env_steps (500, one progress.csv row), "
       "frame_stack (3), replay_capacity (100,000 steps), batch_size (128), n_step "
@@ -54,6 +57,19 @@ void add_run_options(CLI::App& train, TrainArguments& args) {
       "channels_last (true). drqv2's replay buffer is not in its checkpoints: "
       "--resume refills it by replaying the run's env actions, which puts the "
       "same transitions back");
+  train
+      .add_option("--set-algo", args.algo_sets,
+                  "One of the algorithm's settings as KEY=VALUE (repeatable), over --config's: "
+                  "--set-algo gamma=0.95, --set-algo policy.cnn=fine for a member of an object "
+                  "member. VALUE is JSON (0.95, true, [64,64]) or else a word (fine); an unknown "
+                  "KEY or a VALUE of the wrong type is refused as in a config file")
+      ->type_name("KEY=VALUE");
+  train.add_flag("--list-configs", args.list_configs,
+                 "Print the recipes that --config NAME takes (of --algo's algorithm when given, "
+                 "else of each), each with its settings, and exit");
+  train.add_flag("--print-config", args.print_config,
+                 "Print the settings the run would write to config.json (--config, --set-algo "
+                 "and the flags applied) and exit without training or writing anything");
   train.add_option("--steps", args.steps,
                    "Env steps to train for, all envs together; with --set action_repeat=K "
                    "each is K control steps (default: the config's total_env_steps: ppo "

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "examples/pixelgym/cli.h"
 
@@ -16,8 +17,11 @@ namespace pixelgym::cli {
 struct TrainArguments : EnvArguments {
   std::string algo = "ppo";
   bool algo_given = false;
-  std::string config_file;
-  std::int64_t steps = 0;  // 0: the config's total_env_steps
+  std::string config_file;             // --config: a recipe's name, a file or inline JSON
+  std::vector<std::string> algo_sets;  // --set-algo KEY=VALUE, over --config
+  bool list_configs = false;           // --list-configs: print the recipes, train nothing
+  bool print_config = false;           // --print-config: print the settings, train nothing
+  std::int64_t steps = 0;              // 0: the config's total_env_steps
   double minutes = 0.0;
   std::string out;
   std::string resume;

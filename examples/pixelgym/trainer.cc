@@ -9,7 +9,6 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -19,6 +18,7 @@
 #include "examples/trainer/ppo/ppo_algorithm.h"
 #include "examples/trainer/run/evaluation.h"
 #include "examples/trainer/run/process_tuning.h"
+#include "examples/trainer/run/recipes.h"
 #include "examples/trainer/run/training_run.h"
 
 namespace pixelgym::cli {
@@ -136,22 +136,69 @@ void check_same_command_line(const TrainArguments& args,
                    "line (only --out, --quiet and --dist-join-timeout may differ)");
 }
 
-// The settings of a new run: the flags, over the --config file's settings of the algorithm.
+std::vector<std::string> algorithm_names() {
+  std::vector<std::string> names;
+  for (const trainer::AlgorithmFactory* algorithm : kAlgorithms) names.push_back(algorithm->name());
+  return names;
+}
+
+// The algorithm's config of a new run: --config's (a recipe, a file or inline JSON), then each
+// --set-algo over it, each checked by the algorithm as a config file is (UsageError naming the
+// option and what the algorithm said).
+nlohmann::json algorithm_config(const TrainArguments& args,
+                                const trainer::AlgorithmFactory& algorithm) {
+  nlohmann::json config = nlohmann::json::object();
+  if (!args.config_file.empty()) {
+    try {
+      const std::string text =
+          trainer::config_text(args.config_file, algorithm.name(), algorithm_names());
+      algorithm.parse_config(text);  // its errors, before a --set-algo is applied to it
+      config = nlohmann::json::parse(text);
+    } catch (const std::invalid_argument& error) {
+      const std::string message = error.what();
+      throw UsageError(message.rfind("--config", 0) == 0
+                           ? message
+                           : "--config " + args.config_file + ": " + message);
+    }
+  }
+  for (const std::string& set : args.algo_sets) {
+    try {
+      config = trainer::with_setting(config, set);
+      algorithm.parse_config(config.dump());
+    } catch (const std::invalid_argument& error) {
+      const std::string message = error.what();
+      throw UsageError(message.rfind("--set-algo", 0) == 0 ? message
+                                                           : "--set-algo " + set + ": " + message);
+    }
+  }
+  return algorithm.parse_config(config.dump());
+}
+
+// `train --list-configs`: each recipe of `algorithm` with its settings on one line.
+void print_recipes(const trainer::AlgorithmFactory& algorithm) {
+  const std::vector<std::string> names = trainer::recipe_names(algorithm.name());
+  std::cout << algorithm.name() << " (--algo " << algorithm.name() << "), "
+            << trainer::recipe_folder(algorithm.name()).string() << ":\n";
+  if (names.empty()) std::cout << "  (none)\n";
+  std::size_t width = 0;
+  for (const std::string& name : names) width = std::max(width, name.size());
+  for (const std::string& name : names) {
+    const std::string text = trainer::config_text(name, algorithm.name(), {});
+    const nlohmann::json settings = nlohmann::json::parse(text, nullptr, false);
+    std::cout << "  " << name << std::string(width - name.size() + 2, ' ')
+              << (settings.is_discarded() ? "(not valid JSON)" : settings.dump()) << "\n";
+  }
+}
+
+// The settings of a new run: the flags, over --set-algo's, over --config's.
 trainer::RunSettings new_run_settings(const TrainArguments& args,
                                       const trainer::AlgorithmFactory& algorithm) {
   trainer::RunSettings settings;
   settings.env_id = args.id;
   settings.sets = args.sets;
   settings.wraps = args.wraps;
-  std::string config = "{}";
-  if (!args.config_file.empty()) {
-    std::ifstream in(args.config_file);
-    if (!in) throw UsageError("--config " + args.config_file + ": cannot read it");
-    std::stringstream text;
-    text << in.rdbuf();
-    config = text.str();
-  }
-  settings.algorithm_config = algorithm.parse_config(config);
+  settings.algorithm = algorithm.name();
+  settings.algorithm_config = algorithm_config(args, algorithm);
   if (args.seed_given) settings.algorithm_config["seed"] = args.seed;
   if (args.num_envs > 0) settings.algorithm_config["num_envs"] = args.num_envs;
   settings.num_threads = args.threads;
@@ -186,14 +233,29 @@ trainer::ResumeChecks resume_checks(const TrainArguments& args) {
 }
 
 int run_train(const TrainArguments& args) {
+  if (args.list_configs) {
+    for (const trainer::AlgorithmFactory* algorithm : kAlgorithms) {
+      if (!args.algo_given || algorithm->name() == args.algo) print_recipes(*algorithm);
+    }
+    return 0;
+  }
   if (args.resume.empty() && args.id.empty()) {
     throw UsageError("train: give an env id, or --resume RUN_FOLDER");
   }
-  if (!args.resume.empty() && (!args.id.empty() || !args.sets.empty() || !args.wraps.empty() ||
-                               !args.config_file.empty() || !args.out.empty() || args.algo_given)) {
+  if (!args.resume.empty() &&
+      (!args.id.empty() || !args.sets.empty() || !args.wraps.empty() || !args.config_file.empty() ||
+       !args.algo_sets.empty() || !args.out.empty() || args.algo_given || args.print_config)) {
     throw UsageError(
         "train --resume takes the env and settings from the run's config.json: give no id, "
-        "--set, --wrap, --algo, --config or --out with it");
+        "--set, --wrap, --algo, --config, --set-algo, --print-config or --out with it");
+  }
+  if (args.print_config) {
+    parse_sets(args.id, args.sets);  // an unknown id or kwarg, as the run would refuse it
+    const trainer::AlgorithmFactory& algorithm = algorithm_named(args.algo);
+    trainer::RunSettings settings = new_run_settings(args, algorithm);
+    if (args.minutes > 0.0) settings.minutes = args.minutes;  // as the run records its budget
+    std::cout << trainer::settings_to_json(settings).dump(2) << "\n";
+    return 0;
   }
   const bool launcher = args.nproc > 1;
   if (launcher && std::getenv("WORLD_SIZE") != nullptr) {

@@ -43,6 +43,25 @@ TEST(ParamsTest, UnknownKeyListsValidKeysWithTypesAndDefaults) {
   }
 }
 
+// A typo of a key is answered with the key it is a typo of, before the list of all.
+TEST(ParamsTest, UnknownKeySuggestsTheClosestKey) {
+  try {
+    resolve_params(kSpecs, {{"widht", 64}}, "Test-v0");
+    FAIL();
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what())
+                  .find("Test-v0: unknown kwarg \"widht\"; did you mean width? valid kwargs: "),
+              std::string::npos)
+        << error.what();
+  }
+  try {
+    resolve_params(kSpecs, {{"colour", 1}}, "Test-v0");
+    FAIL();
+  } catch (const std::invalid_argument& error) {
+    EXPECT_EQ(std::string(error.what()).find("did you mean"), std::string::npos) << error.what();
+  }
+}
+
 TEST(ParamsTest, WrongTypeNamesExpectedAndGiven) {
   try {
     resolve_params(kSpecs, {{"width", "wide"}}, "Test-v0");

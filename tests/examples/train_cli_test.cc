@@ -772,6 +772,72 @@ TEST(TrainCliTest, DrqV2WritesARunThatEvalReadsAndResumesAsIfItHadNotStopped) {
   fs::remove_all(folder);
 }
 
+// --config takes a recipe's name, a file or inline JSON, and --set-algo one setting over it, each
+// refused as a config file is (did you mean, expected vs given); --print-config shows the result
+// and trains nothing; --list-configs shows the recipes.
+TEST(TrainCliTest, RecipesByNameInlineJsonAndSetAlgo) {
+  const fs::path folder = fresh_folder("recipes");
+  const std::string out = " --out " + (folder / "run").string();
+  const auto printed = [&](const std::string& arguments) {
+    const CliRun result =
+        run_cli("train CartPoleSwingup-v0 " + arguments + " --print-config" + out);
+    EXPECT_EQ(result.exit_code, 0) << arguments << ": " << result.output;
+    return json::parse(result.output, nullptr, false);
+  };
+  const json swingup = printed("--config swingup");
+  ASSERT_FALSE(swingup.is_discarded());
+  EXPECT_EQ(swingup.at("env_id"), "CartPoleSwingup-v0");
+  EXPECT_EQ(swingup.at("ppo").at("gamma"), 0.95);
+  EXPECT_EQ(swingup.at("ppo").at("num_envs"), 16);
+  const json set = printed(
+      "--config '{\"gamma\": 0.9, \"num_steps\": 32}' --set-algo num_steps=64 --set-algo "
+      "policy.cnn=fine --num-envs 4");
+  ASSERT_FALSE(set.is_discarded());
+  EXPECT_EQ(set.at("ppo").at("gamma"), 0.9);
+  EXPECT_EQ(set.at("ppo").at("num_steps"), 64);
+  EXPECT_EQ(set.at("ppo").at("policy").at("cnn"), "fine");
+  EXPECT_EQ(set.at("ppo").at("num_envs"), 4);  // the flag over the config
+  const json drqv2 = printed("--algo drqv2 --config cartpole --set-algo encoder=fine");
+  ASSERT_FALSE(drqv2.is_discarded());
+  EXPECT_EQ(drqv2.at("drqv2").at("total_env_steps"), 12500);
+  EXPECT_EQ(drqv2.at("drqv2").at("encoder"), "fine");
+  EXPECT_FALSE(fs::exists(folder / "run")) << "--print-config wrote the run";
+
+  const auto refused = [&](const std::string& arguments, const std::string& message) {
+    const CliRun result = run_cli("train CartPoleSwingup-v0 " + arguments + out);
+    EXPECT_EQ(result.exit_code, 2) << arguments << ": " << result.output;
+    EXPECT_NE(result.output.find(message), std::string::npos) << arguments << ": " << result.output;
+    EXPECT_NE(result.output.find("\nRun 'pixelgym train --help' for the options.\n"),
+              std::string::npos)
+        << result.output;
+  };
+  refused("--config swingupp", "ppo has no recipe named \"swingupp\"; did you mean swingup?");
+  refused("--config cartpole", "(drqv2 has one: add --algo drqv2)");
+  refused("--set-algo gama=0.9",
+          "--set-algo gama=0.9: PpoConfig JSON: unknown member \"gama\"; did you mean gamma?");
+  refused("--set-algo gamma=abc",
+          "--set-algo gamma=abc: PpoConfig JSON: member \"gamma\" has the wrong type: expected a "
+          "number, got string \"abc\"");
+  refused("--set-algo policy.cnn=big", "--set-algo policy.cnn=big: ");
+  refused("--config '{\"gama\": 0.9}'", "unknown member \"gama\"; did you mean gamma?");
+  refused("--set-algo gamma", "--set-algo expects KEY=VALUE (e.g. gamma=0.95), got \"gamma\"");
+  EXPECT_FALSE(fs::exists(folder / "run"));
+
+  const CliRun listed = run_cli("train --list-configs");
+  EXPECT_EQ(listed.exit_code, 0) << listed.output;
+  EXPECT_NE(listed.output.find("ppo (--algo ppo), " PIXELGYM_SOURCE_DIR
+                               "/examples/trainer/ppo/configs:\n"),
+            std::string::npos)
+      << listed.output;
+  EXPECT_NE(listed.output.find("\n  swingup          {\"gamma\":0.95,"), std::string::npos)
+      << listed.output;
+  EXPECT_NE(listed.output.find("drqv2 (--algo drqv2)"), std::string::npos) << listed.output;
+  EXPECT_NE(listed.output.find("\n  cartpole  {"), std::string::npos) << listed.output;
+  const CliRun ppo_only = run_cli("train --list-configs --algo ppo");
+  EXPECT_EQ(ppo_only.output.find("drqv2 (--algo drqv2)"), std::string::npos) << ppo_only.output;
+  fs::remove_all(folder);
+}
+
 // pixelgym does not link LibTorch: train and eval run in pixelgym-train, the program beside it,
 // which takes the process over once the command line parsed. Without it the other subcommands
 // work, a train usage error is still found, and train says which program is missing.

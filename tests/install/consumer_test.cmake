@@ -1,6 +1,7 @@
 # cmake -DBUILD_DIR=... -DCONSUMER_DIR=... -DWORK_DIR=... -P consumer_test.cmake
 # Installs BUILD_DIR into WORK_DIR/prefix, builds CONSUMER_DIR against it with find_package, runs
-# the consumer and the installed `pixelgym list`, and fails with the step's output when a step
+# the consumer, the installed `pixelgym list` and `pixelgym train --config NAME --print-config`
+# (the installed recipes, found by name), and fails with the step's output when a step
 # fails or prints something other than expected. PIXELGYM_ASSET_PATH is unset throughout: the
 # installed code must find its assets from where it was installed.
 set(prefix ${WORK_DIR}/prefix)
@@ -78,3 +79,26 @@ if(NOT step_output MATCHES "CartPoleSwingup-v0")
   message(FATAL_ERROR "the installed `pixelgym list` did not list CartPoleSwingup-v0:\n${step_output}")
 endif()
 message(STATUS "the installed pixelgym list: ${step_output}")
+
+# The trainer's recipes are installed, and the installed tool finds them by name from where it was
+# installed (its bin/'s share/pixelgym/configs), not from the source tree it was built from.
+foreach(recipe ppo/swingup.json ppo/action_repeat_8.json drqv2/cartpole.json)
+  if(NOT EXISTS ${prefix}/share/pixelgym/configs/${recipe})
+    message(FATAL_ERROR "cmake --install did not install the recipe configs/${recipe}")
+  endif()
+endforeach()
+file(REAL_PATH ${prefix} real_prefix)
+step("the installed pixelgym train --list-configs" ${prefix}/bin/pixelgym train --list-configs)
+string(FIND "${step_output}" "ppo (--algo ppo), ${real_prefix}/share/pixelgym/configs/ppo:\n"
+       listed)
+if(listed EQUAL -1)
+  message(FATAL_ERROR "the installed `pixelgym train --list-configs` did not list the installed "
+                      "recipes of ${real_prefix}/share/pixelgym/configs/ppo:\n${step_output}")
+endif()
+step("the installed pixelgym train --config swingup --print-config" ${prefix}/bin/pixelgym train
+     CartPoleSwingup-v0 --config swingup --print-config)
+if(NOT step_output MATCHES "\"gamma\": 0.95" OR NOT step_output MATCHES "\"num_steps\": 64")
+  message(FATAL_ERROR "the installed `pixelgym train --config swingup` did not take the "
+                      "swingup recipe's settings:\n${step_output}")
+endif()
+message(STATUS "the installed pixelgym train --config swingup: resolved")

@@ -21,9 +21,16 @@ def test_unknown_id_suggests_the_closest():
 
 
 def test_unknown_kwarg_is_a_value_error_listing_the_valid_ones():
-    with pytest.raises(ValueError, match=r'CartPoleSwingup-v0: unknown kwarg "widht"; valid kwargs: '
-                                         r".*width \(int, default 84\)"):
+    with pytest.raises(ValueError, match=r'CartPoleSwingup-v0: unknown kwarg "widht"; did you mean '
+                                         r"width\? valid kwargs: .*width \(int, default 84\)"):
         pixelgym.make("CartPoleSwingup-v0", widht=64)
+
+
+def test_a_mistyped_wrapper_suggests_the_closest_and_the_docs_words_work():
+    with pytest.raises(ValueError, match=r'unknown wrapper "grayscal"; did you mean grayscale\?'):
+        pixelgym.make("CartPoleSwingup-v0", wrap=["grayscal"])
+    grey = pixelgym.make("CartPoleSwingup-v0", obs_mode="pixels", wrap=["greyscale"])
+    assert grey.observation_space["pixels"].shape == (84, 84)
 
 
 def test_kwarg_of_the_wrong_type_is_a_type_error_with_the_registry_message():

@@ -190,6 +190,54 @@ TEST(WrapperSpecTest, UnknownWrapperListsTheKnownOnes) {
   EXPECT_NE(message.find("resize, grayscale"), std::string::npos) << message;
 }
 
+// A typo of a wrapper or of one of its parameters is answered with the name it is a typo of.
+TEST(WrapperSpecTest, UnknownNamesSuggestTheClosest) {
+  const std::string wrapper = error_of([] { parse_wrapper_spec("grayscal"); });
+  EXPECT_NE(wrapper.find("unknown wrapper \"grayscal\"; did you mean grayscale? the wrappers are: "
+                         "resize, grayscale"),
+            std::string::npos)
+      << wrapper;
+  const std::string blur = error_of([] { parse_wrapper_spec("blur=3"); });
+  EXPECT_EQ(blur.find("did you mean"), std::string::npos) << blur;
+  const std::string parameter = error_of([] { parse_wrapper_spec("grayscale=keep_dims=true"); });
+  EXPECT_NE(parameter.find("unknown parameter \"keep_dims\"; did you mean keep_dim? grayscale's "
+                           "parameters are: keep_dim, key"),
+            std::string::npos)
+      << parameter;
+}
+
+// The docs write "grey" and "channels first": those words name the wrappers too.
+TEST(WrapperSpecTest, TheDocsWordsAreAliasesOfTheWrappers) {
+  for (const char* alias : {"greyscale", "grey", "gray"}) {
+    EXPECT_EQ(parse_wrapper_spec(alias).name, "grayscale") << alias;
+  }
+  EXPECT_EQ(parse_wrapper_spec("greyscale=keep_dim").arguments, (Arguments{{"keep_dim", "true"}}));
+  EXPECT_EQ(parse_wrapper_spec("channels_first").name, "channel_first");
+  const std::unique_ptr<Env> grey = apply_wrappers(image_env(), {"greyscale=keep_dim"});
+  EXPECT_EQ(pixels_shape(*grey), (Shape{48, 40, 1}));
+  for (const WrapperSpecHelp& help : wrapper_spec_help()) {
+    if (help.name == "grayscale") {
+      EXPECT_EQ(help.aliases, (std::vector<std::string>{"greyscale", "grey", "gray"}));
+    }
+    for (const std::string& alias : help.aliases) {
+      EXPECT_EQ(parse_wrapper_spec(alias).name, help.name) << alias;
+    }
+  }
+}
+
+// "resize=64,48" reads 48 as the key; the message names the size's form, not a missing key.
+TEST(WrapperSpecTest, TwoNumbersForASizeNameTheSizesForm) {
+  for (const char* text : {"resize=64,48", "resize=size=64,48"}) {
+    const std::string message = error_of([&] { parse_wrapper_spec(text); });
+    EXPECT_NE(message.find("resize's size: expected HEIGHTxWIDTH (e.g. 64x64) or N for NxN, as "
+                           "resize=64x48 for 64 high and 48 wide; got \"64,48\""),
+              std::string::npos)
+        << message;
+  }
+  EXPECT_EQ(parse_wrapper_spec("resize=64,img").arguments,
+            (Arguments{{"size", "64"}, {"key", "img"}}));
+}
+
 TEST(WrapperSpecTest, SyntaxErrorsNameWhatIsWrong) {
   EXPECT_NE(error_of([] { parse_wrapper_spec("=64"); }).find("got no name"), std::string::npos);
   EXPECT_NE(error_of([] { parse_wrapper_spec("resize=64x64,,key=a"); }).find("an empty one"),

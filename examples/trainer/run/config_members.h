@@ -11,6 +11,8 @@
 #include <type_traits>
 #include <vector>
 
+#include "pixelgym/envs/suggestions.h"
+
 namespace pixelgym::trainer {
 
 /// Reads an integer member's value: an integer, or a number with no fraction (1e6) that `T`
@@ -54,8 +56,9 @@ T integer_member(const nlohmann::json& value, const char* name, const char* what
 }
 
 /// Reads member `name` of `json` into `field` when present (absent: `field` keeps its value).
-/// Throws std::invalid_argument "{what} JSON: member \"{name}\" has the wrong type: ..." when it
-/// does not convert; integers as integer_member reads them.
+/// Throws std::invalid_argument "{what} JSON: member \"{name}\" has the wrong type: expected
+/// {the field's JSON type}, got {the value's type} {the value}" when it does not convert (a number
+/// for a bool, "0.9" for a number); integers as integer_member reads them.
 template <typename T>
 void read_member(const nlohmann::json& json, const char* name, T& field, const char* what) {
   const auto found = json.find(name);
@@ -65,16 +68,19 @@ void read_member(const nlohmann::json& json, const char* name, T& field, const c
   } else {
     try {
       field = found->get<T>();
-    } catch (const nlohmann::json::exception& error) {
+    } catch (const nlohmann::json::exception&) {
+      const std::string wanted = nlohmann::json(field).type_name();
+      const bool vowel = wanted.find_first_of("aeiou") == 0;
       throw std::invalid_argument(std::string(what) + " JSON: member \"" + name +
-                                  "\" has the wrong type: " + error.what());
+                                  "\" has the wrong type: expected " + (vowel ? "an " : "a ") +
+                                  wanted + ", got " + found->type_name() + " " + found->dump());
     }
   }
 }
 
 /// Throws std::invalid_argument when `json` is not an object ("{what} JSON must be an object,
-/// got {type}") or has a member not in `known` ("{what} JSON: unknown member \"{key}\"; known:
-/// {the known names}").
+/// got {type}") or has a member not in `known` ("{what} JSON: unknown member \"{key}\"; did you
+/// mean {the closest}? known: {the known names}", "did you mean" only when one is close).
 inline void require_known_members(const nlohmann::json& json, const std::vector<std::string>& known,
                                   const char* what) {
   if (!json.is_object()) {
@@ -85,10 +91,10 @@ inline void require_known_members(const nlohmann::json& json, const std::vector<
     bool ok = false;
     for (const std::string& name : known) ok = ok || item.key() == name;
     if (!ok) {
-      std::string list;
-      for (const std::string& name : known) list += (list.empty() ? "" : ", ") + name;
+      const std::string suggestion = did_you_mean(item.key(), known);
       throw std::invalid_argument(std::string(what) + " JSON: unknown member \"" + item.key() +
-                                  "\"; known: " + list);
+                                  "\"; " + (suggestion.empty() ? "" : suggestion + " ") +
+                                  "known: " + join_names(known));
     }
   }
 }

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace pixelgym::trainer {
 namespace {
@@ -66,10 +67,47 @@ TEST(ConfigMembersTest, FractionsHugeAndNegativeUnsignedValuesAreRefusedByName) 
   EXPECT_EQ(refusal<std::int64_t>(R"("12")"),
             R"(Config JSON: member "n" has the wrong type: expected an integer, got string "12")");
   EXPECT_THAT(refusal<std::int64_t>("true"), HasSubstr("expected an integer, got boolean"));
-  // Other types keep JSON's conversion, and its message.
-  double real = 0;
-  EXPECT_THROW(read_member(json::parse(R"({"x": "a"})"), "x", real, "Config"),
-               std::invalid_argument);
+}
+
+// Other types convert as JSON does; a value of another type is refused naming both types and
+// the value (what a config file and `train --set-algo` both get).
+TEST(ConfigMembersTest, WrongTypesNameWhatWasExpectedAndWhatWasGiven) {
+  const auto refused = [](const std::string& text, auto field) {
+    try {
+      read_member(json::parse(R"({"x": )" + text + "}"), "x", field, "Config");
+    } catch (const std::invalid_argument& error) {
+      return std::string(error.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(refused(R"("0.9")", 0.5),
+            R"(Config JSON: member "x" has the wrong type: expected a number, got string "0.9")");
+  EXPECT_EQ(refused("1", true),
+            R"(Config JSON: member "x" has the wrong type: expected a boolean, got number 1)");
+  EXPECT_EQ(refused("[1]", std::string("mrq")),
+            R"(Config JSON: member "x" has the wrong type: expected a string, got array [1])");
+  EXPECT_EQ(refused("7", std::vector<int>{64}),
+            R"(Config JSON: member "x" has the wrong type: expected an array, got number 7)");
+  double real = 0.5;
+  read_member(json::parse(R"({"x": 2})"), "x", real, "Config");
+  EXPECT_EQ(real, 2.0);
+}
+
+// An unknown member is answered with the closest known ones, then all of them.
+TEST(ConfigMembersTest, UnknownMembersSuggestTheClosest) {
+  const auto refused = [](const std::string& text) {
+    try {
+      require_known_members(json::parse(text), {"gamma", "gae_lambda", "num_envs"}, "Config");
+    } catch (const std::invalid_argument& error) {
+      return std::string(error.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(refused(R"({"gama": 0.9})"), R"(Config JSON: unknown member "gama"; did you mean )"
+                                         "gamma? known: gamma, gae_lambda, num_envs");
+  EXPECT_EQ(refused(R"({"colour": 1})"),
+            R"(Config JSON: unknown member "colour"; known: gamma, gae_lambda, num_envs)");
+  EXPECT_EQ(refused(R"({"gamma": 0.9})"), "accepted");
 }
 
 }  // namespace
