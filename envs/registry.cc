@@ -12,6 +12,27 @@ namespace {
 
 constexpr const char* kMaxEpisodeStepsKey = "max_episode_steps";
 
+// Gymnasium's make takes render_mode; here every env renders off-screen into "rgb_array" frames,
+// its only mode. "rgb_array" is accepted (and dropped) unless the env declares a render_mode
+// kwarg of its own; any other mode ("human": a window) is refused naming the one offered.
+Params without_render_mode(const EnvSpec& spec, const Params& kwargs, const std::string& id) {
+  const auto found = kwargs.find("render_mode");
+  const bool declared = std::any_of(spec.params.begin(), spec.params.end(),
+                                    [](const ParamSpec& p) { return p.name == "render_mode"; });
+  if (found == kwargs.end() || declared) return kwargs;
+  if (found->second.type() != ParamType::kString || found->second.as_string() != "rgb_array") {
+    throw std::invalid_argument(
+        id +
+        ": render_mode must be \"rgb_array\", the only render mode (pixelgym renders "
+        "off-screen, headless: render() returns (H, W, 3) uint8 frames), got " +
+        found->second.to_string() +
+        "; to watch episodes, record a video (`pixelgym record`, wrappers::RecordVideo)");
+  }
+  Params rest = kwargs;
+  rest.erase("render_mode");
+  return rest;
+}
+
 }  // namespace
 
 void Registry::register_env(EnvSpec spec) {
@@ -68,7 +89,7 @@ Registry::Resolved Registry::resolve(const std::string& id, const Params& kwargs
   accepted.push_back({kMaxEpisodeStepsKey,
                       Param(out.spec->max_episode_steps ? *out.spec->max_episode_steps : 0),
                       "steps before TimeLimit truncates the episode; 0 for no limit"});
-  out.kwargs = resolve_params(accepted, kwargs, id);
+  out.kwargs = resolve_params(accepted, without_render_mode(*out.spec, kwargs, id), id);
   const std::int64_t max_episode_steps = out.kwargs.at(kMaxEpisodeStepsKey).as_int();
   if (max_episode_steps < 0) {
     throw std::invalid_argument(id +

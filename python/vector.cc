@@ -111,6 +111,18 @@ class VectorHandle {
     return step_tuple(*result);
   }
 
+  py::tuple render() {
+    std::vector<Array> frames;
+    {
+      py::gil_scoped_release release;
+      std::lock_guard<std::mutex> lock(mutex_);
+      frames = env_->render();
+    }
+    py::tuple out(frames.size());
+    for (std::size_t i = 0; i < frames.size(); ++i) out[i] = to_numpy(frames[i]);
+    return out;
+  }
+
   void close() {
     py::gil_scoped_release release;
     std::lock_guard<std::mutex> lock(mutex_);
@@ -203,6 +215,8 @@ void bind_vector(py::module_& module) {
       .def("step_async", &VectorHandle::step_async, py::arg("actions"),
            "Starts a step on the thread pool and returns.")
       .def("step_wait", &VectorHandle::step_wait, "The results of the step begun by step_async.")
+      .def("render", &VectorHandle::render,
+           "Each env's current frame, (H, W, 3) uint8, env 0 first: a tuple of num_envs arrays.")
       .def("close", &VectorHandle::close, "Closes every env; calling it again does nothing.")
       .def_property_readonly("num_envs", &VectorHandle::num_envs)
       .def_property_readonly("num_threads", &VectorHandle::num_threads,

@@ -43,12 +43,14 @@ void fill_rect(Array& image, int y0, int y1, int x0, int x1, Rgb color) {
 
 std::vector<ParamSpec> GridWorldConfig::params() {
   const GridWorldConfig defaults;
-  return {{"render_width", defaults.render_width, "width of render() frames in pixels"},
-          {"render_height", defaults.render_height, "height of render() frames in pixels"},
-          {"obs_mode", defaults.obs_mode,
-           "\"index\" (Discrete(16)) or \"pixels\" (Dict with an image)"},
-          {"width", defaults.width, "observation image width for obs_mode \"pixels\""},
-          {"height", defaults.height, "observation image height for obs_mode \"pixels\""}};
+  return {
+      {"render_width", defaults.render_width, "width of render() frames in pixels"},
+      {"render_height", defaults.render_height, "height of render() frames in pixels"},
+      {"obs_mode", defaults.obs_mode,
+       "\"index\" (Discrete(16)), \"pixels\" (Dict with an image) or \"rgb\" (the image Box "
+       "itself)"},
+      {"width", defaults.width, "observation image width for obs_mode \"pixels\" and \"rgb\""},
+      {"height", defaults.height, "observation image height for obs_mode \"pixels\" and \"rgb\""}};
 }
 
 GridWorldConfig GridWorldConfig::from_params(const Params& params) {
@@ -58,21 +60,31 @@ GridWorldConfig GridWorldConfig::from_params(const Params& params) {
   config.width = read_size(params, "width");
   config.height = read_size(params, "height");
   config.obs_mode = params.at("obs_mode").as_string();
-  if (config.obs_mode != "index" && config.obs_mode != "pixels") {
-    throw std::invalid_argument("GridWorld: obs_mode must be \"index\" or \"pixels\", got \"" +
-                                config.obs_mode + "\"");
+  if (config.obs_mode != "index" && config.obs_mode != "pixels" && config.obs_mode != "rgb") {
+    throw std::invalid_argument(
+        "GridWorld: obs_mode must be \"index\", \"pixels\" or \"rgb\", got \"" + config.obs_mode +
+        "\"");
   }
   return config;
 }
 
+namespace {
+
+SpacePtr grid_observation_space(const GridWorldConfig& config) {
+  if (config.obs_mode == "index") {
+    return std::make_shared<spaces::Discrete>(GridWorld::kSize * GridWorld::kSize);
+  }
+  const auto image = std::make_shared<spaces::Box>(
+      0.0, 255.0, Shape{config.height, config.width, 3}, DType::kUInt8);
+  if (config.obs_mode == "rgb") return image;
+  return std::make_shared<spaces::Dict>(spaces::Dict::Entries{{"pixels", image}});
+}
+
+}  // namespace
+
 GridWorld::GridWorld(GridWorldConfig config)
     : config_(config),
-      observation_space_(config.obs_mode == "pixels"
-                             ? SpacePtr(std::make_shared<spaces::Dict>(spaces::Dict::Entries{
-                                   {"pixels", std::make_shared<spaces::Box>(
-                                                  0.0, 255.0, Shape{config.height, config.width, 3},
-                                                  DType::kUInt8)}}))
-                             : SpacePtr(std::make_shared<spaces::Discrete>(kSize * kSize))),
+      observation_space_(grid_observation_space(config)),
       action_space_(std::make_shared<spaces::Discrete>(4)) {
   metadata_.render_fps = 4.0;
   metadata_.render_shape = Shape{config.render_height, config.render_width, 3};
@@ -117,6 +129,8 @@ void GridWorld::do_step(const Value& action, StepResult& out) {
 void GridWorld::observe(Value& obs) const {
   if (config_.obs_mode == "pixels") {
     draw(obs.dict().values()[0].array());
+  } else if (config_.obs_mode == "rgb") {
+    draw(obs.array());
   } else {
     *obs.array().data<std::int64_t>() = agent_.row * kSize + agent_.col;
   }

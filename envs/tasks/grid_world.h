@@ -15,9 +15,10 @@ struct GridWorldConfig {
   /// Size of `render()` frames in pixels, each in [16, 8192].
   int render_width = 256;
   int render_height = 256;
-  /// "index": Discrete(16), the agent's cell; "pixels": Dict{"pixels": (height, width, 3) uint8}.
+  /// "index": Discrete(16), the agent's cell; "pixels": Dict{"pixels": (height, width, 3) uint8};
+  /// "rgb": that image itself, a bare (height, width, 3) uint8 Box.
   std::string obs_mode = "index";
-  /// Observation image size for obs_mode "pixels", each in [16, 8192].
+  /// Observation image size for obs_mode "pixels" and "rgb", each in [16, 8192].
   int width = 84;
   int height = 84;
 
@@ -34,7 +35,8 @@ struct GridWorldConfig {
 /// - Actions: Discrete(4), in Gymnasium FrozenLake's order: 0 left, 1 down, 2 right, 3 up. A
 ///   move into the wall or off the grid leaves the agent where it is.
 /// - Observation: Discrete(16), the agent's cell as row * 4 + column; with obs_mode="pixels",
-///   Dict{"pixels": (height, width, 3) uint8}, the grid as render() draws it.
+///   Dict{"pixels": (height, width, 3) uint8}, the grid as render() draws it; with
+///   obs_mode="rgb", that image as a bare Box.
 /// - Reward: +1.0 on the step that reaches the goal, which terminates the episode; -0.04 on
 ///   every other step.
 /// - The registered spec truncates after 50 steps (TimeLimit).

@@ -56,7 +56,9 @@ std::vector<ParamSpec> TaskConfig::params() {
   return {{"width", d.width, "observation image width in pixels"},
           {"height", d.height, "observation image height in pixels"},
           {"camera", d.camera, "observation and render() camera (empty: the task's default)"},
-          {"obs_mode", d.obs_mode, "\"pixels+state\", \"pixels\" or \"state\""},
+          {"obs_mode", d.obs_mode,
+           "\"pixels+state\" (Dict), \"pixels\" (Dict of the image), \"rgb\" (the image Box "
+           "itself, for CnnPolicy) or \"state\""},
           {"render_width", d.render_width, "render() frame width in pixels"},
           {"render_height", d.render_height, "render() frame height in pixels"},
           {"action_repeat", d.action_repeat, "control steps per env step (rewards are summed)"},
@@ -80,10 +82,12 @@ TaskConfig TaskConfig::from_params(const Params& params, const std::vector<std::
     throw std::invalid_argument(env + ": unknown camera \"" + c.camera + "\"; cameras: " + names);
   }
   c.obs_mode = params.at("obs_mode").as_string();
-  if (c.obs_mode != "pixels+state" && c.obs_mode != "pixels" && c.obs_mode != "state") {
-    throw std::invalid_argument(
-        env + ": obs_mode must be \"pixels+state\", \"pixels\" or \"state\", got \"" + c.obs_mode +
-        "\"");
+  if (c.obs_mode != "pixels+state" && c.obs_mode != "pixels" && c.obs_mode != "rgb" &&
+      c.obs_mode != "state") {
+    throw std::invalid_argument(env +
+                                ": obs_mode must be \"pixels+state\", \"pixels\", \"rgb\" or "
+                                "\"state\", got \"" +
+                                c.obs_mode + "\"");
   }
   const std::int64_t repeat = params.at("action_repeat").as_int();
   if (repeat < 1 || repeat > 1000) {
@@ -103,12 +107,10 @@ TaskConfig TaskConfig::from_params(const Params& params, const std::vector<std::
 EnvDescription PixelEnv::describe(const Task& task, const TaskConfig& config) {
   EnvDescription description;
   description.cameras = task.camera_names();
+  const auto image = std::make_shared<spaces::Box>(
+      0.0, 255.0, Shape{config.height, config.width, 3}, DType::kUInt8);
   spaces::Dict::Entries entries;
-  if (config.has_pixels()) {
-    entries.emplace_back(
-        "pixels", std::make_shared<spaces::Box>(0.0, 255.0, Shape{config.height, config.width, 3},
-                                                DType::kUInt8));
-  }
+  if (config.has_pixels()) entries.emplace_back("pixels", image);
   if (config.has_state()) {
     const double inf = std::numeric_limits<double>::infinity();
     for (const StateSpec& spec : task.state_specs()) {
@@ -116,7 +118,8 @@ EnvDescription PixelEnv::describe(const Task& task, const TaskConfig& config) {
                            std::make_shared<spaces::Box>(-inf, inf, spec.shape, DType::kFloat32));
     }
   }
-  description.observation_space = std::make_shared<spaces::Dict>(std::move(entries));
+  description.observation_space =
+      config.image_only() ? SpacePtr(image) : std::make_shared<spaces::Dict>(std::move(entries));
   description.action_space = task.action_space();
   // The episode ends after the task's control steps, counted in env steps of action_repeat.
   description.max_episode_steps =
@@ -229,6 +232,10 @@ void PixelEnv::diverged(const std::string& what) const {
 }
 
 void PixelEnv::observe(Value& obs) {
+  if (config_.image_only()) {
+    render_camera_into(camera_, config_.msaa, obs.array());
+    return;
+  }
   // Entries in observation_space() order: "pixels" first when present, then the state arrays.
   std::vector<Value>& slots = obs.dict().values();
   std::size_t next = 0;

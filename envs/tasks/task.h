@@ -25,8 +25,10 @@ struct TaskConfig {
   int height = 84;
   /// One of the task's camera names; empty for its default (the first).
   std::string camera;
-  /// "pixels+state": Dict of "pixels" and the state arrays; "pixels": only "pixels";
-  /// "state": only the state arrays (no rendering at all).
+  /// "pixels+state": Dict of "pixels" and the state arrays; "pixels": Dict of "pixels" alone;
+  /// "rgb": the (height, width, 3) uint8 image itself, a bare Box (ALE's obs_type="rgb", what
+  /// SB3's CnnPolicy and Gymnasium's image wrappers take); "state": only the state arrays (no
+  /// rendering at all).
   std::string obs_mode = "pixels+state";
   /// Size of `render()` frames (anti-aliased), separate from the observation.
   int render_width = 256;
@@ -42,10 +44,12 @@ struct TaskConfig {
   /// whose observations stay as they were (render() frames always use 4).
   int msaa = 0;
 
-  /// Whether observations hold "pixels" (obs_mode is not "state").
+  /// Whether observations hold the image (obs_mode is not "state").
   bool has_pixels() const { return obs_mode != "state"; }
-  /// Whether observations hold the state arrays (obs_mode is not "pixels").
-  bool has_state() const { return obs_mode != "pixels"; }
+  /// Whether observations hold the state arrays (obs_mode is "pixels+state" or "state").
+  bool has_state() const { return obs_mode == "pixels+state" || obs_mode == "state"; }
+  /// Whether the observation is the image itself, a bare Box (obs_mode "rgb").
+  bool image_only() const { return obs_mode == "rgb"; }
 
   /// The keys above with their defaults and docs.
   static std::vector<ParamSpec> params();

@@ -90,6 +90,14 @@ const Env& BatchRunner::env(int i) const {
   return *envs_[static_cast<std::size_t>(i)];
 }
 
+std::vector<Array> BatchRunner::render() {
+  require_usable("render()");
+  std::vector<Array> frames;
+  frames.reserve(envs_.size());
+  for (const std::unique_ptr<Env>& env : envs_) frames.push_back(env->render());
+  return frames;
+}
+
 const Space& BatchRunner::single_observation_space() const { return envs_[0]->observation_space(); }
 const Space& BatchRunner::single_action_space() const { return envs_[0]->action_space(); }
 

@@ -67,6 +67,8 @@ class BatchRunner : public VectorEnv {
   /// binds its GL context there only for the length of each call (render::Context). Throws
   /// std::out_of_range.
   const Env& env(int i) const override;
+  /// Each env's render() on the calling thread (as env(i) is inspected: see above).
+  std::vector<Array> render() override;
 
  protected:
   /// Throws std::invalid_argument naming `type_name` unless num_envs >= 1.

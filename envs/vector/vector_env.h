@@ -134,6 +134,11 @@ class VectorEnv {
   virtual std::string name() const = 0;
   /// Env `i`, for inspection between calls (see BatchRunner::env). Throws std::out_of_range.
   virtual const Env& env(int i) const = 0;
+  /// Every env's current render() frame, env 0 first: (H, W, 3) uint8 arrays, new memory
+  /// (Gymnasium's VectorEnv.render() with render_mode "rgb_array"). Between calls only. Throws
+  /// ResetNeeded after close() or while a step_async() is pending, and what an env's render()
+  /// throws (ResetNeeded before its first reset).
+  virtual std::vector<Array> render() = 0;
 
   /// The VectorEnv beneath every wrapper (this one when it is not a wrapper).
   virtual VectorEnv& unwrapped() { return *this; }

@@ -59,6 +59,8 @@ class VectorWrapper : public VectorEnv {
   std::string name() const override;
   /// Env `i` of the VectorEnv underneath. Throws std::out_of_range.
   const Env& env(int i) const override { return env_->env(i); }
+  /// The inner env's frames (a wrapper changes observations, not what the envs render).
+  std::vector<Array> render() override { return env_->render(); }
 
   /// The VectorEnv beneath every wrapper.
   VectorEnv& unwrapped() override { return env_->unwrapped(); }

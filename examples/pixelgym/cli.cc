@@ -94,7 +94,8 @@ void add_id_argument(CLI::App& command, std::string& id, const std::string& exam
 void add_set_option(CLI::App& command, std::vector<std::string>& sets) {
   command
       .add_option("--set", sets,
-                  "Env kwarg as key=value (repeatable); `pixelgym info ID` lists the keys")
+                  "Env kwarg as key=value (repeatable), e.g. obs_mode=rgb for the image Box "
+                  "alone as the observation; `pixelgym info ID` lists the keys")
       ->type_name("KEY=VALUE");
 }
 

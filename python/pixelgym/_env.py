@@ -62,7 +62,10 @@ class Env(CoreBacked, _Base):
     def __init__(self, id, render_mode="rgb_array", wrap=(), **kwargs):
         if render_mode not in _RENDER_MODES:
             raise ValueError(
-                f"{id}: render_mode must be one of {list(_RENDER_MODES)}, got {render_mode!r}"
+                f"{id}: render_mode must be 'rgb_array' (the default) or None, got "
+                f"{render_mode!r}: pixelgym renders off-screen (headless, no window) and render() "
+                "returns (H, W, 3) uint8 frames; to watch episodes, record a video "
+                "(gymnasium.wrappers.RecordVideo, `pixelgym record`)"
             )
         wrap = wrap_list(wrap)
         self._core = _core.Env(id, kwargs, wrap)

@@ -89,7 +89,9 @@ class VectorEnv(CoreBacked, _Base):
                  **kwargs):
         if render_mode not in (None, "rgb_array"):
             raise ValueError(
-                f"{id}: render_mode must be None or 'rgb_array', got {render_mode!r}"
+                f"{id}: render_mode must be 'rgb_array' (the default) or None, got "
+                f"{render_mode!r}: pixelgym renders off-screen (headless, no window) and render() "
+                "returns each env's (H, W, 3) uint8 frame"
             )
         wrap = wrap_list(wrap)
         num_envs = _count("num_envs", num_envs, 1)
@@ -182,6 +184,20 @@ class VectorEnv(CoreBacked, _Base):
                 final[i] = _row(batch, i)
             infos["final_obs"] = final
         return (_copy_obs(obs) if self.copy else obs), rewards, terminations, truncations, infos
+
+    def render(self):
+        """Each env's current frame, env 0 first: a tuple of num_envs (H, W, 3) uint8 arrays, as
+        Gymnasium's SyncVectorEnv.render() gives with render_mode "rgb_array" (None, with a
+        warning, when made with render_mode=None). Raises ResetNeeded before the first reset,
+        after close() and while a step_async() is pending."""
+        if self.render_mode is None:
+            if gymnasium is not None:
+                gymnasium.logger.warn(
+                    f"{self._core.name}: render() was called with render_mode=None; make the "
+                    'vector env with render_mode="rgb_array" for frames'
+                )
+            return None
+        return self._core.render()
 
     def close(self, **kwargs):
         # Also called by __del__ on an object whose __init__ raised (no _core then).

@@ -8,12 +8,17 @@ gymnasium).
     venv = VecMonitor(make_sb3_vec("CartPoleBalance-v0", num_envs=8, num_threads=2))
     PPO("MultiInputPolicy", venv).learn(10_000)
 
+    # The image alone, a uint8 (84, 84, 3) Box, for SB3's CnnPolicy:
+    venv = VecMonitor(make_sb3_vec("CartPoleBalance-v0", num_envs=8, obs_mode="rgb"))
+    PPO("CnnPolicy", venv).learn(10_000)
+
 SB3 does not take a gymnasium.vector.VectorEnv; its own VecEnv protocol resets an ended env in
 the same step and hands the episode's last observation over in ``infos[i]["terminal_observation"]``.
 ``SB3VecEnv`` speaks that protocol over a pixelgym VectorEnv made with
 ``autoreset_mode="SameStep"``, stepping all envs in C++ (``step_async`` starts the thread pool
 and returns). Observations are copied out of the vector env's buffers (SB3 keeps the last
-observation across a step, as its DummyVecEnv does).
+observation across a step, as its DummyVecEnv does). ``render()`` tiles the envs' frames
+(``get_images``) as SB3's VecEnvs do, so ``VecVideoRecorder`` records it.
 """
 
 import numpy as np
@@ -48,6 +53,9 @@ class SB3VecEnv(_VecEnv):
         self.venv = venv
         self._pending = None
         super().__init__(venv.num_envs, venv.single_observation_space, venv.single_action_space)
+        # SB3's VecEnv sets metadata to its render modes alone; VecVideoRecorder plays frames at
+        # metadata["render_fps"] (30 when absent): the envs' own rate.
+        self.metadata["render_fps"] = venv.metadata["render_fps"]
 
     def reset(self):
         seeds = self._seeds
@@ -112,19 +120,43 @@ class SB3VecEnv(_VecEnv):
         self.venv.close()
 
     def get_attr(self, attr_name, indices=None):
+        """The vector env's attribute (render_mode, metadata, ...) once per env: the C++ envs
+        share their settings."""
         return [getattr(self.venv, attr_name)] * len(self._indices(indices))
 
     def set_attr(self, attr_name, value, indices=None):
-        raise AttributeError(f"SB3VecEnv: the C++ envs have no settable attribute {attr_name!r}")
+        raise AttributeError(
+            f"SB3VecEnv: the C++ envs have no Python attributes to set; got {attr_name!r}")
 
     def env_method(self, method_name, *method_args, indices=None, **method_kwargs):
-        raise AttributeError(f"SB3VecEnv: the C++ envs have no Python method {method_name!r}")
+        """Calls a method on each env of ``indices`` and returns the results, as SB3's
+        DummyVecEnv does. The C++ envs offer ``render`` (each env's (H, W, 3) uint8 frame) and
+        ``get_wrapper_attr(name)`` (as get_attr); stepping or resetting one env of the batch
+        alone is not possible."""
+        indices = self._indices(indices)
+        if method_name == "render" and not method_args and not method_kwargs:
+            frames = self._frames()
+            return [frames[i] for i in indices]
+        if method_name == "get_wrapper_attr":
+            return self.get_attr(*method_args, indices=indices, **method_kwargs)
+        raise AttributeError(
+            f"SB3VecEnv: env_method({method_name!r}): the C++ envs offer 'render' and "
+            "'get_wrapper_attr' (step and reset go through the VecEnv as a whole)")
 
     def env_is_wrapped(self, wrapper_class, indices=None):
         return [False] * len(self._indices(indices))
 
     def get_images(self):
-        raise NotImplementedError("SB3VecEnv: the C++ vector env does not render")
+        """Each env's current frame, (H, W, 3) uint8; SB3's VecEnv.render() tiles them into one
+        image (render_mode "rgb_array")."""
+        return list(self._frames())
+
+    def _frames(self):
+        if self.venv.render_mode != "rgb_array":
+            raise ValueError(
+                f"SB3VecEnv: the envs render with render_mode='rgb_array', got "
+                f"{self.venv.render_mode!r}")
+        return self.venv.render()
 
     def _indices(self, indices):
         if indices is None:

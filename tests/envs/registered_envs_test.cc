@@ -8,6 +8,8 @@
 
 #include "pixelgym/envs/checker.h"
 #include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/spaces/dict.h"
 #include "pixelgym/envs/tasks/pixel_env.h"
 #include "tests/envs/env_ids.h"
 #include "tests/golden.h"
@@ -125,6 +127,38 @@ TEST_P(RegisteredEnvTest, StateModeNeedsNoRendering) {
   EXPECT_EQ(pixel_env.frames_rendered(), 0);
   env->render();
   EXPECT_EQ(pixel_env.frames_rendered(), 1);
+}
+
+// Every env with an obs_mode offers "rgb": the observation is the image itself, a uint8 (H, W, 3)
+// Box (what SB3's CnnPolicy and Gymnasium's image wrappers take), the same pixels, byte for byte,
+// as obs_mode "pixels" puts under its one key; and the env passes check_env that way.
+TEST_P(RegisteredEnvTest, RgbModeObservesTheImageBoxItself) {
+  const auto spec = default_registry().spec(GetParam());
+  const bool has_obs_mode = std::any_of(spec->params.begin(), spec->params.end(),
+                                        [](const ParamSpec& p) { return p.name == "obs_mode"; });
+  if (!has_obs_mode) GTEST_SKIP() << GetParam() << " has no obs_mode";
+  std::unique_ptr<Env> rgb = make(GetParam(), {{"obs_mode", "rgb"}, {"width", 64}});
+  std::unique_ptr<Env> pixels = make(GetParam(), {{"obs_mode", "pixels"}, {"width", 64}});
+  const auto* box = dynamic_cast<const spaces::Box*>(&rgb->observation_space());
+  ASSERT_NE(box, nullptr) << rgb->observation_space().to_string();
+  EXPECT_EQ(*box->dtype(), DType::kUInt8);
+  EXPECT_EQ(*box->shape(), (Shape{84, 64, 3}));
+  const auto& dict = dynamic_cast<const spaces::Dict&>(pixels->observation_space());
+  EXPECT_TRUE(box->equals(dict.at("pixels"))) << rgb->observation_space().to_string();
+  Rng actions(2);
+  ASSERT_TRUE(rgb->reset(7).obs.array().equals(pixels->reset(7).obs.dict().at("pixels").array()));
+  for (int t = 0; t < 20; ++t) {
+    const Value action = rgb->action_space().sample(actions);
+    const StepResult a = rgb->step(action);
+    const StepResult b = pixels->step(action);
+    ASSERT_TRUE(a.obs.array().equals(b.obs.dict().at("pixels").array())) << "step " << t;
+    ASSERT_EQ(a.reward, b.reward);
+    if (a.terminated || a.truncated) break;
+  }
+  const CheckReport report = check_env(*rgb, {/*seed=*/0, /*num_steps=*/20});
+  for (const CheckResult& result : report.failures()) {
+    ADD_FAILURE() << GetParam() << " obs_mode=rgb: " << result.name << ": " << result.reason;
+  }
 }
 
 // The 84 x 84 observation after reset(seed=0), against tests/golden/env_<id>.png under the

@@ -84,6 +84,28 @@ TEST(RegistryTest, UnknownKwargListsValidOnesWithTypesAndDefaults) {
   EXPECT_THAT(message, HasSubstr("max_episode_steps (int, default 0)"));
 }
 
+// Gymnasium's render_mode: "rgb_array", the one mode, is accepted and changes nothing; any other
+// ("human": a window) is refused naming the mode offered, by make and describe alike.
+TEST(RegistryTest, RenderModeOtherThanRgbArrayIsRefusedNamingIt) {
+  Registry registry;
+  registry.register_env(probe_spec("Probe-v0"));
+  EXPECT_TRUE(registry.make("Probe-v0", {{"render_mode", "rgb_array"}})
+                  ->spec()
+                  ->kwargs.count("render_mode") == 0);
+  for (const Param& mode : {Param("human"), Param(1)}) {
+    const std::string message = error_of([&] {
+      registry.make("Probe-v0", {{"render_mode", mode}});
+    });
+    EXPECT_THAT(message, HasSubstr("Probe-v0: render_mode must be \"rgb_array\", the only render "
+                                   "mode (pixelgym renders off-screen, headless"));
+    EXPECT_THAT(message, HasSubstr("got " + mode.to_string()));
+    EXPECT_THAT(error_of([&] {
+                  registry.describe("Probe-v0", {{"render_mode", mode}});
+                }),
+                HasSubstr("render_mode must be \"rgb_array\""));
+  }
+}
+
 TEST(RegistryTest, WrongKwargTypeIsRejected) {
   Registry registry;
   registry.register_env(probe_spec("Probe-v0"));

@@ -179,7 +179,8 @@ TEST(PixelgymCliTest, InfoConfigColumnsLineUpWithoutColliding) {
     EXPECT_EQ(rows, static_cast<int>(default_registry().spec(id)->params.size()) + 1) << id;
   }
   EXPECT_THAT(run("info CartPoleSwingup-v0").output,
-              HasSubstr("\"pixels+state\"  \"pixels+state\", \"pixels\" or \"state\""));
+              HasSubstr("\"pixels+state\"  \"pixels+state\" (Dict), \"pixels\" (Dict of the "
+                        "image), \"rgb\" (the image Box itself, for CnnPolicy) or \"state\""));
 }
 
 // --- check ---

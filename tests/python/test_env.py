@@ -1,7 +1,7 @@
 """One env from Python: seeding, byte-identical determinism, time limits, rendering, copies."""
 
 import copy
-import importlib
+import importlib.util
 import os
 import pickle
 import subprocess
@@ -143,3 +143,65 @@ def test_without_gymnasium_one_warning_says_how_to_get_it():
     assert out.stdout.strip() == "False ['Env', 'CoreBacked', 'NumpyRandom', 'object']"
     assert out.stderr.count("GymnasiumMissingWarning") == 1
     assert "pip install gymnasium" in out.stderr
+
+
+def test_obs_mode_rgb_is_the_image_box_that_obs_mode_pixels_holds_under_its_key():
+    rgb = pixelgym.make("CartPoleSwingup-v1", obs_mode="rgb", width=64)
+    pixels = pixelgym.make("CartPoleSwingup-v1", obs_mode="pixels", width=64)
+    space = rgb.observation_space
+    assert space.shape == (84, 64, 3) and space.dtype == np.uint8
+    assert not isinstance(space, dict) and not hasattr(space, "spaces")
+    assert space == pixels.observation_space["pixels"]
+    a, b = rollout(rgb, 3, 12), rollout(pixels, 3, 12)
+    assert len(a) == len(b)
+    for x, y in zip(a, b):
+        x, y = (x[0], y[0]) if isinstance(x, tuple) else (x, y)
+        assert isinstance(x, np.ndarray) and same(x, y["pixels"])
+    assert trajectories_equal(a, rollout(pixelgym.make("CartPoleSwingup-v1", obs_mode="rgb",
+                                                       width=64), 3, 12))
+
+
+def test_pixelgym_wrappers_take_the_rgb_image_box():
+    env = pixelgym.make("CartPoleSwingup-v1", obs_mode="rgb",
+                        wrap=["resize=48x40", "grayscale", "frame_stack=3"])
+    assert env.observation_space.shape == (3, 48, 40)
+    obs, _ = env.reset(seed=0)
+    assert obs.shape == (3, 48, 40) and obs.dtype == np.uint8 and obs in env.observation_space
+
+
+def test_gymnasiums_own_image_wrappers_take_the_rgb_image_box():
+    gymnasium = pytest.importorskip("gymnasium")
+    from gymnasium.error import DependencyNotInstalled
+    from gymnasium.wrappers import FrameStackObservation, GrayscaleObservation, ResizeObservation
+
+    rgb = pixelgym.make("CartPoleSwingup-v1", obs_mode="rgb")
+    # ResizeObservation asserts that the observation is a uint8 [0, 255] image Box, then needs
+    # OpenCV's Python module (cv2): the Dict of obs_mode "pixels" fails its assertions.
+    with pytest.raises(AssertionError):
+        ResizeObservation(pixelgym.make("CartPoleSwingup-v1", obs_mode="pixels"), (64, 48))
+    if importlib.util.find_spec("cv2") is None:
+        with pytest.raises(DependencyNotInstalled, match="cv2"):
+            ResizeObservation(rgb, (64, 48))
+        env = rgb
+        shape = (84, 84)
+    else:
+        env = ResizeObservation(rgb, (64, 48))
+        shape = (64, 48)
+        assert env.observation_space.shape == (64, 48, 3)
+        obs, _ = env.reset(seed=0)
+        assert obs.shape == (64, 48, 3) and obs.dtype == np.uint8 and obs in env.observation_space
+    env = FrameStackObservation(GrayscaleObservation(env), 4)
+    env.reset(seed=0)
+    obs, *_ = env.step(env.action_space.sample())
+    assert obs.shape == (4, *shape) and obs in env.observation_space
+    from gymnasium.utils.env_checker import check_env
+
+    check_env(gymnasium.make("pixelgym/CartPoleSwingup-v1", obs_mode="rgb").unwrapped,
+              skip_render_check=True)
+
+
+def test_render_mode_human_is_refused_naming_the_modes_offered():
+    for make in (pixelgym.make, lambda *a, **k: pixelgym.make_vec(*a, 2, **k)):
+        with pytest.raises(ValueError, match=r"render_mode must be 'rgb_array' \(the default\) "
+                                             r"or None, got 'human': pixelgym renders off-screen"):
+            make("CartPoleSwingup-v1", render_mode="human")

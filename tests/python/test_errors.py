@@ -47,7 +47,7 @@ def test_kwarg_of_the_wrong_type_is_a_type_error_with_the_registry_message():
 
 def test_a_bad_kwarg_value_is_a_value_error():
     with pytest.raises(ValueError, match='obs_mode'):
-        pixelgym.make("GridWorld-v0", obs_mode="rgb")
+        pixelgym.make("GridWorld-v0", obs_mode="rgba")
     with pytest.raises(ValueError, match="max_episode_steps"):
         pixelgym.make("GridWorld-v0", max_episode_steps=-1)
     with pytest.raises(ValueError, match="render_mode"):

@@ -150,3 +150,34 @@ def test_copies_make_a_new_vector_env():
     for made in (copy.deepcopy(envs), pickle.loads(pickle.dumps(envs))):
         assert made.num_envs == 2 and made.autoreset_mode == "SameStep"
         assert list(made.reset(seed=0)[0]) == [0, 0]
+
+
+def test_obs_mode_rgb_batches_the_image_box():
+    envs = pixelgym.make_vec("CartPoleSwingup-v1", 3, num_threads=2, obs_mode="rgb",
+                             wrap=["resize=64x64"])
+    assert envs.single_observation_space.shape == (64, 64, 3)
+    assert envs.observation_space.shape == (3, 64, 64, 3)
+    obs, _ = envs.reset(seed=4)
+    assert isinstance(obs, np.ndarray) and obs.shape == (3, 64, 64, 3) and obs.dtype == np.uint8
+    one = pixelgym.make("CartPoleSwingup-v1", obs_mode="rgb", wrap=["resize=64x64"])
+    assert same(obs[2], one.reset(seed=6)[0])
+    obs, *_ = envs.step(envs.action_space.sample())
+    assert obs.shape == (3, 64, 64, 3) and obs in envs.observation_space
+
+
+def test_render_gives_each_envs_frame():
+    envs = pixelgym.make_vec("CartPoleSwingup-v1", 3, num_threads=2, render_width=32,
+                             render_height=24)
+    with pytest.raises(pixelgym.ResetNeeded):
+        envs.render()
+    envs.reset(seed=7)
+    frames = envs.render()
+    assert isinstance(frames, tuple) and len(frames) == 3
+    for i, frame in enumerate(frames):
+        one = pixelgym.make("CartPoleSwingup-v1", render_width=32, render_height=24)
+        one.reset(seed=7 + i)
+        assert same(frame, one.render()), f"env {i}"
+    assert pixelgym.make_vec("GridWorld-v0", 2, render_mode=None).render() is None
+    envs.close()
+    with pytest.raises(pixelgym.ResetNeeded):
+        envs.render()

@@ -3,6 +3,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "pixelgym/envs/checker.h"
 #include "pixelgym/envs/registry.h"
@@ -10,6 +11,7 @@
 #include "pixelgym/wrappers/channel_first_observation.h"
 #include "pixelgym/wrappers/grayscale_observation.h"
 #include "pixelgym/wrappers/resize_observation.h"
+#include "pixelgym/wrappers/wrapper_spec.h"
 
 namespace pixelgym::wrappers {
 namespace {
@@ -52,6 +54,26 @@ TEST(ImageWrappersEnvTest, AStackOfAllThree) {
             "ChannelFirstObservation<GrayscaleObservation<ResizeObservation<TimeLimit<"
             "CartPoleSwingup-v0>>>>");
   expect_check_env_passes(stack);
+}
+
+// On obs_mode "rgb" (a bare image Box) the wrapper specs give, byte for byte, what they give on
+// the "pixels" key of obs_mode "pixels", and the wrapped env passes check_env.
+TEST(ImageWrappersEnvTest, TheSameStackOnTheImageBoxAndOnThePixelsKey) {
+  const std::vector<std::string> specs = {"resize=64x48", "grayscale", "frame_stack=3"};
+  auto box = apply_wrappers(make("CartPoleSwingup-v1", {{"obs_mode", "rgb"}}), specs);
+  auto dict = apply_wrappers(make("CartPoleSwingup-v1", {{"obs_mode", "pixels"}}), specs);
+  EXPECT_TRUE(box->observation_space().equals(
+      dynamic_cast<const spaces::Dict&>(dict->observation_space()).at("pixels")));
+  EXPECT_EQ(box->observation_space().shape().value(), (Shape{3, 64, 48}));
+  Rng actions(3);
+  ASSERT_TRUE(box->reset(5).obs.array().equals(dict->reset(5).obs.dict().at("pixels").array()));
+  for (int t = 0; t < 10; ++t) {
+    const Value action = box->action_space().sample(actions);
+    ASSERT_TRUE(
+        box->step(action).obs.array().equals(dict->step(action).obs.dict().at("pixels").array()))
+        << "step " << t;
+  }
+  expect_check_env_passes(*box);
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 
 #include "examples/trainer/run/atomic_file.h"
 #include "examples/trainer/run/evaluation.h"
+#include "examples/trainer/run/observation_summary.h"
 
 namespace pixelgym::trainer {
 namespace {
@@ -428,6 +429,10 @@ std::optional<json> TrainingRun::train() {
       if (!folder_existed) fs::remove(folder_, ignored);  // only when empty
     }
     throw;
+  }
+  if (lead()) {
+    output_.out << "observation: " << observation_summary(env_->single_observation_space())
+                << std::endl;
   }
   if (checkpoint_) {
     restore_from_checkpoint();

@@ -130,7 +130,14 @@ TEST(GridWorldTest, PixelObservationsShowTheAgentMoving) {
   const Value moved = env->step(move(GridWorld::kRight)).obs;
   EXPECT_EQ(cell_colour(moved.dict().at("pixels").array(), 0, 1),
             (std::array<int, 3>{31, 100, 200}));
-  EXPECT_THROW(make("GridWorld-v0", {{"obs_mode", "rgb"}}), std::invalid_argument);
+  EXPECT_THROW(make("GridWorld-v0", {{"obs_mode", "rgba"}}), std::invalid_argument);
+  // obs_mode "rgb": the same image as a bare Box.
+  std::unique_ptr<Env> rgb = make("GridWorld-v0", {{"obs_mode", "rgb"}});
+  const Value image = rgb->reset(0).obs;
+  ASSERT_TRUE(image.is_array());
+  EXPECT_TRUE(image.array().equals(frame));
+  EXPECT_TRUE(
+      rgb->step(move(GridWorld::kRight)).obs.array().equals(moved.dict().at("pixels").array()));
 }
 
 TEST(GridWorldTest, ConfigIsValidated) {

@@ -14,6 +14,7 @@
 #include "pixelgym/envs/described_env.h"
 #include "pixelgym/envs/registry.h"
 #include "pixelgym/envs/tasks/pixel_env.h"
+#include "pixelgym/envs/vector/async_vector_env.h"
 #include "pixelgym/envs/vector/memory_check.h"
 #include "pixelgym/render/mesa_copy.h"
 #include "pixelgym/wrappers/wrapper_spec.h"
@@ -150,6 +151,33 @@ TEST(MakeVecMemoryTest, CheckMemoryNamesTheCountTheEstimateAndWhatIsAvailable) {
   ASSERT_TRUE(here.has_value());
   EXPECT_GT(here->bytes, 0U);
   EXPECT_FALSE(here->source.empty());
+}
+
+// render() gives every env's own frame, env 0 first, as each env's render() would (Gymnasium's
+// VectorEnv.render), through a vector wrapper too, and is refused while a step is pending and
+// after close().
+TEST(VectorRenderTest, RenderGivesEachEnvsFrame) {
+  const Params kwargs = {{"render_width", 32}, {"render_height", 24}};
+  VectorOptions options;
+  options.mode = VectorMode::kAsync;
+  options.num_threads = 2;
+  std::unique_ptr<VectorEnv> env = make_vec("CartPoleSwingup-v1", 3, kwargs, nullptr, options);
+  EXPECT_THROW(env->render(), ResetNeeded);
+  env->reset(11);
+  const std::vector<Array> frames = env->render();
+  ASSERT_EQ(frames.size(), 3U);
+  for (int i = 0; i < 3; ++i) {
+    std::unique_ptr<Env> one = make("CartPoleSwingup-v1", kwargs);
+    one->reset(11 + i);
+    EXPECT_EQ(frames[i].shape(), (Shape{24, 32, 3}));
+    EXPECT_TRUE(frames[i].equals(one->render())) << "env " << i;
+  }
+  auto& async = dynamic_cast<AsyncVectorEnv&>(*env);
+  async.step_async(env->action_space().zeros());
+  EXPECT_THROW(env->render(), ResetNeeded);
+  async.step_wait();
+  env->close();
+  EXPECT_THROW(env->render(), ResetNeeded);
 }
 
 }  // namespace
