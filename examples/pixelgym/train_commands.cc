@@ -168,9 +168,15 @@ void declare_eval(CLI::App& eval, EvalArguments& args) {
       "clipped_action_fraction= (the share of action elements the policy put outside the "
       "bounds: near 1 is bang-bang control)");
   eval.add_option("run", args.run, "Run folder or checkpoint file (.pgck)")->required();
-  add_checked_option(eval, "--episodes", args.episodes, "Episodes, seeded seed, seed + 1, ...",
-                     CLI::Range(std::int64_t{1}, std::int64_t{1} << 20));
-  add_seed_option(eval, args.seed, "Seed of the first episode");
+  eval.add_option("--episodes", args.episodes,
+                  "Episodes, seeded seed, seed + 1, ... (default: as the run's final evaluation, "
+                  "summary.json's: --eval-episodes)")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 20));
+  add_seed_option(eval, args.seed,
+                  "Seed of the first episode (default: as the run's final evaluation, "
+                  "summary.json's: the run's --seed + 1000000, so that the returns agree with "
+                  "it)")
+      ->each([&args](const std::string&) { args.seed_given = true; });
   eval.add_option("--video", args.video, "Record the first episode to this .mp4");
   eval.add_flag("--stochastic", args.stochastic,
                 "Sample actions from the policy instead of taking its mean / most likely one");
@@ -182,6 +188,7 @@ struct CompareArguments {
   std::vector<std::string> runs;
   std::string out;
   std::string curve = "eval";
+  bool curve_given = false;
   std::string title;
   int width = 1100;
   int height = 500;
@@ -197,7 +204,31 @@ double action_repeat_of(const nlohmann::json& config) {
   return repeat;
 }
 
-int run_compare(const CompareArguments& args) {
+// The folder of a compare argument (FOLDER or FOLDER=LABEL).
+fs::path compared_folder(const std::string& spec) { return spec.substr(0, spec.find('=')); }
+
+int run_compare(const CompareArguments& given) {
+  CompareArguments args = given;
+  // Every run must have the curve asked for, found before the table starts: runs stopped by
+  // --minutes before their first evaluation have no eval.csv.
+  if (args.curve == "eval") {
+    for (const std::string& spec : args.runs) {
+      const fs::path file = compared_folder(spec) / "eval.csv";
+      if (fs::exists(file)) continue;
+      if (args.curve_given) {
+        throw UsageError("compare --curve eval: " + file.string() +
+                         " does not exist (the run made no evaluation during training: "
+                         "--eval-every 0, or its budget ended before the first); its training "
+                         "returns are in progress.csv: --curve train draws those");
+      }
+      std::cerr << "compare: " << compared_folder(spec).string()
+                << " has no eval.csv (no evaluation during training: --eval-every 0, or its "
+                   "budget ended before the first), so every run's training returns are drawn "
+                   "(--curve train)\n";
+      args.curve = "train";
+      break;
+    }
+  }
   std::vector<trainer::ComparedCurve> curves;
   std::cout << "run,control_steps,wall_minutes,return_mean,return_std\n";
   for (const std::string& spec : args.runs) {
@@ -260,9 +291,11 @@ void declare_compare(CLI::App& compare, CompareArguments& args) {
   compare.add_option("--out", args.out, "The PNG to write")->required();
   compare
       .add_option("--curve", args.curve,
-                  "eval: the evaluations during training (eval.csv: deterministic episodes); "
-                  "train: the training episodes' returns (progress.csv)")
-      ->check(CLI::IsMember({"eval", "train"}));
+                  "eval: the evaluations during training (eval.csv: deterministic episodes; by "
+                  "default, and when a run has none, every run's training returns instead, "
+                  "said on stderr); train: the training episodes' returns (progress.csv)")
+      ->check(CLI::IsMember({"eval", "train"}))
+      ->each([&args](const std::string&) { args.curve_given = true; });
   compare.add_option("--title", args.title, "The plot's title");
   add_checked_option(compare, "--width", args.width, "Width in pixels", CLI::Range(400, 8000));
   add_checked_option(compare, "--height", args.height, "Height in pixels", CLI::Range(250, 8000));
