@@ -60,9 +60,12 @@ void add_run_options(CLI::App& train, TrainArguments& args) {
                    "1,000,000, drqv2 100,000)");
   train
       .add_option("--minutes", args.minutes,
-                  "Stop after this much wall time (then checkpoint, evaluate, write the video); "
-                  "with --resume, this much more, and at least one update (without it, a "
-                  "resumed run stops when its whole wall time reaches its budget so far)")
+                  "Stop after this much wall time, the final checkpoint, evaluation and video "
+                  "included: training stops within an update when the time left is what the "
+                  "final evaluation needs (at most a quarter of it: fewer --eval-episodes, or "
+                  "no video, when they do not fit; said in a line and in summary.json); with "
+                  "--resume, this much more, and at least one update (without it, a resumed "
+                  "run stops when its whole wall time reaches its budget so far)")
       ->check(CLI::Range(0.0, 1e9));
   train.add_option("--out", args.out, "The run folder (default runs/ID); must not hold a run");
   train.add_option("--resume", args.resume,
@@ -95,8 +98,8 @@ void add_run_options(CLI::App& train, TrainArguments& args) {
                   "missing (default: --dist-timeout, at least 60)")
       ->check(CLI::Range(1.0, 86400.0));
   train.add_flag("--quiet", args.quiet,
-                 "No progress bar: a plain line every 10 updates (also when stdout is not a "
-                 "terminal)");
+                 "No progress bar: a plain line every 10 updates, and at least every 10 s (also "
+                 "when stdout is not a terminal)");
 }
 
 // The run's settings, which a resume checks against the run's: --seed to --eval-episodes.
@@ -114,8 +117,9 @@ void add_run_setting_options(CLI::App& train, TrainArguments& args) {
                      integer_in(1));
   add_checked_option(train, "--torch-threads", args.torch_threads,
                      "LibTorch intra-op threads for the forward passes and updates (0: one per "
-                     "core this process may run on, or OMP_NUM_THREADS when set); config.json "
-                     "records the count used and --resume keeps it",
+                     "core this process may run on, as PyTorch, or OMP_NUM_THREADS when set; a "
+                     "warning when that is more than the cores the machine's load leaves "
+                     "free); config.json records the count used and --resume keeps it",
                      integer_in(0));
   add_checked_option(train, "--keep-checkpoints", args.keep_checkpoints,
                      "The newest checkpoints kept in the run folder, older ones deleted after "

@@ -60,7 +60,7 @@ class ProgressLine {
   /// The most seconds between two lines in kPlain while updates, evaluations or ticks go on (the
   /// promise is a line at least every 10 s; ticks come between small steps, so the slack covers
   /// the longest step).
-  static constexpr double kMaxSilenceS = 8.0;
+  static constexpr double kMaxSilenceS = 6.0;
   /// Seconds on a monotonic clock (steady_clock when absent).
   using Clock = std::function<double()>;
 
