@@ -178,7 +178,8 @@ double EvaluationCost::evaluation_seconds(std::int64_t episodes, bool video) con
 
 EvaluationCost measure_evaluation_cost(Actor& actor, const RunSettings& settings,
                                        const EnvKwargsParser& parse_sets,
-                                       const fs::path& scratch_folder, std::int64_t steps) {
+                                       const fs::path& scratch_folder, std::int64_t steps,
+                                       const std::function<void()>& on_step) {
   EvaluationCost cost;
   const auto setup_start = Clock::now();
   wrappers::RecordVideo* recorder = nullptr;
@@ -193,16 +194,15 @@ EvaluationCost measure_evaluation_cost(Actor& actor, const RunSettings& settings
     cost.episode_steps_known = true;
   }
   ActCounts counts;
-  const std::function<void()> none;
   // Untimed: the first steps warm the policy and the renderer up.
   std::int64_t warm = 0;
   play_episode(actor, env, settings.seed() + kEvaluationSeedOffset, true, actions, counts, warm,
-               none, kWarmUpSteps);
+               on_step, kWarmUpSteps);
   std::int64_t played = 0;
   auto start = Clock::now();
   while (played < steps) {
     play_episode(actor, env, settings.seed() + kEvaluationSeedOffset, true, actions, counts, played,
-                 none, steps - played);
+                 on_step, steps - played);
   }
   cost.step_s = seconds_since(start) / static_cast<double>(played);
   // Recorded: the first step opens the video file and the last finishes it (fixed costs); the
@@ -212,14 +212,14 @@ EvaluationCost measure_evaluation_cost(Actor& actor, const RunSettings& settings
   start = Clock::now();
   std::int64_t recorded = 0;
   play_episode(actor, env, settings.seed() + kEvaluationSeedOffset, true, actions, counts, recorded,
-               none, 1);
+               on_step, 1);
   const double first_s = seconds_since(start);
   start = Clock::now();
   const std::int64_t more = std::max<std::int64_t>(steps - 1, 1);
   std::int64_t later = 0;
   while (later < more) {
     play_episode(actor, env, settings.seed() + kEvaluationSeedOffset, true, actions, counts, later,
-                 none, more - later);
+                 on_step, more - later);
   }
   // A recorded step costs what a plain one does and more (the timings of a busy machine may say
   // otherwise).

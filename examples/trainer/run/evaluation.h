@@ -64,12 +64,13 @@ struct EvaluationCost {
 };
 
 /// Times `steps` env steps of `actor` (deterministic) on one env built as the run's, then
-/// `steps` more recorded to a scratch video in `scratch_folder` (removed after). Throws what the
-/// env throws.
+/// `steps` more recorded to a scratch video in `scratch_folder` (removed after), calling
+/// `on_step` (when set) after each. Throws what the env throws.
 EvaluationCost measure_evaluation_cost(Actor& actor, const RunSettings& settings,
                                        const EnvKwargsParser& parse_sets,
                                        const std::filesystem::path& scratch_folder,
-                                       std::int64_t steps);
+                                       std::int64_t steps,
+                                       const std::function<void()>& on_step = {});
 
 /// The final evaluation a time budget allows: the most of `asked` episodes (at least one) that
 /// fit in `seconds` at `cost`, the first recorded to the video while one video episode fits

@@ -566,15 +566,23 @@ bool TrainingRun::interrupt_requested() const {
 void TrainingRun::update_training_deadline() {
   planned_ =
       plan_final_evaluation(kEvaluationShare * left_at_start_s_, *cost_, settings_.eval_episodes);
-  training_deadline_s_ = time_limit_s_ - planned_.seconds - kCheckpointMarginS;
+  // Never more than the share: an episode estimated at its longest (max_episode_steps) may end
+  // far sooner, and training keeps the rest of the budget.
+  const double kept =
+      std::min(planned_.seconds, kEvaluationShare * std::max(left_at_start_s_, 0.0));
+  training_deadline_s_ = time_limit_s_ - kept - kCheckpointMarginS;
 }
 
 void TrainingRun::plan_time_budget() {
   training_deadline_s_ = time_limit_s_;
   left_at_start_s_ = time_limit_s_ - elapsed_s();
   if (time_limit_s_ <= 0.0 || !lead()) return;
-  cost_ = measure_evaluation_cost(algorithm_->actor(), settings_, parse_sets_, run_->path(),
-                                  kCostProbeSteps);
+  const auto probe_start = std::chrono::steady_clock::now();
+  cost_ = measure_evaluation_cost(
+      algorithm_->actor(), settings_, parse_sets_, run_->path(), kCostProbeSteps, [&] {
+        progress_->tick_note("time budget: timing evaluation steps (" +
+                             one_decimal(seconds_since(probe_start)) + " s so far)");
+      });
   update_training_deadline();
   output_.out << "time budget: " << one_decimal(std::max(left_at_start_s_, 0.0))
               << " s left; an evaluation episode takes about "
@@ -583,7 +591,8 @@ void TrainingRun::plan_time_budget() {
               << (cost_->episode_steps_known ? "" : ", the env has no TimeLimit: 1000 assumed")
               << "), so training stops at about "
               << one_decimal(std::max(training_deadline_s_, 0.0)) << " s of the run's "
-              << one_decimal(time_limit_s_) << " s to keep " << one_decimal(planned_.seconds)
+              << one_decimal(time_limit_s_) << " s to keep "
+              << one_decimal(time_limit_s_ - kCheckpointMarginS - training_deadline_s_)
               << " s for the final evaluation (" << planned_.episodes
               << (planned_.episodes == 1 ? " episode" : " episodes")
               << (planned_.video ? ", the first recorded to final.mp4" : ", no video") << ")"
@@ -849,7 +858,7 @@ json TrainingRun::evaluate_and_summarize() {
     if (cost_) {
       budget["evaluation_episode_s"] = cost_->episode_seconds(false);
       budget["evaluation_video_episode_s"] = cost_->episode_seconds(true);
-      budget["evaluation_reserved_s"] = planned_.seconds;
+      budget["evaluation_reserved_s"] = time_limit_s_ - kCheckpointMarginS - training_deadline_s_;
       budget["training_deadline_s"] = training_deadline_s_;
     }
     budget["final_evaluation"] = note.empty() ? json("as asked") : json(note);
