@@ -76,9 +76,12 @@ void add_run_options(CLI::App& train, TrainArguments& args) {
                    "1,000,000, drqv2 100,000)");
   train
       .add_option("--minutes", args.minutes,
-                  "Stop after this much wall time (then checkpoint, evaluate, write the video); "
-                  "with --resume, this much more, and at least one update (without it, a "
-                  "resumed run stops when its whole wall time reaches its budget so far)")
+                  "Stop after this much wall time, the final checkpoint, evaluation and video "
+                  "included: training stops within an update when the time left is what the "
+                  "final evaluation needs (at most a quarter of it: fewer --eval-episodes, or "
+                  "no video, when they do not fit; said in a line and in summary.json); with "
+                  "--resume, this much more, and at least one update (without it, a resumed "
+                  "run stops when its whole wall time reaches its budget so far)")
       ->check(CLI::Range(0.0, 1e9));
   train.add_option("--out", args.out, "The run folder (default runs/ID); must not hold a run");
   train.add_option("--resume", args.resume,
@@ -111,8 +114,8 @@ void add_run_options(CLI::App& train, TrainArguments& args) {
                   "missing (default: --dist-timeout, at least 60)")
       ->check(CLI::Range(1.0, 86400.0));
   train.add_flag("--quiet", args.quiet,
-                 "No progress bar: a plain line every 10 updates (also when stdout is not a "
-                 "terminal)");
+                 "No progress bar: a plain line every 10 updates, and at least every 10 s (also "
+                 "when stdout is not a terminal)");
 }
 
 // The run's settings, which a resume checks against the run's: --seed to --eval-episodes.
@@ -130,8 +133,9 @@ void add_run_setting_options(CLI::App& train, TrainArguments& args) {
                      integer_in(1));
   add_checked_option(train, "--torch-threads", args.torch_threads,
                      "LibTorch intra-op threads for the forward passes and updates (0: one per "
-                     "core this process may run on, or OMP_NUM_THREADS when set); config.json "
-                     "records the count used and --resume keeps it",
+                     "core this process may run on, as PyTorch, or OMP_NUM_THREADS when set; a "
+                     "warning when that is more than the cores the machine's load leaves "
+                     "free); config.json records the count used and --resume keeps it",
                      integer_in(0));
   add_checked_option(train, "--keep-checkpoints", args.keep_checkpoints,
                      "The newest checkpoints kept in the run folder, older ones deleted after "
@@ -184,9 +188,15 @@ void declare_eval(CLI::App& eval, EvalArguments& args) {
       "clipped_action_fraction= (the share of action elements the policy put outside the "
       "bounds: near 1 is bang-bang control)");
   eval.add_option("run", args.run, "Run folder or checkpoint file (.pgck)")->required();
-  add_checked_option(eval, "--episodes", args.episodes, "Episodes, seeded seed, seed + 1, ...",
-                     CLI::Range(std::int64_t{1}, std::int64_t{1} << 20));
-  add_seed_option(eval, args.seed, "Seed of the first episode");
+  eval.add_option("--episodes", args.episodes,
+                  "Episodes, seeded seed, seed + 1, ... (default: as the run's final evaluation, "
+                  "summary.json's: --eval-episodes)")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 20));
+  add_seed_option(eval, args.seed,
+                  "Seed of the first episode (default: as the run's final evaluation, "
+                  "summary.json's: the run's --seed + 1000000, so that the returns agree with "
+                  "it)")
+      ->each([&args](const std::string&) { args.seed_given = true; });
   eval.add_option("--video", args.video, "Record the first episode to this .mp4");
   eval.add_flag("--stochastic", args.stochastic,
                 "Sample actions from the policy instead of taking its mean / most likely one");
@@ -198,6 +208,7 @@ struct CompareArguments {
   std::vector<std::string> runs;
   std::string out;
   std::string curve = "eval";
+  bool curve_given = false;
   std::string title;
   int width = 1100;
   int height = 500;
@@ -213,7 +224,31 @@ double action_repeat_of(const nlohmann::json& config) {
   return repeat;
 }
 
-int run_compare(const CompareArguments& args) {
+// The folder of a compare argument (FOLDER or FOLDER=LABEL).
+fs::path compared_folder(const std::string& spec) { return spec.substr(0, spec.find('=')); }
+
+int run_compare(const CompareArguments& given) {
+  CompareArguments args = given;
+  // Every run must have the curve asked for, found before the table starts: runs stopped by
+  // --minutes before their first evaluation have no eval.csv.
+  if (args.curve == "eval") {
+    for (const std::string& spec : args.runs) {
+      const fs::path file = compared_folder(spec) / "eval.csv";
+      if (fs::exists(file)) continue;
+      if (args.curve_given) {
+        throw UsageError("compare --curve eval: " + file.string() +
+                         " does not exist (the run made no evaluation during training: "
+                         "--eval-every 0, or its budget ended before the first); its training "
+                         "returns are in progress.csv: --curve train draws those");
+      }
+      std::cerr << "compare: " << compared_folder(spec).string()
+                << " has no eval.csv (no evaluation during training: --eval-every 0, or its "
+                   "budget ended before the first), so every run's training returns are drawn "
+                   "(--curve train)\n";
+      args.curve = "train";
+      break;
+    }
+  }
   std::vector<trainer::ComparedCurve> curves;
   std::cout << "run,control_steps,wall_minutes,return_mean,return_std\n";
   for (const std::string& spec : args.runs) {
@@ -276,9 +311,11 @@ void declare_compare(CLI::App& compare, CompareArguments& args) {
   compare.add_option("--out", args.out, "The PNG to write")->required();
   compare
       .add_option("--curve", args.curve,
-                  "eval: the evaluations during training (eval.csv: deterministic episodes); "
-                  "train: the training episodes' returns (progress.csv)")
-      ->check(CLI::IsMember({"eval", "train"}));
+                  "eval: the evaluations during training (eval.csv: deterministic episodes; by "
+                  "default, and when a run has none, every run's training returns instead, "
+                  "said on stderr); train: the training episodes' returns (progress.csv)")
+      ->check(CLI::IsMember({"eval", "train"}))
+      ->each([&args](const std::string&) { args.curve_given = true; });
   compare.add_option("--title", args.title, "The plot's title");
   add_checked_option(compare, "--width", args.width, "Width in pixels", CLI::Range(400, 8000));
   add_checked_option(compare, "--height", args.height, "Height in pixels", CLI::Range(250, 8000));

@@ -46,8 +46,9 @@ struct TrainArguments : EnvArguments {
 /// `pixelgym eval`'s command line.
 struct EvalArguments {
   std::string run;
-  std::int64_t episodes = 10;
+  std::int64_t episodes = 0;  // 0: the run's final evaluation's (summary.json's)
   std::uint64_t seed = 0;
+  bool seed_given = false;  // else the run's final evaluation's seed (summary.json's)
   std::string video;
   bool stochastic = false;
 };

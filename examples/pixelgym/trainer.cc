@@ -1,7 +1,11 @@
 // pixelgym-train's train and eval: the trainer's run (examples/trainer/run) with an algorithm:
 // PPO (examples/trainer/ppo) or DrQ-v2 (examples/trainer/drqv2). Only pixelgym-train links it,
 // and with it LibTorch.
+#include <signal.h>
+
 #include <algorithm>
+#include <atomic>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -30,6 +34,15 @@ namespace fs = std::filesystem;
 const ppo::PpoAlgorithmFactory kPpo;
 const drqv2::DrqV2AlgorithmFactory kDrqV2;
 const trainer::AlgorithmFactories kAlgorithms = {&kPpo, &kDrqV2};
+
+// Set by the first SIGINT (Ctrl-C) during `train`: the run stops at its next step, checkpoints
+// and says how to resume; a second SIGINT ends the process at once (the default action).
+std::atomic<bool> interrupt_requested{false};
+
+extern "C" void on_interrupt(int) {
+  interrupt_requested.store(true);
+  ::signal(SIGINT, SIG_DFL);
+}
 
 const trainer::AlgorithmFactory& algorithm_named(const std::string& name) {
   for (const trainer::AlgorithmFactory* algorithm : kAlgorithms) {
@@ -289,6 +302,8 @@ int run_train(const TrainArguments& args) {
                                         std::cerr);
   }
   trainer::tune_process_for_training();
+  // Lines reach a pipe (tee, a log reader) as they are written, not a buffer later.
+  std::setvbuf(stdout, nullptr, _IOLBF, BUFSIZ);
   std::unique_ptr<distributed::GlooCommunicator> communicator;
   if (ranks && ranks->world_size > 1) {
     try {
@@ -318,7 +333,14 @@ int run_train(const TrainArguments& args) {
             : trainer::TrainingRun::resume(algorithm, parse_sets, args.resume, budget,
                                            resume_checks(args), output);
     if (communicator) run.distribute(*communicator);
+    run.stop_when(interrupt_requested);
+    ::signal(SIGINT, on_interrupt);
     run.train();
+    ::signal(SIGINT, SIG_DFL);
+    if (run.interrupted()) {
+      std::cout << "resume with: pixelgym train --resume " << run.folder().string() << std::endl;
+      return 130;  // 128 + SIGINT, as a shell reports a process ended by Ctrl-C
+    }
   } catch (const trainer::RunRequestError& error) {
     throw UsageError(error.what());
   }
@@ -335,13 +357,18 @@ int run_eval(const EvalArguments& args) {
   // Before any episode runs: a path that cannot take the video is found now, not after them.
   if (!args.video.empty()) check_video_file("eval --video", args.video);
   trainer::tune_process_for_training();
-  trainer::EvaluationRequest request{args.episodes, args.seed, args.stochastic, std::nullopt};
+  trainer::CheckpointEvaluationRequest request;
+  if (args.episodes > 0) request.episodes = args.episodes;
+  if (args.seed_given) request.seed = args.seed;
+  request.stochastic = args.stochastic;
   if (!args.video.empty()) request.video = fs::path(args.video);
   const trainer::CheckpointEvaluation result =
       trainer::evaluate_checkpoint(kAlgorithms, parse_sets, args.run, request, std::cerr);
   const trainer::PolicyEvaluation& evaluation = result.evaluation;
-  std::cout << result.checkpoint.string() << ": " << result.settings.env_id << ", " << args.episodes
-            << " episodes from seed " << args.seed
+  const std::string from =
+      args.seed_given && args.episodes > 0 ? "" : " (as " + result.defaults_from + ")";
+  std::cout << result.checkpoint.string() << ": " << result.settings.env_id << ", "
+            << result.request.episodes << " episodes from seed " << result.request.seed << from
             << (args.stochastic ? ", sampled actions" : ", deterministic actions") << "\n";
   for (std::size_t e = 0; e < evaluation.returns.size(); ++e) {
     std::cout << "episode " << e << ": return=" << evaluation.returns[e] << "\n";

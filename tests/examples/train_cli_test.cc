@@ -4,18 +4,24 @@
 // rollouts) keep it to seconds; learning itself is measured in bench/, not here.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <poll.h>
 #include <sched.h>
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include "examples/trainer/drqv2/drqv2.h"
 #include "examples/trainer/run/checkpoint_file.h"
@@ -105,9 +111,12 @@ TEST(TrainCliTest, AShortRunWritesACompleteRunFolder) {
   EXPECT_EQ(summary.at("env_steps"), 320);
   EXPECT_EQ(summary.at("evaluation").at("episodes"), 1);
 
-  // The run evaluates again from its folder, the same as at the end of training (same seed).
-  const CliRun evaluated = run_cli("eval " + run.string() + " --episodes 1 --seed 1000000");
+  // The run evaluates again from its folder, the same as at the end of training: by default
+  // with the final evaluation's episodes and seed (summary.json's), and says so.
+  const CliRun evaluated = run_cli("eval " + run.string());
   ASSERT_EQ(evaluated.exit_code, 0) << evaluated.output;
+  EXPECT_THAT(evaluated.output,
+              ::testing::HasSubstr(", 1 episodes from seed 1000000 (as summary.json)"));
   std::ostringstream expected;
   expected << "return_mean=" << summary.at("evaluation").at("return_mean").get<double>();
   EXPECT_NE(evaluated.output.find(expected.str()), std::string::npos) << evaluated.output;
@@ -405,7 +414,8 @@ TEST(TrainCliTest, AResumedRunKeepsItsTimeBudgetUnlessGivenMore) {
   const fs::path folder = fresh_folder("minutes");
   const fs::path run = folder / "run";
   const auto rows = [&] { return trainer::read_progress_csv(run / "progress.csv").rows.size(); };
-  // 0.6 ms: the run stops by time after its one update.
+  // 0.6 ms: the run stops by time within its one update, at the shortest rollout an update
+  // takes (one step of the 2 envs: a transition for each of the 2 minibatches).
   const CliRun trained =
       run_cli(train_arguments(folder, "--steps 320 --minutes 0.00001 --out " + run.string()));
   ASSERT_EQ(trained.exit_code, 0) << trained.output;
@@ -431,7 +441,7 @@ TEST(TrainCliTest, AResumedRunKeepsItsTimeBudgetUnlessGivenMore) {
   const json config = json::parse(read_text(run / "config.json"));
   ASSERT_EQ(config.at("resumes").size(), 1U);
   const json& resume = config.at("resumes")[0];
-  EXPECT_EQ(resume.at("steps"), 32);
+  EXPECT_EQ(resume.at("steps"), 2);
   EXPECT_EQ(resume.at("total_env_steps"), 320);
   EXPECT_EQ(resume.at("minutes_given"), 0.00001);
   EXPECT_GT(resume.at("minutes").get<double>(), 0.00001);  // the wall time so far + 0.00001
@@ -449,12 +459,18 @@ TEST(TrainCliTest, AResumedRunKeepsItsTimeBudgetUnlessGivenMore) {
   const CliRun unfinished = run_cli("train --resume " + run.string() + " --quiet");
   ASSERT_EQ(unfinished.exit_code, 0) << unfinished.output;
   EXPECT_EQ(rows(), 2U);
-  EXPECT_EQ(json::parse(read_text(run / "summary.json")).at("env_steps"), 64);
-  EXPECT_TRUE(fs::exists(run / "final.mp4"));
+  const json summary = json::parse(read_text(run / "summary.json"));
+  EXPECT_EQ(summary.at("env_steps"), 4);
+  // The budget holds no recorded episode: no video, and summary.json says why.
+  EXPECT_FALSE(fs::exists(run / "final.mp4"));
+  EXPECT_TRUE(summary.at("video").is_null());
+  EXPECT_THAT(summary.at("time_budget").at("final_evaluation").get<std::string>(),
+              ::testing::HasSubstr("no final.mp4"));
+  EXPECT_EQ(summary.at("evaluation").at("episodes"), 1);
   // Budgets that cannot be: --steps no more than done, negative minutes.
-  const CliRun fewer = run_cli("train --resume " + run.string() + " --quiet --steps 64");
+  const CliRun fewer = run_cli("train --resume " + run.string() + " --quiet --steps 4");
   EXPECT_EQ(fewer.exit_code, 2) << fewer.output;
-  EXPECT_NE(fewer.output.find("the run has 64 env steps done; give more to train on"),
+  EXPECT_NE(fewer.output.find("the run has 4 env steps done; give more to train on"),
             std::string::npos)
       << fewer.output;
   const CliRun negative = run_cli("train --resume " + run.string() + " --quiet --minutes -1");
@@ -835,6 +851,284 @@ TEST(TrainCliTest, RecipesByNameInlineJsonAndSetAlgo) {
   EXPECT_NE(listed.output.find("\n  cartpole  {"), std::string::npos) << listed.output;
   const CliRun ppo_only = run_cli("train --list-configs --algo ppo");
   EXPECT_EQ(ppo_only.output.find("drqv2 (--algo drqv2)"), std::string::npos) << ppo_only.output;
+  fs::remove_all(folder);
+}
+
+// A run's output as a reader of a pipe sees it: each line with the seconds since the start when
+// it arrived, and the run's exit code and wall time.
+struct PipedRun {
+  int exit_code = -1;
+  double wall_s = 0.0;
+  std::vector<std::pair<double, std::string>> lines;
+  std::string output() const {
+    std::string text;
+    for (const auto& line : lines) text += line.second;
+    return text;
+  }
+  // The longest wait between two lines, from the first line to the end.
+  double longest_silence_s() const {
+    double longest = 0.0;
+    for (std::size_t i = 1; i < lines.size(); ++i) {
+      longest = std::max(longest, lines[i].first - lines[i - 1].first);
+    }
+    if (!lines.empty()) longest = std::max(longest, wall_s - lines.back().first);
+    return longest;
+  }
+};
+
+// Runs `pixelgym ARGUMENTS` with stdout and stderr into a pipe read line by line; kills it
+// after `kill_after_s` (a run that ignores its budget fails instead of hanging the test).
+PipedRun run_piped(const std::string& arguments, double kill_after_s) {
+  PipedRun run;
+  const auto start = std::chrono::steady_clock::now();
+  const auto since = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  int fds[2];
+  if (::pipe(fds) != 0) return run;
+  const std::string command = std::string("exec ") + PIXELGYM_CLI + " " + arguments + " 2>&1";
+  const pid_t child = fork();
+  if (child == 0) {
+    ::dup2(fds[1], STDOUT_FILENO);
+    ::close(fds[0]);
+    ::close(fds[1]);
+    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  ::close(fds[1]);
+  std::string line;
+  std::array<char, 4096> buffer{};
+  for (;;) {
+    pollfd ready{fds[0], POLLIN, 0};
+    const int waited = ::poll(&ready, 1, 200);
+    if (since() > kill_after_s) {
+      ::kill(child, SIGKILL);
+      run.lines.emplace_back(since(),
+                             "(killed by the test after " + std::to_string(kill_after_s) + " s)\n");
+      break;
+    }
+    if (waited <= 0) continue;
+    const ssize_t got = ::read(fds[0], buffer.data(), buffer.size());
+    if (got <= 0) break;
+    // Each whole line with the time it arrived.
+    for (ssize_t i = 0; i < got; ++i) {
+      line += buffer[static_cast<std::size_t>(i)];
+      if (buffer[static_cast<std::size_t>(i)] == '\n') {
+        run.lines.emplace_back(since(), line);
+        line.clear();
+      }
+    }
+  }
+  if (!line.empty()) run.lines.emplace_back(since(), line);
+  ::close(fds[0]);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  run.wall_s = since();
+  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return run;
+}
+
+// --minutes bounds the whole run's wall time, the final evaluation included, within 10 % or
+// 30 s (whichever is larger), however long an iteration is: the budget is checked within
+// iterations (here one iteration would take minutes), and time is kept for the final
+// evaluation. The cut iteration is checkpointed and a resume goes on from it. A pipe gets a line
+// at least every 10 s throughout.
+TEST(TrainCliTest, MinutesBoundTheWholeRunAndLinesReachAPipeEvery10Seconds) {
+  const fs::path folder = fresh_folder("budget");
+  constexpr double kMinutes = 0.25;
+  const double bound_s = kMinutes * 60.0 + std::max(0.1 * kMinutes * 60.0, 30.0);
+  const std::string cheap =
+      " --set obs_mode=pixels --set width=32 --set height=32 --set max_episode_steps=50 "
+      "--wrap frame_stack=2 --threads 1 --eval-episodes 3 --quiet --minutes 0.25 ";
+  // PPO: a rollout of 2 x 4096 steps and 10 epochs of 8 minibatches over it.
+  std::ofstream(folder / "ppo.json")
+      << R"({"num_steps": 4096, "num_envs": 2, "num_minibatches": 8, "update_epochs": 10})";
+  // DrQ-v2: one iteration of 5000 env steps, an update after each.
+  std::ofstream(folder / "drqv2.json")
+      << R"({"iteration_env_steps": 5000, "seed_env_steps": 100, "batch_size": 64,
+             "frame_stack": 2})";
+  for (const std::string algo : {"ppo", "drqv2"}) {
+    SCOPED_TRACE(algo);
+    const fs::path run = folder / algo;
+    const PipedRun trained =
+        run_piped("train CartPoleBalance-v1 --algo " + algo + cheap + "--config " +
+                      (folder / (algo + ".json")).string() + " --out " + run.string(),
+                  bound_s + 30.0);
+    ASSERT_EQ(trained.exit_code, 0) << trained.output();
+    std::cout << algo << ": --minutes " << kMinutes << " ran " << trained.wall_s << " s (bound "
+              << bound_s << " s), longest silence on the pipe " << trained.longest_silence_s()
+              << " s\n";
+    EXPECT_LE(trained.wall_s, bound_s) << trained.output();
+    EXPECT_LE(trained.longest_silence_s(), 10.0) << trained.output();
+    const json summary = json::parse(read_text(run / "summary.json"));
+    EXPECT_EQ(summary.at("stopped_by"), "time") << trained.output();
+    EXPECT_LE(summary.at("wall_time_s").get<double>(), bound_s);
+    EXPECT_TRUE(summary.at("time_budget").contains("evaluation_reserved_s"));
+    // The cut iteration was kept: the last checkpoint is of the summary's steps.
+    const trainer::CheckpointSearch latest = trainer::find_latest_checkpoint(run);
+    ASSERT_TRUE(latest.latest.has_value());
+    const std::int64_t steps = summary.at("env_steps").get<std::int64_t>();
+    EXPECT_EQ(json::parse(latest.latest->blobs.at("meta")).at("env_steps"), steps);
+    EXPECT_GT(steps, 0);
+    if (algo == "ppo") {
+      // And a resume goes on from it, within its own minutes.
+      const CliRun resumed = run_cli("train --resume " + run.string() + " --quiet --minutes 0.05");
+      ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+      EXPECT_NE(resumed.output.find("replayed the " + std::to_string(steps) + " env steps"),
+                std::string::npos)
+          << resumed.output;
+      EXPECT_GT(json::parse(read_text(run / "summary.json")).at("env_steps").get<std::int64_t>(),
+                steps);
+    }
+  }
+  fs::remove_all(folder);
+}
+
+// Ctrl-C (SIGINT) ends the iteration in progress, writes a checkpoint of it and prints the
+// command that resumes the run; the exit code is 130 (128 + SIGINT), as for a process killed by
+// Ctrl-C. The command resumes.
+TEST(TrainCliTest, CtrlCCheckpointsAndPrintsTheCommandThatResumes) {
+  const fs::path folder = fresh_folder("sigint");
+  const fs::path run = folder / "run";
+  const std::string command =
+      std::string(PIXELGYM_CLI) + " " +
+      train_arguments(folder, "--checkpoint-every 1 --out " + run.string()) + " > " +
+      (folder / "log.txt").string() + " 2>&1";
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    execl("/bin/sh", "sh", "-c", ("exec " + command).c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (!fs::exists(run / "ckpt-000002.pgck") && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ::kill(child, SIGINT);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  const std::string log = read_text(folder / "log.txt");
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal, not stopped\n" << log;
+  EXPECT_EQ(WEXITSTATUS(status), 130) << log;
+  const std::string resume = "resume with: pixelgym train --resume " + run.string() + "\n";
+  EXPECT_NE(log.find(resume), std::string::npos) << log;
+  EXPECT_NE(log.find("interrupted at "), std::string::npos) << log;
+  EXPECT_FALSE(fs::exists(run / "summary.json"));
+  // The checkpoint it names holds the steps it names.
+  const trainer::CheckpointSearch latest = trainer::find_latest_checkpoint(run);
+  ASSERT_TRUE(latest.latest.has_value());
+  const std::int64_t steps = json::parse(latest.latest->blobs.at("meta")).at("env_steps");
+  EXPECT_NE(log.find("interrupted at " + std::to_string(steps) + " env steps: wrote " +
+                     latest.latest->path.string()),
+            std::string::npos)
+      << log;
+  const CliRun resumed = run_cli("train --resume " + run.string() + " --steps " +
+                                 std::to_string(steps + 32) + " --quiet");
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  EXPECT_TRUE(fs::exists(run / "summary.json"));
+  fs::remove_all(folder);
+}
+
+// More torch threads than the cores left free by the machine's load draw a warning naming the
+// figures and what to do (PIXELGYM_LOADAVG fakes the load); none on an idle machine
+// (ProcessTuningTest checks the bounds).
+TEST(TrainCliTest, TorchThreadsAboveTheFreeCoresAreWarnedOf) {
+  cpu_set_t cpus;
+  CPU_ZERO(&cpus);
+  ASSERT_EQ(sched_getaffinity(0, sizeof(cpus), &cpus), 0);
+  const int cores = CPU_COUNT(&cpus);
+  const fs::path folder = fresh_folder("busy");
+  const auto train = [&](const std::string& load, const std::string& threads) {
+    fs::remove_all(folder / "run");
+    return run_cli(train_arguments(folder, "--steps 32 --out " + (folder / "run").string() +
+                                               " --torch-threads " + threads),
+                   "OMP_NUM_THREADS= PIXELGYM_LOADAVG=" + load);
+  };
+  const CliRun busy = train("64", std::to_string(std::max(cores, 2)));
+  ASSERT_EQ(busy.exit_code, 0) << busy.output;
+  EXPECT_THAT(busy.output,
+              ::testing::HasSubstr("warning: torch_threads=" + std::to_string(std::max(cores, 2)) +
+                                   " (--torch-threads), but about 0.0 of the " +
+                                   std::to_string(cores) + " cores"));
+  EXPECT_THAT(busy.output, ::testing::HasSubstr("load average 64.00 over the last minute"));
+  EXPECT_THAT(busy.output, ::testing::HasSubstr("Give --torch-threads 1 (the free cores)"));
+  const CliRun idle = train("0", std::to_string(cores));
+  ASSERT_EQ(idle.exit_code, 0) << idle.output;
+  EXPECT_THAT(idle.output, ::testing::Not(::testing::HasSubstr("warning: torch_threads")));
+  fs::remove_all(folder);
+}
+
+// compare's default curve (the evaluations, eval.csv) falls back to the training returns when a
+// run has no eval.csv, saying so before the table; asked for by --curve eval, it is refused
+// before any line of the table, naming the curve that exists.
+TEST(TrainCliTest, CompareFallsBackToTheTrainingCurveWithoutEvaluations) {
+  const fs::path folder = fresh_folder("compare");
+  const fs::path run = folder / "run";
+  const CliRun trained =
+      run_cli(train_arguments(folder, "--steps 32 --eval-every 0 --out " + run.string()));
+  ASSERT_EQ(trained.exit_code, 0) << trained.output;
+  ASSERT_FALSE(fs::exists(run / "eval.csv"));
+  const CliRun fallback =
+      run_cli("compare " + run.string() + " --out " + (folder / "default.png").string());
+  ASSERT_EQ(fallback.exit_code, 0) << fallback.output;
+  EXPECT_THAT(fallback.output, ::testing::HasSubstr("has no eval.csv"));
+  EXPECT_THAT(fallback.output, ::testing::HasSubstr("\nrun,32,"));
+  EXPECT_LT(fallback.output.find("has no eval.csv"),
+            fallback.output.find("run,control_steps,wall_minutes"));
+  EXPECT_TRUE(fs::exists(folder / "default.png"));
+  const CliRun refused =
+      run_cli("compare " + run.string() + " --curve eval --out " + (folder / "eval.png").string());
+  EXPECT_EQ(refused.exit_code, 2) << refused.output;
+  EXPECT_THAT(refused.output, ::testing::HasSubstr("--curve train"));
+  EXPECT_THAT(refused.output, ::testing::Not(::testing::HasSubstr("run,control_steps")));
+  EXPECT_FALSE(fs::exists(folder / "eval.png"));
+  fs::remove_all(folder);
+}
+
+// A mistyped env id or kwarg is refused before the run folder is touched: no folder is made,
+// and a folder given with --out is left without a .lock.
+TEST(TrainCliTest, AMistypedIdOrKwargLeavesNoFolderAndNoLock) {
+  const fs::path folder = fresh_folder("mistyped");
+  for (const std::string typo : {"CartPoleBalanc-v0", "CartPoleBalance-v0 --set widht=32"}) {
+    SCOPED_TRACE(typo);
+    const CliRun fresh =
+        run_cli("train " + typo + " --steps 16 --quiet --out " + (folder / "new").string());
+    EXPECT_NE(fresh.exit_code, 0) << fresh.output;
+    EXPECT_THAT(fresh.output, ::testing::AnyOf(::testing::HasSubstr("\"CartPoleBalanc-v0\""),
+                                               ::testing::HasSubstr("\"widht\"")));
+    EXPECT_FALSE(fs::exists(folder / "new"));
+    fs::create_directories(folder / "given");
+    const CliRun given =
+        run_cli("train " + typo + " --steps 16 --quiet --out " + (folder / "given").string());
+    EXPECT_NE(given.exit_code, 0) << given.output;
+    EXPECT_TRUE(fs::is_empty(folder / "given")) << "a refused run left files in its folder";
+  }
+  // A kwarg the env refuses only once it is built (a value out of range) is refused after the
+  // lock is taken: the lock goes with the refusal.
+  const CliRun built = run_cli(
+      train_arguments(folder, "--steps 16 --set width=1 --out " + (folder / "given").string()));
+  EXPECT_NE(built.exit_code, 0) << built.output;
+  EXPECT_TRUE(fs::is_empty(folder / "given")) << built.output;
+  fs::remove_all(folder);
+}
+
+// An evaluation during training skipped for taking too much of the wall time is said once, not
+// once per evaluation; summary.json counts them.
+TEST(TrainCliTest, SkippedEvaluationsAreSaidOnce) {
+  const fs::path folder = fresh_folder("skipped");
+  const fs::path run = folder / "run";
+  const CliRun trained = run_cli(train_arguments(
+      folder, "--steps 160 --eval-every 32 --eval-every-episodes 1 --eval-max-share 0.001 --out " +
+                  run.string()));
+  ASSERT_EQ(trained.exit_code, 0) << trained.output;
+  std::size_t said = 0;
+  for (std::size_t at = trained.output.find("env steps skipped"); at != std::string::npos;
+       at = trained.output.find("env steps skipped", at + 1)) {
+    ++said;
+  }
+  EXPECT_EQ(said, 1U) << trained.output;
+  const json summary = json::parse(read_text(run / "summary.json"));
+  EXPECT_EQ(summary.at("evaluations_skipped").get<int>(), 4) << trained.output;
   fs::remove_all(folder);
 }
 

@@ -198,7 +198,7 @@ void DrqV2Algorithm::step_env(std::vector<double>* ended_returns, StepTimes& tim
   env_steps_ += config_.num_envs;
 }
 
-IterationStats DrqV2Algorithm::iterate() {
+IterationStats DrqV2Algorithm::iterate(const trainer::StopCheck& stop) {
   if (!started_) start();
   IterationStats stats;
   StepTimes times;
@@ -207,10 +207,14 @@ IterationStats DrqV2Algorithm::iterate() {
   double critic_loss = 0.0, actor_loss = 0.0, q_mean = 0.0, target_mean = 0.0;
   std::int64_t updates = 0;
   const std::int64_t steps = config_.iteration_env_steps / config_.num_envs;
-  for (std::int64_t s = 0; s < steps; ++s) {
+  bool stopped = false;
+  for (std::int64_t s = 0; s < steps && !stopped; ++s) {
     choose_actions(times);
     step_env(&stats.episode_returns, times);
-    if (env_steps_ < config_.seed_env_steps || !buffer_.can_sample()) continue;
+    if (env_steps_ < config_.seed_env_steps || !buffer_.can_sample()) {
+      stopped = stop && stop(env_steps_);
+      continue;
+    }
     update_credit_ += static_cast<double>(config_.num_envs) * config_.updates_per_env_step;
     while (update_credit_ >= 1.0) {
       update_credit_ -= 1.0;
@@ -226,7 +230,12 @@ IterationStats DrqV2Algorithm::iterate() {
       target_mean += update.target_mean;
       ++updates;
       ++gradient_updates_;
+      if (stop && stop(env_steps_)) {
+        stopped = true;
+        break;
+      }
     }
+    if (!stopped && stop) stopped = stop(env_steps_);
   }
   ++iterations_;
   stats.extra = {

@@ -41,7 +41,9 @@ class DrqV2Actor final : public trainer::Actor {
 /// for the first seed_env_steps, then the policy's with the scheduled noise), adds the
 /// transitions to the replay buffer (a step that ends an episode adds the episode's final
 /// observation, then the next episode's first), and then makes updates_per_env_step updates
-/// per env step (the fraction carried over), each from a batch sampled from the buffer.
+/// per env step (the fraction carried over), each from a batch sampled from the buffer. `stop`
+/// is asked after each env step and each update: once it answers true the iteration ends there,
+/// the updates it did not make left as credit for the next env steps.
 ///
 /// Determinism: torch::manual_seed(seed) before the weights; the replay sampling draws from a
 /// std::mt19937_64 seeded with seed, the augmentation from a torch generator seeded seed + 1,
@@ -66,7 +68,7 @@ class DrqV2Algorithm final : public trainer::Algorithm {
   /// autoreset in SameStep mode or has another num_envs, and as input_layout for the spaces.
   DrqV2Algorithm(vector::VectorEnv& env, DrqV2Config config);
 
-  trainer::IterationStats iterate() override;
+  trainer::IterationStats iterate(const trainer::StopCheck& stop) override;
   std::int64_t env_steps() const override { return env_steps_; }
   std::int64_t updates() const override { return iterations_; }
   void set_progress(std::int64_t env_steps, std::int64_t updates) override;

@@ -579,7 +579,9 @@ std::uint64_t Trainer::env_digest() const {
   return digest;
 }
 
-RolloutStats Trainer::collect() {
+bool Trainer::alone() const { return communicator_ == nullptr || communicator_->world_size() == 1; }
+
+RolloutStats Trainer::collect(const trainer::StopCheck& stop) {
   torch::NoGradGuard no_grad;
   RolloutStats stats;
   if (!started_) {
@@ -641,6 +643,11 @@ RolloutStats Trainer::collect() {
       stats.policy_seconds += seconds_since(start);
     }
     current_obs_ = observation_tensors(step.obs);
+    // Every minibatch of the update must hold a transition.
+    if (stop && stop(env_steps_ + steps * envs) && alone() &&
+        steps * envs >= config_.num_minibatches) {
+      break;
+    }
   }
   const auto start = Clock::now();
   storage_.last_values.copy_(policy_->value(current_obs_));
@@ -799,7 +806,7 @@ double Trainer::step_minibatch(const UpdateBatch& batch, const torch::Tensor& in
   return approx_kl;
 }
 
-UpdateStats Trainer::update() {
+UpdateStats Trainer::update(const trainer::StopCheck& stop_check) {
   if (!collected_) throw std::logic_error("Trainer::update: no rollout collected since the last");
   UpdateStats stats;
   collective_seconds_ = 0.0;
@@ -813,8 +820,9 @@ UpdateStats Trainer::update() {
   // without moving the policy.
   const bool value_after_stop = policy_->config().separate_value_network;
   bool stop = false;
-  for (std::int64_t epoch = 0; epoch < config_.update_epochs && !(stop && !value_after_stop);
-       ++epoch) {
+  bool out_of_time = false;
+  for (std::int64_t epoch = 0;
+       epoch < config_.update_epochs && !(stop && !value_after_stop) && !out_of_time; ++epoch) {
     const torch::Tensor order = minibatch_order_
                                     ? minibatch_order_(epoch, batch.size)
                                     : torch::randperm(batch.size, sampling_, torch::kInt64);
@@ -829,9 +837,16 @@ UpdateStats Trainer::update() {
       const torch::Tensor index = order.slice(0, m * batch.size / config_.num_minibatches,
                                               (m + 1) * batch.size / config_.num_minibatches);
       const MinibatchPosition at{epoch, m};
+      // Out of time (the run's check, asked after every minibatch, alone only: the ranks' updates
+      // must take the same minibatches).
+      const auto out_of_time_now = [&] { return stop_check && stop_check(env_steps_) && alone(); };
       if (stop) {
         step_value_only(batch, index, at);
         stats.value_minibatches += 1;
+        if (out_of_time_now()) {
+          out_of_time = true;
+          break;
+        }
         continue;
       }
       double approx_kl = step_minibatch(batch, index, at, stats);
@@ -845,6 +860,10 @@ UpdateStats Trainer::update() {
       if (config_.target_kl > 0.0 && approx_kl > config_.target_kl) {
         stop = true;
         if (!value_after_stop) break;
+      }
+      if (out_of_time_now()) {
+        out_of_time = true;
+        break;
       }
     }
     if (policy_steps_in_epoch > 0) stats.epochs += 1;

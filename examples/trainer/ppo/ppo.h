@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "examples/trainer/ppo/policy.h"
+#include "examples/trainer/run/algorithm.h"
 #include "examples/trainer/run/communicator.h"
 #include "examples/trainer/run/memory_budget.h"
 #include "pixelgym/envs/vector/vector_env.h"
@@ -249,8 +250,11 @@ class Trainer {
 
   /// Steps every env num_steps times with actions sampled from the policy (no gradients),
   /// storing the transitions and the values GAE needs, then computes advantages and returns.
-  /// The first call resets the envs with config.seed (unless replay_env did).
-  RolloutStats collect();
+  /// The first call resets the envs with config.seed (unless replay_env did). `stop` (when set) is
+  /// asked after each step with the env steps done so far; once it answers true and the rollout
+  /// holds at least num_minibatches transitions, the rollout ends there (a shorter one, learned
+  /// from as a whole; not used with a communicator of several ranks, whose rollouts end together).
+  RolloutStats collect(const trainer::StopCheck& stop = {});
   /// config.update_epochs passes of minibatch PPO over the last rollout; then merges its
   /// observations into the observation statistics. The learning rate is set first, from the
   /// env steps done before the rollout (annealing). With augmentation, one random shift per
@@ -258,8 +262,10 @@ class Trainer {
   /// recomputed under it (no gradients), so the ratio starts at 1 on the shifted images.
   /// Throws std::logic_error before any collect(), and std::runtime_error (naming the update,
   /// epoch and minibatch, the losses and the gradient norm) when a minibatch's loss or gradient
-  /// norm is not finite; that minibatch's step is not taken.
-  UpdateStats update();
+  /// norm is not finite; that minibatch's step is not taken. `stop` (when set) is asked after each
+  /// minibatch; once it answers true the update ends there (at least one minibatch is taken),
+  /// as after a target_kl stop (not with a communicator of several ranks).
+  UpdateStats update(const trainer::StopCheck& stop = {});
 
   /// The order in which an update visits the rollout's transitions in `epoch` (a permutation of
   /// 0 .. size - 1, int64, over this rank's flattened rollout, step-major: index t N + n); absent:
@@ -366,6 +372,8 @@ class Trainer {
                         const wrappers::RunningStatistics& rewards);
   // Whether a rollout at step `t` (steps done t + 1) should stop as a straggler.
   bool preempted(std::int64_t steps_done);
+  // Whether the trainer runs alone (no communicator of several ranks).
+  bool alone() const;
   // Appends the episodes that `step` ended (episodes_'s infos) to `ended`.
   void add_ended_episodes(const vector::VectorStepResult& step, std::vector<Episode>& ended) const;
 

@@ -69,10 +69,10 @@ std::vector<std::string> PpoAlgorithm::rank_blobs() const {
   return {"rng_sampling", "rng_augmentation"};
 }
 
-IterationStats PpoAlgorithm::iterate() {
-  const RolloutStats rollout = trainer_.collect();
+IterationStats PpoAlgorithm::iterate(const trainer::StopCheck& stop) {
+  const RolloutStats rollout = trainer_.collect(stop);
   const auto update_start = std::chrono::steady_clock::now();
-  const UpdateStats update = trainer_.update();
+  const UpdateStats update = trainer_.update(stop);
   const double update_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - update_start).count();
   IterationStats stats;

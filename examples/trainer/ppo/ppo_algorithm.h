@@ -25,7 +25,7 @@ class PpoActor final : public trainer::Actor {
   std::shared_ptr<Policy> policy_;
 };
 
-/// A Trainer on a vector env as an Algorithm: iterate() is collect() then update().
+/// A Trainer on a vector env as an Algorithm: iterate(stop) is collect(stop) then update(stop).
 ///
 /// Checkpoint: blobs "model" (the policy's parameters and buffers, torch::save), "optimizer"
 /// (Adam's state), "rng_sampling" and "rng_augmentation" (TrainerRngState), and meta
@@ -41,7 +41,7 @@ class PpoAlgorithm final : public trainer::Algorithm {
   PpoAlgorithm(vector::VectorEnv& env, PpoConfig config,
                trainer::Communicator* communicator = nullptr);
 
-  trainer::IterationStats iterate() override;
+  trainer::IterationStats iterate(const trainer::StopCheck& stop) override;
   std::int64_t env_steps() const override { return trainer_.env_steps(); }
   std::int64_t updates() const override { return trainer_.updates(); }
   void set_progress(std::int64_t env_steps, std::int64_t updates) override;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -52,6 +53,13 @@ struct IterationStats {
   std::map<std::string, double> extra;
 };
 
+/// Asked by an iteration between its small steps (each env step batch, each gradient step), with
+/// the env steps it has done so far (all envs, the run's before it included): the run reports
+/// progress from it and answers true when the iteration must end now (the run's time budget is
+/// spent, or it was interrupted). The iteration then ends as soon as what it did can be kept: a
+/// shorter rollout learned from, fewer gradient steps; the run checkpoints it as any other.
+using StopCheck = std::function<bool(std::int64_t env_steps)>;
+
 /// A learning algorithm on a vector env, driven by a TrainingRun: the run calls iterate() until
 /// its budget is spent, and checkpoints, resumes and evaluates through the calls below. The
 /// algorithm keeps a reference to the env it was built on (AlgorithmFactory::make) and is the
@@ -60,8 +68,9 @@ class Algorithm {
  public:
   virtual ~Algorithm() = default;
 
-  /// Collects experience from the env and learns from it (PPO: one rollout, one update).
-  virtual IterationStats iterate() = 0;
+  /// Collects experience from the env and learns from it (PPO: one rollout, one update), asking
+  /// `stop` (when set) between its steps; a stopped iteration still counts as one.
+  virtual IterationStats iterate(const StopCheck& stop) = 0;
 
   /// Env steps done (all envs together) and iterations done (the run names and spaces its
   /// checkpoints by them, and records them as "updates").

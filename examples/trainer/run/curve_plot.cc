@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <stdexcept>
 
 namespace pixelgym::trainer {
@@ -18,6 +19,7 @@ const cv::Scalar kText(30, 30, 30);
 const cv::Scalar kMean(180, 100, 25);   // a strong blue
 const cv::Scalar kBand(240, 215, 190);  // the same blue, pale
 const cv::Scalar kNote(120, 120, 120);
+const cv::Scalar kEvaluation(14, 127, 255);  // orange
 
 constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 constexpr double kTickScale = 0.42;
@@ -276,11 +278,44 @@ std::string format_tick(double value, double step, double axis_max_magnitude) {
   return buffer;
 }
 
-render::Image draw_curve(const ProgressTable& progress, const CurvePlotOptions& options) {
+namespace {
+
+// The evaluations: a marker with a +/- std bar each, joined by a thin line.
+void draw_evaluations(cv::Mat& image, const Panel& panel, const std::vector<double>& x,
+                      const EvaluationPoints& evaluations) {
+  std::optional<cv::Point> previous;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const double mean = evaluations.mean[i];
+    if (!finite(x[i]) || !finite(mean)) continue;
+    const double s = finite(evaluations.std[i]) ? evaluations.std[i] : 0.0;
+    const cv::Point at = panel.point(x[i], mean);
+    if (s > 0.0) {
+      cv::line(image, panel.point(x[i], mean - s), panel.point(x[i], mean + s), kEvaluation, 1,
+               cv::LINE_AA, kShift);
+    }
+    if (previous) cv::line(image, *previous, at, kEvaluation, 1, cv::LINE_AA, kShift);
+    previous = at;
+  }
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    if (!finite(x[i]) || !finite(evaluations.mean[i])) continue;
+    cv::circle(image, panel.point(x[i], evaluations.mean[i]), static_cast<int>(4 * kSubPixel),
+               kEvaluation, cv::FILLED, cv::LINE_AA, kShift);
+  }
+}
+
+}  // namespace
+
+render::Image draw_curve(const ProgressTable& progress, const CurvePlotOptions& options,
+                         const EvaluationPoints& evaluations) {
   if (options.width < 400 || options.height < 250) {
     throw std::invalid_argument("draw_curve: expected a size of at least 400x250, got " +
                                 std::to_string(options.width) + "x" +
                                 std::to_string(options.height));
+  }
+  const std::size_t evaluation_count = evaluations.steps.size();
+  if (evaluations.wall_time_s.size() != evaluation_count ||
+      evaluations.mean.size() != evaluation_count || evaluations.std.size() != evaluation_count) {
+    throw std::invalid_argument("draw_curve: the evaluations' members differ in length");
   }
   const std::vector<double> steps = progress.column("steps");
   const std::vector<double> wall_time_s = progress.column("wall_time_s");
@@ -302,6 +337,12 @@ render::Image draw_curve(const ProgressTable& progress, const CurvePlotOptions& 
     y_low = std::min(y_low, mean[i] - s);
     y_high = std::max(y_high, mean[i] + s);
   }
+  for (std::size_t i = 0; i < evaluation_count; ++i) {
+    if (!finite(evaluations.mean[i])) continue;
+    const double s = finite(evaluations.std[i]) ? evaluations.std[i] : 0.0;
+    y_low = std::min(y_low, evaluations.mean[i] - s);
+    y_high = std::max(y_high, evaluations.mean[i] + s);
+  }
   const bool any_return = finite(y_low);
   if (!any_return) {
     y_low = 0.0;
@@ -312,7 +353,7 @@ render::Image draw_curve(const ProgressTable& progress, const CurvePlotOptions& 
 
   // The legend, under the title.
   const int legend_y = title_y + 22;
-  const int legend_x = options.width / 2 - 110;
+  const int legend_x = options.width / 2 - (evaluation_count > 0 ? 200 : 110);
   cv::line(image, {legend_x, legend_y - 4}, {legend_x + 24, legend_y - 4}, kMean, 2, cv::LINE_AA);
   put_text(image, "mean over recent episodes", legend_x + 30, legend_y, kTickScale, kText,
            Align::kLeft);
@@ -320,6 +361,12 @@ render::Image draw_curve(const ProgressTable& progress, const CurvePlotOptions& 
       legend_x + 30 + text_size("mean over recent episodes", kTickScale, 1, &baseline).width + 16;
   cv::rectangle(image, cv::Rect(band_x, legend_y - 10, 24, 12), kBand, cv::FILLED);
   put_text(image, "+/- std", band_x + 30, legend_y, kTickScale, kText, Align::kLeft);
+  if (evaluation_count > 0) {
+    const int eval_x = band_x + 30 + text_size("+/- std", kTickScale, 1, &baseline).width + 16;
+    cv::circle(image, {eval_x + 12, legend_y - 4}, 4, kEvaluation, cv::FILLED, cv::LINE_AA);
+    put_text(image, "evaluations (eval.csv)", eval_x + 30, legend_y, kTickScale, kText,
+             Align::kLeft);
+  }
 
   // Two panels side by side; room on the left of each for the y tick labels.
   const PanelLayout layout = panel_layout(y_axis, y_magnitude, legend_y, options);
@@ -329,13 +376,27 @@ render::Image draw_curve(const ProgressTable& progress, const CurvePlotOptions& 
   const int panel_width = layout.panel_width;
   const int panel_height = layout.panel_height;
 
-  const auto [wall_time, wall_label] = wall_time_axis(wall_time_s);
+  // The wall time axis in one unit for the rows and the evaluations.
+  std::vector<double> all_wall = wall_time_s;
+  all_wall.insert(all_wall.end(), evaluations.wall_time_s.begin(), evaluations.wall_time_s.end());
+  const std::string wall_label = wall_time_axis(all_wall).second;
+  const double wall_unit = wall_label == "wall time (h)"     ? 3600.0
+                           : wall_label == "wall time (min)" ? 60.0
+                                                             : 1.0;
+  std::vector<double> wall_time;
+  for (const double value : wall_time_s) wall_time.push_back(value / wall_unit);
+  std::vector<double> evaluation_wall;
+  for (const double value : evaluations.wall_time_s) evaluation_wall.push_back(value / wall_unit);
   const std::vector<std::pair<std::vector<double>, std::string>> xs = {{steps, "env steps"},
                                                                        {wall_time, wall_label}};
   for (std::size_t p = 0; p < xs.size(); ++p) {
     const std::vector<double>& x = xs[p].first;
+    const std::vector<double>& evaluation_x = p == 0 ? evaluations.steps : evaluation_wall;
     double x_high = 0.0;
     for (const double value : x) {
+      if (finite(value)) x_high = std::max(x_high, value);
+    }
+    for (const double value : evaluation_x) {
       if (finite(value)) x_high = std::max(x_high, value);
     }
     if (x_high <= 0.0) x_high = 1.0;
@@ -351,6 +412,7 @@ render::Image draw_curve(const ProgressTable& progress, const CurvePlotOptions& 
     draw_band(image, panel, series);
     draw_axes(image, panel);  // grid lines over the band, under the mean
     draw_mean(image, panel, series);
+    draw_evaluations(image, panel, evaluation_x, evaluations);
     cv::rectangle(image, panel.area, kAxis, 1);
     if (!any_return) {
       put_text(image, "no episode has ended yet", panel.area.x + panel.area.width / 2,
@@ -456,8 +518,8 @@ render::Image draw_comparison(const std::vector<ComparedCurve>& curves,
 }
 
 void write_curve_png(const std::filesystem::path& path, const ProgressTable& progress,
-                     const CurvePlotOptions& options) {
-  const render::Image image = draw_curve(progress, options);
+                     const CurvePlotOptions& options, const EvaluationPoints& evaluations) {
+  const render::Image image = draw_curve(progress, options, evaluations);
   render::write_png(path.string(), image.view());
 }
 

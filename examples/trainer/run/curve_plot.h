@@ -19,6 +19,15 @@ struct CurvePlotOptions {
   std::string x_label = "control steps";
 };
 
+/// Evaluations to draw on a run's curve (eval.csv's rows): at env steps and wall time in
+/// seconds, their mean return and its std; all of one length.
+struct EvaluationPoints {
+  std::vector<double> steps;
+  std::vector<double> wall_time_s;
+  std::vector<double> mean;
+  std::vector<double> std;
+};
+
 /// One run's curve in a comparison: y against x (e.g. control steps) and against wall minutes.
 struct ComparedCurve {
   std::string label;
@@ -57,13 +66,16 @@ std::string format_tick(double value, double step, double axis_max_magnitude);
 /// Draws the curve: two panels, episode return against env steps and against wall time (in s,
 /// min or h by the run's length), each with the mean line, a band of +/- std, grid lines and
 /// tick labels. Rows whose episode_return_mean is NaN (no episode ended yet) leave gaps; an
-/// isolated point is drawn as a dot; with no finite return the panels say so. Returns RGB pixels.
-/// Throws std::invalid_argument for a size below the minimum or a table without the steps,
-/// wall_time_s, episode_return_mean and episode_return_std columns.
-render::Image draw_curve(const ProgressTable& progress, const CurvePlotOptions& options);
+/// isolated point is drawn as a dot; with no finite return the panels say so. `evaluations`
+/// (when any) are drawn over it in another colour, a marker with a +/- std bar each, joined by a
+/// thin line, and named in the legend. Returns RGB pixels. Throws std::invalid_argument for a
+/// size below the minimum, a table without the steps, wall_time_s, episode_return_mean and
+/// episode_return_std columns, or evaluations whose members differ in length.
+render::Image draw_curve(const ProgressTable& progress, const CurvePlotOptions& options,
+                         const EvaluationPoints& evaluations = {});
 
 /// draw_curve, written to `path` as a PNG atomically (render::write_png).
 void write_curve_png(const std::filesystem::path& path, const ProgressTable& progress,
-                     const CurvePlotOptions& options);
+                     const CurvePlotOptions& options, const EvaluationPoints& evaluations = {});
 
 }  // namespace pixelgym::trainer

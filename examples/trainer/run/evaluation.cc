@@ -1,11 +1,17 @@
 #include "examples/trainer/run/evaluation.h"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <fstream>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
 #include <utility>
 
+#include "pixelgym/envs/time_limit.h"
 #include "pixelgym/envs/vector/sync_vector_env.h"
+#include "pixelgym/envs/wrapper.h"
 #include "pixelgym/wrappers/record_video.h"
 
 namespace pixelgym::trainer {
@@ -14,20 +20,68 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-// One episode of `actor` from `seed` to its end; returns its return.
+using Clock = std::chrono::steady_clock;
+
+// Steps played before the cost of an evaluation step is timed.
+constexpr std::int64_t kWarmUpSteps = 5;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// One episode of `actor` from `seed` to its end (or `max_steps`, when > 0); returns its return
+// and adds its steps to `steps`.
 double play_episode(Actor& actor, vector::VectorEnv& env, std::uint64_t seed, bool deterministic,
-                    Value& actions, ActCounts& counts) {
+                    Value& actions, ActCounts& counts, std::int64_t& steps,
+                    const std::function<void()>& on_step, std::int64_t max_steps = 0) {
   const Value* obs = &env.reset(seed).obs;
   double total = 0.0;
-  for (;;) {
+  for (std::int64_t t = 0; max_steps <= 0 || t < max_steps; ++t) {
     const ActCounts step_counts = actor.act(*obs, deterministic, actions);
     counts.clipped_elements += step_counts.clipped_elements;
     counts.float_elements += step_counts.float_elements;
     const vector::VectorStepResult& step = env.step(actions);
+    ++steps;
+    if (on_step) on_step();
     total += step.rewards.data<double>()[0];
     obs = &step.obs;
     if (step.terminated.data<bool>()[0] || step.truncated.data<bool>()[0]) return total;
   }
+  return total;
+}
+
+// The shortest max_episode_steps of the TimeLimits around `env`'s core; 0 when there is none.
+std::int64_t time_limit_of(Env& env) {
+  std::int64_t limit = 0;
+  Env* layer = &env;
+  while (auto* wrapper = dynamic_cast<Wrapper*>(layer)) {
+    if (const auto* time_limit = dynamic_cast<const TimeLimit*>(wrapper)) {
+      const std::int64_t steps = time_limit->max_episode_steps();
+      limit = limit == 0 ? steps : std::min(limit, steps);
+    }
+    layer = &wrapper->env();
+  }
+  return limit;
+}
+
+// A vector env of one env built as the run's, recorded through `recorder` when `video_folder`
+// is given.
+std::unique_ptr<vector::SyncVectorEnv> evaluation_env(const RunSettings& settings,
+                                                      const EnvKwargsParser& parse_sets,
+                                                      const std::optional<fs::path>& video_folder,
+                                                      wrappers::RecordVideo*& recorder,
+                                                      std::int64_t* time_limit = nullptr) {
+  recorder = nullptr;
+  const vector::EnvFactory factory = [&](int) {
+    std::unique_ptr<Env> env = make_run_env(settings, parse_sets);
+    if (time_limit != nullptr) *time_limit = time_limit_of(*env);
+    if (!video_folder) return env;
+    auto recorded = std::make_unique<wrappers::RecordVideo>(
+        std::move(env), *video_folder, [](std::int64_t) { return false; }, nullptr, 0, "eval");
+    recorder = recorded.get();
+    return std::unique_ptr<Env>(std::move(recorded));
+  };
+  return std::make_unique<vector::SyncVectorEnv>(1, factory, vector::AutoresetMode::kDisabled);
 }
 
 // The checkpoint `run_or_checkpoint` names (see evaluate_checkpoint) and the folder of its run.
@@ -78,25 +132,24 @@ std::pair<RunSettings, const AlgorithmFactory*> checkpoint_settings(
 PolicyEvaluation evaluate(Actor& actor, const RunSettings& settings,
                           const EnvKwargsParser& parse_sets, const EvaluationRequest& request) {
   const std::optional<fs::path>& video = request.video;
+  std::optional<fs::path> video_folder;
+  if (video) video_folder = video->parent_path().empty() ? fs::path(".") : video->parent_path();
   wrappers::RecordVideo* recorder = nullptr;
-  const vector::EnvFactory factory = [&](int) {
-    std::unique_ptr<Env> env = make_run_env(settings, parse_sets);
-    if (!video) return env;
-    const fs::path folder = video->parent_path().empty() ? fs::path(".") : video->parent_path();
-    auto recorded = std::make_unique<wrappers::RecordVideo>(
-        std::move(env), folder, [](std::int64_t) { return false; }, nullptr, 0, "eval");
-    recorder = recorded.get();
-    return std::unique_ptr<Env>(std::move(recorded));
-  };
-  vector::SyncVectorEnv env(1, factory, vector::AutoresetMode::kDisabled);
+  const std::unique_ptr<vector::SyncVectorEnv> made =
+      evaluation_env(settings, parse_sets, video_folder, recorder);
+  vector::SyncVectorEnv& env = *made;
   Value actions = env.action_space().zeros();
   PolicyEvaluation result;
   ActCounts counts;
   for (std::int64_t e = 0; e < request.episodes; ++e) {
+    if (e > 0 && request.more && !request.more(e)) break;
+    const auto episode_start = Clock::now();
     if (e == 0 && recorder != nullptr) recorder->start_recording(video->stem().string());
     result.returns.push_back(play_episode(actor, env, request.seed + static_cast<std::uint64_t>(e),
-                                          !request.stochastic, actions, counts));
+                                          !request.stochastic, actions, counts, result.steps,
+                                          request.on_step));
     if (e == 0 && recorder != nullptr) recorder->stop_recording();
+    result.episode_s.push_back(seconds_since(episode_start));
   }
   double sum = 0.0;
   for (const double r : result.returns) sum += r;
@@ -110,6 +163,109 @@ PolicyEvaluation evaluate(Actor& actor, const RunSettings& settings,
   }
   env.close();
   return result;
+}
+
+double EvaluationCost::episode_seconds(bool video) const {
+  const auto steps = static_cast<double>(episode_steps);
+  return video ? video_fixed_s + steps * video_step_s : steps * step_s;
+}
+
+double EvaluationCost::evaluation_seconds(std::int64_t episodes, bool video) const {
+  if (episodes <= 0) return 0.0;
+  return setup_s + episode_seconds(video) +
+         static_cast<double>(episodes - 1) * episode_seconds(false);
+}
+
+EvaluationCost measure_evaluation_cost(Actor& actor, const RunSettings& settings,
+                                       const EnvKwargsParser& parse_sets,
+                                       const fs::path& scratch_folder, std::int64_t steps,
+                                       const std::function<void()>& on_step) {
+  EvaluationCost cost;
+  const auto setup_start = Clock::now();
+  wrappers::RecordVideo* recorder = nullptr;
+  std::int64_t time_limit = 0;
+  const std::unique_ptr<vector::SyncVectorEnv> made =
+      evaluation_env(settings, parse_sets, scratch_folder, recorder, &time_limit);
+  vector::SyncVectorEnv& env = *made;
+  Value actions = env.action_space().zeros();
+  cost.setup_s = seconds_since(setup_start);
+  if (time_limit > 0) {
+    cost.episode_steps = time_limit;
+    cost.episode_steps_known = true;
+  }
+  ActCounts counts;
+  // Untimed: the first steps warm the policy and the renderer up.
+  std::int64_t warm = 0;
+  play_episode(actor, env, settings.seed() + kEvaluationSeedOffset, true, actions, counts, warm,
+               on_step, kWarmUpSteps);
+  std::int64_t played = 0;
+  auto start = Clock::now();
+  while (played < steps) {
+    play_episode(actor, env, settings.seed() + kEvaluationSeedOffset, true, actions, counts, played,
+                 on_step, steps - played);
+  }
+  cost.step_s = seconds_since(start) / static_cast<double>(played);
+  // Recorded: the first step opens the video file and the last finishes it (fixed costs); the
+  // steps between are the per-step cost.
+  const std::string scratch = ".evaluation_cost_probe";
+  recorder->start_recording(scratch);
+  start = Clock::now();
+  std::int64_t recorded = 0;
+  play_episode(actor, env, settings.seed() + kEvaluationSeedOffset, true, actions, counts, recorded,
+               on_step, 1);
+  const double first_s = seconds_since(start);
+  start = Clock::now();
+  const std::int64_t more = std::max<std::int64_t>(steps - 1, 1);
+  std::int64_t later = 0;
+  while (later < more) {
+    play_episode(actor, env, settings.seed() + kEvaluationSeedOffset, true, actions, counts, later,
+                 on_step, more - later);
+  }
+  // A recorded step costs what a plain one does and more (the timings of a busy machine may say
+  // otherwise).
+  cost.video_step_s = std::max(seconds_since(start) / static_cast<double>(later), cost.step_s);
+  start = Clock::now();
+  recorder->stop_recording();
+  cost.video_fixed_s = std::max(0.0, first_s - cost.video_step_s) + seconds_since(start);
+  env.close();
+  std::error_code ignored;
+  fs::remove(scratch_folder / (scratch + ".mp4"), ignored);
+  return cost;
+}
+
+FinalEvaluationPlan plan_final_evaluation(double seconds, const EvaluationCost& cost,
+                                          std::int64_t asked) {
+  FinalEvaluationPlan plan;
+  const auto fitting = [&](bool video) {
+    std::int64_t episodes = asked;
+    while (episodes > 1 && cost.evaluation_seconds(episodes, video) > seconds) --episodes;
+    return episodes;
+  };
+  const auto plural = [](std::int64_t n) { return n == 1 ? " episode" : " episodes"; };
+  std::ostringstream note;
+  note.precision(2);
+  note << std::fixed;
+  if (cost.evaluation_seconds(1, true) <= seconds) {
+    plan.video = true;
+    plan.episodes = fitting(true);
+  } else {
+    plan.video = false;
+    plan.episodes = fitting(false);
+    note << "no final.mp4 (one recorded episode takes about " << cost.evaluation_seconds(1, true)
+         << " s, more than the " << std::max(seconds, 0.0) << " s the time budget leaves it)";
+  }
+  if (plan.episodes < asked) {
+    if (!note.str().empty()) note << "; ";
+    note << plan.episodes << " of --eval-episodes " << asked << plural(asked) << " (about "
+         << cost.episode_seconds(false) << " s each at most, "
+         << cost.evaluation_seconds(plan.episodes, plan.video) << " s in all"
+         << (cost.evaluation_seconds(plan.episodes, plan.video) > seconds ? ", more than the "
+                                                                          : " of the ")
+         << std::max(seconds, 0.0) << " s the time budget leaves)";
+  }
+  plan.seconds = cost.evaluation_seconds(plan.episodes, plan.video);
+  plan.note = note.str();
+  return plan;
 }
 
 json evaluation_json(const PolicyEvaluation& evaluation, const EvaluationRequest& request) {
@@ -127,11 +283,33 @@ json evaluation_json(const PolicyEvaluation& evaluation, const EvaluationRequest
 CheckpointEvaluation evaluate_checkpoint(const AlgorithmFactories& algorithms,
                                          const EnvKwargsParser& parse_sets,
                                          const fs::path& run_or_checkpoint,
-                                         const EvaluationRequest& request, std::ostream& errors) {
+                                         const CheckpointEvaluationRequest& given,
+                                         std::ostream& errors) {
   const auto [checkpoint, folder] = find_checkpoint(run_or_checkpoint, errors);
   auto [settings, found] = checkpoint_settings(checkpoint, folder, algorithms);
   const AlgorithmFactory& algorithm = *found;
-  CheckpointEvaluation result{checkpoint.path, std::move(settings), {}};
+  CheckpointEvaluation result{checkpoint.path, std::move(settings), {}, {}, {}};
+  // The run's final evaluation: summary.json's when it is of this checkpoint (the same env
+  // steps), else the run's settings.
+  EvaluationRequest& request = result.request;
+  request.episodes = result.settings.eval_episodes;
+  request.seed = result.settings.seed() + kEvaluationSeedOffset;
+  result.defaults_from = "the run's settings";
+  std::ifstream summary_file(folder / "summary.json");
+  const json summary = summary_file ? json::parse(summary_file, nullptr, false) : json();
+  const auto meta = checkpoint.blobs.find("meta");
+  if (summary.is_object() && summary.contains("evaluation") && meta != checkpoint.blobs.end() &&
+      json::parse(meta->second, nullptr, false).value("env_steps", std::int64_t{-1}) ==
+          summary.value("env_steps", std::int64_t{-2})) {
+    const json& evaluation = summary.at("evaluation");
+    request.episodes = evaluation.value("episodes", request.episodes);
+    request.seed = evaluation.value("seed", request.seed);
+    result.defaults_from = "summary.json";
+  }
+  if (given.episodes) request.episodes = *given.episodes;
+  if (given.seed) request.seed = *given.seed;
+  request.stochastic = given.stochastic;
+  request.video = given.video;
   algorithm.set_threads(result.settings.torch_threads);
   // The spaces come from one env built as the run's.
   std::unique_ptr<Env> probe = make_run_env(result.settings, parse_sets);

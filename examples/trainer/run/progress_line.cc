@@ -4,9 +4,11 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <utility>
 
 namespace pixelgym::trainer {
 namespace {
@@ -129,13 +131,25 @@ std::string format_plain_line(const ProgressStatus& status) {
   return line;
 }
 
-ProgressLine::ProgressLine(std::ostream& out, Mode mode, int every_n_updates, int columns)
-    : out_(out), mode_(mode), every_n_updates_(every_n_updates), columns_(columns) {
+ProgressLine::ProgressLine(std::ostream& out, Mode mode, int every_n_updates, int columns,
+                           Clock clock)
+    : out_(out),
+      mode_(mode),
+      every_n_updates_(every_n_updates),
+      columns_(columns),
+      clock_(std::move(clock)) {
   if (every_n_updates < 1 || columns < 20) {
     throw std::invalid_argument(
         "ProgressLine: expected every_n_updates >= 1 and columns >= 20, got " +
         std::to_string(every_n_updates) + " and " + std::to_string(columns));
   }
+  if (!clock_) {
+    clock_ = [] {
+      return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
+          .count();
+    };
+  }
+  last_line_s_ = clock_();
 }
 
 ProgressLine::Mode ProgressLine::mode_for_stdout(bool quiet) {
@@ -153,21 +167,61 @@ int ProgressLine::stdout_columns() {
 
 void ProgressLine::update(const ProgressStatus& status) {
   ++updates_;
+  const double now = clock_();
   if (mode_ == Mode::kBar) {
     out_ << '\r' << format_bar_line(status, columns_) << "\x1b[K" << std::flush;
+    last_line_s_ = now;
+    bar_open_ = true;
     return;
   }
-  last_written_ = updates_ % every_n_updates_ == 0;
-  if (last_written_) out_ << format_plain_line(status) << '\n' << std::flush;
+  last_written_ = updates_ % every_n_updates_ == 0 || now - last_line_s_ >= kMaxSilenceS;
+  if (last_written_) {
+    out_ << format_plain_line(status) << '\n' << std::flush;
+    last_line_s_ = now;
+  }
+}
+
+bool ProgressLine::tick(const ProgressStatus& status) {
+  const double now = clock_();
+  if (mode_ == Mode::kBar) {
+    if (now - last_line_s_ < 1.0) return false;
+    out_ << '\r' << format_bar_line(status, columns_) << "\x1b[K" << std::flush;
+    last_line_s_ = now;
+    bar_open_ = true;
+    return true;
+  }
+  if (now - last_line_s_ < kMaxSilenceS) return false;
+  out_ << format_plain_line(status) << '\n' << std::flush;
+  last_line_s_ = now;
+  last_written_ = false;  // the update's own state is still to come
+  return true;
+}
+
+bool ProgressLine::tick_note(const std::string& line) {
+  const double now = clock_();
+  if (now - last_line_s_ < kMaxSilenceS) return false;
+  if (bar_open_) out_ << '\n';
+  bar_open_ = false;
+  out_ << line << '\n' << std::flush;
+  last_line_s_ = now;
+  return true;
+}
+
+void ProgressLine::wrote_line() {
+  last_line_s_ = clock_();
+  bar_open_ = false;
 }
 
 void ProgressLine::finish(const ProgressStatus& status) {
   if (mode_ == Mode::kBar) {
     out_ << '\r' << format_bar_line(status, columns_) << "\x1b[K\n" << std::flush;
+    last_line_s_ = clock_();
+    bar_open_ = false;
     return;
   }
   if (!last_written_) out_ << format_plain_line(status) << '\n' << std::flush;
   last_written_ = true;
+  last_line_s_ = clock_();
 }
 
 }  // namespace pixelgym::trainer

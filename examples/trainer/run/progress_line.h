@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <ostream>
 #include <string>
@@ -47,24 +48,43 @@ std::string format_bar_line(const ProgressStatus& status, int columns);
 /// 0:36  ETA 4:05".
 std::string format_plain_line(const ProgressStatus& status);
 
-/// Writes the progress to a stream once per update.
+/// Writes the progress to a stream once per update, and within updates so that a reader of a
+/// pipe never waits long: a plain line at least every kMaxSilenceS seconds.
 class ProgressLine {
  public:
   enum class Mode {
     kBar,    // redraw one line in place ('\r', then erase to the end of the line)
-    kPlain,  // a plain line every `every_n_updates` updates
+    kPlain,  // a plain line every `every_n_updates` updates, or kMaxSilenceS after the last line
   };
 
+  /// The most seconds between two lines in kPlain while updates, evaluations or ticks go on (the
+  /// promise is a line at least every 10 s; ticks come between small steps, so the slack covers
+  /// the longest step).
+  static constexpr double kMaxSilenceS = 6.0;
+  /// Seconds on a monotonic clock (steady_clock when absent).
+  using Clock = std::function<double()>;
+
   /// Throws std::invalid_argument for every_n_updates < 1 or columns < 20.
-  ProgressLine(std::ostream& out, Mode mode, int every_n_updates, int columns = 100);
+  ProgressLine(std::ostream& out, Mode mode, int every_n_updates, int columns = 100,
+               Clock clock = {});
 
   /// kBar when stdout is a terminal and not `quiet`, else kPlain.
   static Mode mode_for_stdout(bool quiet);
   /// The width of the terminal on stdout, or 100 when it is not one.
   static int stdout_columns();
 
-  /// Reports one update (flushes what it writes).
+  /// Reports one update (flushes what it writes): kPlain writes the line every every_n_updates
+  /// updates, or when kMaxSilenceS passed since the last line.
   void update(const ProgressStatus& status);
+  /// Reports progress within an update (call it often): kPlain writes the line when
+  /// kMaxSilenceS passed since the last line, kBar redraws the bar at most once a second.
+  /// Returns whether it wrote.
+  bool tick(const ProgressStatus& status);
+  /// Writes `line` (and a newline) when kMaxSilenceS passed since the last line: progress of
+  /// work that is not training (an evaluation). Returns whether it wrote.
+  bool tick_note(const std::string& line);
+  /// Says that the caller wrote a line of its own to the stream (the silence starts again).
+  void wrote_line();
   /// Reports the end: the bar's last state and a newline, or the final plain line (unless the
   /// last update wrote that state already).
   void finish(const ProgressStatus& status);
@@ -74,8 +94,11 @@ class ProgressLine {
   Mode mode_;
   int every_n_updates_;
   int columns_;
+  Clock clock_;
+  double last_line_s_ = 0.0;  // when the last line was written (or the bar drawn)
   std::int64_t updates_ = 0;
-  bool last_written_ = false;  // the last update wrote a plain line
+  bool last_written_ = false;  // the last update or tick wrote a plain line of the latest state
+  bool bar_open_ = false;      // kBar: the bar is drawn and its line not ended
 };
 
 }  // namespace pixelgym::trainer

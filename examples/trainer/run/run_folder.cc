@@ -247,10 +247,10 @@ void RunFolder::append_progress(const ProgressRow& row) {
   progress_.rows.push_back(std::move(values));
 }
 
-void RunFolder::write_curve(const std::string& title) const {
+void RunFolder::write_curve(const std::string& title, const EvaluationPoints& evaluations) const {
   CurvePlotOptions options;
   options.title = title;
-  write_curve_png(folder_ / kCurveName, progress_, options);
+  write_curve_png(folder_ / kCurveName, progress_, options, evaluations);
 }
 
 void RunFolder::write_summary(const nlohmann::json& summary) const {

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "examples/trainer/run/curve_plot.h"
 #include "examples/trainer/run/progress_csv.h"
 
 namespace pixelgym::trainer {
@@ -58,8 +59,9 @@ class RunFolder {
   /// naming the file when the write fails.
   void append_progress(const ProgressRow& row);
 
-  /// Draws progress() into curve.png (see write_curve_png), titled `title`.
-  void write_curve(const std::string& title) const;
+  /// Draws progress() and `evaluations` (eval.csv's) into curve.png (see write_curve_png),
+  /// titled `title`.
+  void write_curve(const std::string& title, const EvaluationPoints& evaluations = {}) const;
 
   /// Writes summary.json atomically (pretty-printed).
   void write_summary(const nlohmann::json& summary) const;

@@ -10,8 +10,10 @@
 #include <vector>
 
 #include "examples/trainer/run/atomic_file.h"
+#include "examples/trainer/run/curve_plot.h"
 #include "examples/trainer/run/evaluation.h"
 #include "examples/trainer/run/observation_summary.h"
+#include "examples/trainer/run/process_tuning.h"
 
 namespace pixelgym::trainer {
 namespace {
@@ -19,25 +21,49 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-// Episodes whose returns the progress rows summarize (as Stable-Baselines3's ep_info_buffer).
+// Episodes whose returns the progress rows summarize at most (as Stable-Baselines3's
+// ep_info_buffer), and the share of the env steps done that their window spans at least.
 constexpr std::size_t kReturnWindow = 100;
+constexpr std::int64_t kReturnWindowStepsDivisor = 10;
 
-// The seed of the final evaluation's first episode: seed + this.
-constexpr std::uint64_t kEvaluationSeedOffset = 1'000'000;
+// Env steps of the evaluation cost's measurement (each of plain and recorded).
+constexpr std::int64_t kCostProbeSteps = 20;
+// Seconds kept for the last checkpoint and the end of the iteration in progress.
+constexpr double kCheckpointMarginS = 1.0;
 
-double mean_of(const std::deque<double>& values) {
+using Returns = RecentReturns;
+
+double mean_of(const Returns& values) {
   if (values.empty()) return std::nan("");
   double sum = 0.0;
-  for (const double v : values) sum += v;
+  for (const auto& v : values) sum += v.second;
   return sum / static_cast<double>(values.size());
 }
 
-double std_of(const std::deque<double>& values) {
+double std_of(const Returns& values) {
   if (values.empty()) return std::nan("");
   const double mean = mean_of(values);
   double squares = 0.0;
-  for (const double v : values) squares += (v - mean) * (v - mean);
+  for (const auto& v : values) squares += (v.second - mean) * (v.second - mean);
   return std::sqrt(squares / static_cast<double>(values.size()));
+}
+
+// eval.csv's rows as curve.png draws them.
+EvaluationPoints evaluation_points(const std::vector<EvalRow>& rows) {
+  EvaluationPoints points;
+  for (const EvalRow& row : rows) {
+    points.steps.push_back(static_cast<double>(row.steps));
+    points.wall_time_s.push_back(row.wall_time_s);
+    points.mean.push_back(row.return_mean);
+    points.std.push_back(row.return_std);
+  }
+  return points;
+}
+
+std::string one_decimal(double s) {
+  std::ostringstream text;
+  text << std::fixed << std::setprecision(1) << s;
+  return text.str();
 }
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
@@ -124,6 +150,17 @@ CheckpointBlobs rank_checkpoint(const CheckpointBlobs& all, int rank, int world,
 const char* const kEvalHeader = "steps,wall_time_s,return_mean,return_std,episodes,eval_s";
 
 }  // namespace
+
+void add_recent_returns(RecentReturns& recent, const std::vector<double>& returns,
+                        std::int64_t steps, std::int64_t iteration_steps) {
+  for (const double episode_return : returns) {
+    recent.emplace_back(steps, episode_return);
+    if (recent.size() > kReturnWindow) recent.pop_front();
+  }
+  const std::int64_t window =
+      std::max(steps / kReturnWindowStepsDivisor, std::max<std::int64_t>(iteration_steps, 1));
+  while (recent.size() > 1 && recent.front().first < steps - window) recent.pop_front();
+}
 
 std::string format_eval_csv(const std::vector<EvalRow>& rows) {
   std::ostringstream out;
@@ -402,7 +439,13 @@ std::optional<json> TrainingRun::train() {
     const bool nothing = checkpoint_ && nothing_to_do();
     // The count in use goes into config.json, so that a resume runs with it (results depend on
     // it).
+    const bool threads_given = settings_.torch_threads != 0;
     settings_.torch_threads = factory_->set_threads(settings_.torch_threads);
+    if (!nothing) {
+      const std::string warning =
+          busy_cores_warning(settings_.torch_threads, threads_given, cpu_availability());
+      if (!warning.empty()) output_.out << warning << std::endl;
+    }
     if (distributed()) send_start(nothing);
     if (nothing) {
       if (communicator_ != nullptr) communicator_->finish();
@@ -453,6 +496,12 @@ std::optional<json> TrainingRun::train() {
     communicator_->finish();
     return std::nullopt;
   }
+  if (interrupted_) {
+    output_.out << "interrupted at " << algorithm_->env_steps() << " env steps: wrote "
+                << last_checkpoint_.string() << " (no final evaluation)" << std::endl;
+    if (communicator_ != nullptr) communicator_->finish();
+    return std::nullopt;
+  }
   json summary = evaluate_and_summarize();
   if (communicator_ != nullptr) communicator_->finish();
   return summary;
@@ -462,8 +511,12 @@ void TrainingRun::restore_from_checkpoint() {
   algorithm_->set_progress(meta_.at("env_steps").get<std::int64_t>(),
                            meta_.at("updates").get<std::int64_t>());
   algorithm_->restore(*checkpoint_, meta_);
-  for (const double r : meta_.at("recent_returns").get<std::vector<double>>()) {
-    returns_.push_back(r);
+  const auto recent = meta_.at("recent_returns").get<std::vector<double>>();
+  // Checkpoints written before the steps were kept: as if they ended at the checkpoint.
+  const auto ended = meta_.value("recent_return_steps",
+                                 std::vector<std::int64_t>(recent.size(), algorithm_->env_steps()));
+  for (std::size_t i = 0; i < recent.size(); ++i) {
+    returns_.emplace_back(i < ended.size() ? ended[i] : algorithm_->env_steps(), recent[i]);
   }
   // The budget from here on: the env steps, and the minutes of wall time over the whole run
   // (0: none), with the minutes this resume was given, when it was.
@@ -511,50 +564,108 @@ void TrainingRun::replay_env_actions() {
 
 double TrainingRun::elapsed_s() const { return wall_before_s_ + seconds_since(start_); }
 
+bool TrainingRun::interrupt_requested() const {
+  return interrupt_ != nullptr && interrupt_->load();
+}
+
+void TrainingRun::update_training_deadline() {
+  planned_ =
+      plan_final_evaluation(kEvaluationShare * left_at_start_s_, *cost_, settings_.eval_episodes);
+  // Never more than the share: an episode estimated at its longest (max_episode_steps) may end
+  // far sooner, and training keeps the rest of the budget.
+  const double kept =
+      std::min(planned_.seconds, kEvaluationShare * std::max(left_at_start_s_, 0.0));
+  training_deadline_s_ = time_limit_s_ - kept - kCheckpointMarginS;
+}
+
+void TrainingRun::plan_time_budget() {
+  training_deadline_s_ = time_limit_s_;
+  left_at_start_s_ = time_limit_s_ - elapsed_s();
+  if (time_limit_s_ <= 0.0 || !lead()) return;
+  const auto probe_start = std::chrono::steady_clock::now();
+  cost_ = measure_evaluation_cost(
+      algorithm_->actor(), settings_, parse_sets_, run_->path(), kCostProbeSteps, [&] {
+        progress_->tick_note("time budget: timing evaluation steps (" +
+                             one_decimal(seconds_since(probe_start)) + " s so far)");
+      });
+  update_training_deadline();
+  output_.out << "time budget: " << one_decimal(std::max(left_at_start_s_, 0.0))
+              << " s left; an evaluation episode takes about "
+              << one_decimal(cost_->episode_seconds(false)) << " s (its " << cost_->episode_steps
+              << " steps at most"
+              << (cost_->episode_steps_known ? "" : ", the env has no TimeLimit: 1000 assumed")
+              << "), so training stops at about "
+              << one_decimal(std::max(training_deadline_s_, 0.0)) << " s of the run's "
+              << one_decimal(time_limit_s_) << " s to keep "
+              << one_decimal(time_limit_s_ - kCheckpointMarginS - training_deadline_s_)
+              << " s for the final evaluation (" << planned_.episodes
+              << (planned_.episodes == 1 ? " episode" : " episodes")
+              << (planned_.video ? ", the first recorded to final.mp4" : ", no video") << ")"
+              << (planned_.note.empty() ? "" : ": " + planned_.note) << std::endl;
+  progress_->wrote_line();
+}
+
+bool TrainingRun::stop_requested(std::int64_t env_steps) {
+  if (!lead()) return false;
+  status_.steps = env_steps;
+  status_.elapsed_s = elapsed_s();
+  progress_->tick(status_);
+  // The ranks of a distributed run end their iterations together: between iterations only.
+  if (distributed()) return false;
+  return interrupt_requested() ||
+         (time_limit_s_ > 0.0 && status_.elapsed_s >= training_deadline_s_);
+}
+
 void TrainingRun::train_until_spent() {
   const std::string title = settings_.env_id + " (" + folder_.filename().string() + ")";
-  ProgressLine progress(output_.out, output_.progress_mode, 10, output_.columns);
+  progress_.emplace(output_.out, output_.progress_mode, 10, output_.columns);
   start_ = std::chrono::steady_clock::now();
   // The time budget counts the run's whole wall time, as of its latest checkpoint: a killed
   // 10-minute run, resumed, trains for what was left of its 10 minutes. Minutes given to this
-  // process add to the wall time so far, and always allow one update.
-  const double time_limit_s = budget_minutes_ * 60.0;
+  // process add to the wall time so far, and always allow one update (which the budget may cut
+  // short).
+  time_limit_s_ = budget_minutes_ * 60.0;
   bool one_update_due = minutes_given_ > 0.0;
   const std::int64_t total_steps = settings_.total_env_steps();
   // Where the run stands before any update of this process (what the line shows should none be
   // left to do).
-  ProgressStatus status{algorithm_->env_steps(), total_steps,      elapsed_s(), time_limit_s,
-                        ProgressStatus::kNone,   mean_of(returns_)};
-  while (keep_training(algorithm_->env_steps() < total_steps &&
-                       (time_limit_s <= 0.0 || one_update_due || elapsed_s() < time_limit_s))) {
+  status_ = {algorithm_->env_steps(), total_steps,           elapsed_s(),
+             time_limit_s_,           ProgressStatus::kNone, mean_of(returns_)};
+  plan_time_budget();
+  const StopCheck stop = [this](std::int64_t steps) { return stop_requested(steps); };
+  while (keep_training(
+      algorithm_->env_steps() < total_steps && !interrupt_requested() &&
+      (time_limit_s_ <= 0.0 || one_update_due || elapsed_s() < training_deadline_s_))) {
     one_update_due = false;
     const std::int64_t steps_before = algorithm_->env_steps();
-    const ProgressRow row = iterate_once();
+    const ProgressRow row = iterate_once(stop);
     if (distributed() && algorithm_->updates() % kDigestEvery == 0) {
       parameter_digests_ = check_same_on_every_rank(*communicator_, algorithm_->parameter_digest(),
                                                     algorithm_->updates());
     }
     if (lead()) {
-      run_->write_curve(title);
       evaluate_when_due(steps_before);
+      run_->write_curve(title, evaluation_points(evals_));
     }
     if (algorithm_->updates() % settings_.checkpoint_every == 0) save_checkpoint();
-    status = {algorithm_->env_steps(), total_steps, elapsed_s(), time_limit_s, row.fps,
-              row.episode_return_mean};
-    progress.update(status);
+    status_ = {algorithm_->env_steps(), total_steps, elapsed_s(),
+               time_limit_s_,           row.fps,     row.episode_return_mean};
+    progress_->update(status_);
   }
-  progress.finish(status);
+  progress_->finish(status_);
+  interrupted_ = interrupt_requested();
+  stopped_by_ = interrupted_                             ? "interrupt"
+                : algorithm_->env_steps() >= total_steps ? "steps"
+                                                         : "time";
 }
 
-ProgressRow TrainingRun::iterate_once() {
+ProgressRow TrainingRun::iterate_once(const StopCheck& stop) {
   const auto iteration_start = std::chrono::steady_clock::now();
   const std::int64_t steps_before = algorithm_->env_steps();
-  IterationStats stats = algorithm_->iterate();
+  IterationStats stats = algorithm_->iterate(stop);
   stats.episode_returns = gather_returns(stats.episode_returns);
-  for (const double episode_return : stats.episode_returns) {
-    returns_.push_back(episode_return);
-    if (returns_.size() > kReturnWindow) returns_.pop_front();
-  }
+  add_recent_returns(returns_, stats.episode_returns, algorithm_->env_steps(),
+                     algorithm_->env_steps() - steps_before);
   const double seconds = seconds_since(iteration_start);
   ProgressRow row;
   row.steps = algorithm_->env_steps();
@@ -572,6 +683,14 @@ ProgressRow TrainingRun::iterate_once() {
   return row;
 }
 
+void TrainingRun::report_skip(const std::string& reason, const std::string& line) {
+  ++evaluations_skipped_;
+  if (!skip_reasons_.insert(reason).second) return;
+  output_.out << line << " (later evaluations skipped for this reason are not reported)"
+              << std::endl;
+  progress_->wrote_line();
+}
+
 void TrainingRun::evaluate_when_due(std::int64_t steps_before) {
   const std::int64_t every = settings_.eval_every;
   const std::int64_t steps = algorithm_->env_steps();
@@ -583,14 +702,33 @@ void TrainingRun::evaluate_when_due(std::int64_t steps_before) {
     return text.str();
   };
   if (eval_seconds_ > settings_.eval_max_share * this_process_s) {
-    output_.out << "eval at " << steps << " env steps skipped: evaluations took "
-                << seconds(eval_seconds_) << " s of " << seconds(this_process_s)
-                << " s, more than --eval-max-share " << settings_.eval_max_share << "\n";
+    std::ostringstream share;
+    share << settings_.eval_max_share;
+    report_skip("share", "eval at " + std::to_string(steps) +
+                             " env steps skipped: evaluations took " + seconds(eval_seconds_) +
+                             " s of " + seconds(this_process_s) +
+                             " s, more than --eval-max-share " + share.str());
     return;
   }
+  if (cost_ && time_limit_s_ > 0.0) {
+    const double needed = cost_->evaluation_seconds(settings_.eval_every_episodes, false);
+    const double left = training_deadline_s_ - elapsed_s();
+    if (needed > left) {
+      report_skip("time", "eval at " + std::to_string(steps) +
+                              " env steps skipped: it takes about " + seconds(needed) +
+                              " s and the time budget leaves training " +
+                              seconds(std::max(left, 0.0)) + " s");
+      return;
+    }
+  }
   const auto eval_start = std::chrono::steady_clock::now();
-  const EvaluationRequest request{settings_.eval_every_episodes,
-                                  settings_.seed() + kEvaluationSeedOffset, false, std::nullopt};
+  EvaluationRequest request;
+  request.episodes = settings_.eval_every_episodes;
+  request.seed = settings_.seed() + kEvaluationSeedOffset;
+  request.on_step = [this, steps, eval_start] {
+    progress_->tick_note("eval at " + std::to_string(steps) + " env steps: evaluating (" +
+                         one_decimal(seconds_since(eval_start)) + " s so far)");
+  };
   const PolicyEvaluation evaluation =
       evaluate(algorithm_->actor(), settings_, parse_sets_, request);
   EvalRow row;
@@ -606,7 +744,15 @@ void TrainingRun::evaluate_when_due(std::int64_t steps_before) {
   write_file_atomically(run_->path() / "eval.csv", {text}, "train");
   output_.out << "eval at " << steps << " env steps: return " << evaluation.mean << " +/- "
               << evaluation.std << " over " << row.episodes << " episodes (" << seconds(row.eval_s)
-              << " s)\n";
+              << " s)" << std::endl;
+  progress_->wrote_line();
+  if (cost_ && evaluation.steps > 0) {
+    // What the episodes cost now, for the final evaluation's share of the budget.
+    double played_s = 0.0;
+    for (const double s : evaluation.episode_s) played_s += s;
+    cost_->step_s = played_s / static_cast<double>(evaluation.steps);
+    update_training_deadline();
+  }
 }
 
 void TrainingRun::save_checkpoint() {
@@ -637,30 +783,92 @@ void TrainingRun::save_checkpoint() {
   meta["env_steps"] = algorithm_->env_steps();
   meta["updates"] = algorithm_->updates();
   meta["wall_time_s"] = elapsed_s();
-  meta["recent_returns"] = std::vector<double>(returns_.begin(), returns_.end());
+  std::vector<double> recent;
+  std::vector<std::int64_t> ended;
+  for (const auto& [steps, value] : returns_) {
+    ended.push_back(steps);
+    recent.push_back(value);
+  }
+  meta["recent_returns"] = recent;
+  meta["recent_return_steps"] = ended;
   // Where the envs are, for a resume to check its replay of the actions below against.
   meta["env_digest"] = algorithm_->env_digest();
   blobs["meta"] = meta.dump();
   // The envs' state, as the actions that led to it; none when the log does not go back to the
   // first reset.
   if (algorithm_->env_action_log_complete()) blobs["env_actions"] = algorithm_->env_action_log();
-  write_checkpoint(run_->checkpoint_path(algorithm_->updates()), blobs);
+  last_checkpoint_ = run_->checkpoint_path(algorithm_->updates());
+  write_checkpoint(last_checkpoint_, blobs);
   prune_checkpoints(run_->path(), settings_.keep_checkpoints);
 }
 
 json TrainingRun::evaluate_and_summarize() {
   const fs::path video = run_->path() / "final.mp4";
-  const EvaluationRequest request{settings_.eval_episodes, settings_.seed() + kEvaluationSeedOffset,
-                                  false, video};
+  EvaluationRequest request;
+  request.episodes = settings_.eval_episodes;
+  request.seed = settings_.seed() + kEvaluationSeedOffset;
+  request.video = video;
+  std::string note;
+  if (cost_ && time_limit_s_ > 0.0) {
+    // What the time left holds, at least one episode; then another only while one fits.
+    const FinalEvaluationPlan plan =
+        plan_final_evaluation(time_limit_s_ - elapsed_s(), *cost_, settings_.eval_episodes);
+    request.episodes = plan.episodes;
+    if (!plan.video) request.video.reset();
+    note = plan.note;
+    if (!note.empty()) {
+      output_.out << "final evaluation: " << note << std::endl;
+      progress_->wrote_line();
+    }
+  }
+  std::optional<std::chrono::steady_clock::time_point> first_plain;
+  if (cost_ && time_limit_s_ > 0.0) {
+    request.more = [&](std::int64_t done) {
+      const auto now = std::chrono::steady_clock::now();
+      if (!first_plain) first_plain = now;
+      const double next = done >= 2 ? seconds_since(*first_plain) / static_cast<double>(done - 1)
+                                    : cost_->episode_seconds(false);
+      return elapsed_s() + next <= time_limit_s_;
+    };
+  }
+  const auto eval_start = std::chrono::steady_clock::now();
+  request.on_step = [&] {
+    progress_->tick_note("final evaluation: " + one_decimal(seconds_since(eval_start)) +
+                         " s so far");
+  };
+  std::error_code ignored;
+  if (!request.video) fs::remove(video, ignored);  // a previous process's, not of this policy
   const PolicyEvaluation evaluation =
       evaluate(algorithm_->actor(), settings_, parse_sets_, request);
+  const auto played = static_cast<std::int64_t>(evaluation.returns.size());
+  if (played < request.episodes) {
+    const std::string cut = std::to_string(played) + " of " + std::to_string(request.episodes) +
+                            " episodes: the time budget held no more";
+    note += (note.empty() ? "" : "; ") + cut;
+    output_.out << "final evaluation: " << cut << std::endl;
+  }
   json summary;
   summary["env_id"] = settings_.env_id;
   summary["env_steps"] = algorithm_->env_steps();
   summary["updates"] = algorithm_->updates();
   summary["wall_time_s"] = elapsed_s();
+  summary["stopped_by"] = stopped_by_;
   summary["evaluation"] = evaluation_json(evaluation, request);
-  summary["video"] = video.filename().string();
+  if (played < settings_.eval_episodes)
+    summary["evaluation"]["episodes_asked"] = settings_.eval_episodes;
+  summary["video"] = request.video ? json(video.filename().string()) : json(nullptr);
+  if (evaluations_skipped_ > 0) summary["evaluations_skipped"] = evaluations_skipped_;
+  if (time_limit_s_ > 0.0) {
+    json budget = {{"minutes", budget_minutes_}, {"limit_s", time_limit_s_}};
+    if (cost_) {
+      budget["evaluation_episode_s"] = cost_->episode_seconds(false);
+      budget["evaluation_video_episode_s"] = cost_->episode_seconds(true);
+      budget["evaluation_reserved_s"] = time_limit_s_ - kCheckpointMarginS - training_deadline_s_;
+      budget["training_deadline_s"] = training_deadline_s_;
+    }
+    budget["final_evaluation"] = note.empty() ? json("as asked") : json(note);
+    summary["time_budget"] = budget;
+  }
   if (distributed()) {
     json digests = json::array();
     for (const std::uint64_t digest : parameter_digests_) digests.push_back(hex_digest(digest));
@@ -672,7 +880,7 @@ json TrainingRun::evaluate_and_summarize() {
               << evaluation.returns.size() << " episodes\n"
               << "wrote " << run_->path().string() << "/{config.json, progress.csv, curve.png, "
               << run_->checkpoint_path(algorithm_->updates()).filename().string()
-              << ", final.mp4, summary.json}\n";
+              << (request.video ? ", final.mp4" : "") << ", summary.json}" << std::endl;
   return summary;
 }
 

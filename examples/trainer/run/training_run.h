@@ -2,6 +2,7 @@
 // and time budget, checkpoint, evaluate, write final.mp4 and summary.json.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <deque>
@@ -10,12 +11,15 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <ostream>
+#include <set>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "examples/trainer/run/algorithm.h"
 #include "examples/trainer/run/checkpoint_file.h"
+#include "examples/trainer/run/evaluation.h"
 #include "examples/trainer/run/progress_line.h"
 #include "examples/trainer/run/run_folder.h"
 #include "examples/trainer/run/run_settings.h"
@@ -69,6 +73,16 @@ std::string format_eval_csv(const std::vector<EvalRow>& rows);
 /// a line that is not a row of six numbers or a header that is not format_eval_csv's.
 std::vector<EvalRow> parse_eval_csv(const std::string& text, const std::string& source);
 
+/// The recent episodes that progress rows summarize: (the env steps when each ended, its
+/// return), oldest first.
+using RecentReturns = std::deque<std::pair<std::int64_t, double>>;
+
+/// Adds `returns` (of the episodes that ended in an iteration of `iteration_steps` env steps,
+/// which brought the run to `steps`) to `recent`, then keeps the latest 100 at most that ended
+/// within the last max(steps / 10, iteration_steps) env steps, and always the latest one.
+void add_recent_returns(RecentReturns& recent, const std::vector<double>& returns,
+                        std::int64_t steps, std::int64_t iteration_steps);
+
 /// Where a run reports: messages and the progress line to `out`, skipped checkpoints to `errors`.
 struct RunOutput {
   std::ostream& out;
@@ -81,7 +95,15 @@ struct RunOutput {
 /// (which read and check, and write nothing), then `train()`.
 ///
 /// Budget: training stops once the env steps reach total_env_steps or the run's whole wall time
-/// (resumed runs included, as of their latest checkpoint) reaches its time budget. Checkpoints
+/// (resumed runs included, as of their latest checkpoint) reaches its time budget less the time
+/// kept for the final evaluation. The time is checked within iterations too (Algorithm::iterate's
+/// StopCheck, between env steps and gradient steps; in one process only): a cut iteration keeps
+/// what it did and is checkpointed as any other. With a time budget the run first measures what
+/// an evaluation episode costs (measure_evaluation_cost, a few dozen steps) and keeps for the
+/// final evaluation what it needs, at most kEvaluationShare of the time left
+/// (plan_final_evaluation: fewer episodes, or no video, when they do not fit, each said in a line
+/// and in summary.json's "time_budget"); the final evaluation plays another episode only while
+/// the time left holds one. One episode is always played. Checkpoints
 /// are written every checkpoint_every updates and at the end, keeping the newest
 /// keep_checkpoints. A resumed run restores the algorithm from the latest valid checkpoint and
 /// replays the checkpoint's env actions, so that the envs continue their episodes: with the
@@ -91,7 +113,14 @@ struct RunOutput {
 /// plays eval_every_episodes deterministic seeded episodes (the final evaluation's seeds) and a
 /// row goes to eval.csv (rewritten atomically; a resume drops the rows after its checkpoint).
 /// An evaluation is skipped when those of this process have taken more than eval_max_share (a
-/// tenth by default) of its wall time, so that they never take much more.
+/// tenth by default) of its wall time, so that they never take much more, or when it would not
+/// end before the time budget stops training; each reason is said once.
+///
+/// Progress: the progress line (ProgressLine) once per update and within updates, so that a
+/// plain line reaches a pipe at least every 10 s, evaluations included. The episodes the line
+/// and progress.csv's episode_return_mean summarize: the latest 100 at most that ended within the
+/// last max(a tenth of the env steps done, the latest iteration's env steps), and always the
+/// latest one (a window of episodes alone spanned whole runs of long episodes).
 class TrainingRun {
  public:
   /// A new run of `settings` (settings.algorithm_config as algorithm.parse_config gives it) in
@@ -139,6 +168,20 @@ class TrainingRun {
   static TrainingRun join(const AlgorithmFactories& algorithms, EnvKwargsParser parse_sets,
                           Communicator& communicator, RunOutput output);
 
+  /// Makes `flag` (set by a signal handler: Ctrl-C) stop the run: once it is true the iteration
+  /// in progress ends as a time budget would end it, the last checkpoint is written, and train()
+  /// returns nullopt with interrupted() true, without the final evaluation. `flag` must outlive
+  /// the run.
+  void stop_when(const std::atomic<bool>& flag) { interrupt_ = &flag; }
+  /// Whether train() was stopped by stop_when's flag.
+  bool interrupted() const { return interrupted_; }
+  /// The newest checkpoint train() wrote (empty before).
+  const std::filesystem::path& last_checkpoint() const { return last_checkpoint_; }
+
+  /// The most of the time left at the start of a process with a time budget that the final
+  /// evaluation may take.
+  static constexpr double kEvaluationShare = 0.25;
+
   /// Updates between two comparisons of the ranks' parameter digests.
   static constexpr std::int64_t kDigestEvery = 10;
 
@@ -160,8 +203,16 @@ class TrainingRun {
   void restore_from_checkpoint();
   void replay_env_actions();
   void train_until_spent();
+  // With a time budget (rank 0): measures the evaluation's cost and sets the training deadline.
+  void plan_time_budget();
+  void update_training_deadline();
+  // What an iteration asks between its steps: progress, and whether to stop.
+  bool stop_requested(std::int64_t env_steps);
+  bool interrupt_requested() const;
+  // Says why an evaluation during training is skipped, once per reason.
+  void report_skip(const std::string& reason, const std::string& line);
   // One iterate() and its progress.csv row; returns the row.
-  ProgressRow iterate_once();
+  ProgressRow iterate_once(const StopCheck& stop);
   // An evaluation when the steps since `steps_before` passed a multiple of eval_every.
   void evaluate_when_due(std::int64_t steps_before);
   void save_checkpoint();
@@ -196,7 +247,7 @@ class TrainingRun {
   std::unique_ptr<vector::VectorEnv> env_;
   std::unique_ptr<Algorithm> algorithm_;
   std::optional<RunFolder> run_;
-  std::deque<double> returns_;  // the latest episodes' returns (kReturnWindow at most)
+  RecentReturns returns_;       // see add_recent_returns
   std::vector<EvalRow> evals_;  // eval.csv's rows
   double eval_seconds_ = 0.0;   // spent in evaluations during training by this process
   std::chrono::steady_clock::time_point start_;
@@ -204,6 +255,20 @@ class TrainingRun {
   std::vector<std::uint64_t> parameter_digests_;  // every rank's, at the last check
   std::optional<RunLock> lock_;                   // the run folder's, from resume or train
   AlgorithmFactories join_algorithms_;            // join: the algorithm rank 0's config names
+  // Progress and budget while training.
+  std::optional<ProgressLine> progress_;
+  ProgressStatus status_;
+  double time_limit_s_ = 0.0;           // of the run's whole wall time; 0: none
+  double training_deadline_s_ = 0.0;    // the limit less what the final evaluation needs
+  double left_at_start_s_ = 0.0;        // of the time limit, when this process began training
+  std::optional<EvaluationCost> cost_;  // measured when there is a time limit
+  FinalEvaluationPlan planned_;         // the final evaluation the deadline keeps time for
+  std::string stopped_by_;              // "steps", "time" or "interrupt"
+  std::set<std::string> skip_reasons_;  // evaluations skipped, by reason (said once each)
+  std::int64_t evaluations_skipped_ = 0;
+  const std::atomic<bool>* interrupt_ = nullptr;
+  bool interrupted_ = false;
+  std::filesystem::path last_checkpoint_;
 };
 
 }  // namespace pixelgym::trainer

@@ -79,12 +79,13 @@ std::vector<std::pair<int, int>> band_pixels(const render::Image& image) {
 
 // Draws `table` into {test output}/trainer_run/curves/{name}.png (for a person to look at) and
 // returns the image.
-render::Image draw_and_save(const std::string& name, const ProgressTable& table) {
+render::Image draw_and_save(const std::string& name, const ProgressTable& table,
+                            const EvaluationPoints& evaluations = {}) {
   const fs::path folder = fs::path(PIXELGYM_TEST_OUTPUT_DIR) / "trainer_run" / "curves";
   fs::create_directories(folder);
   CurvePlotOptions options;
   options.title = "CartPoleBalance-v0  (" + name + ")";
-  write_curve_png(folder / (name + ".png"), table, options);
+  write_curve_png(folder / (name + ".png"), table, options, evaluations);
   const render::Image image = render::read_png((folder / (name + ".png")).string());
   EXPECT_EQ(image.width, 900);
   EXPECT_EQ(image.height, 450);
@@ -148,6 +149,39 @@ TEST(CurvePlotTest, RealisticRunDrawsBothPanelsWithBands) {
   EXPECT_GT(left, 300);
   EXPECT_GT(right, 300);
   EXPECT_GT(band.size(), 5000U);
+}
+
+// eval.csv's evaluations are drawn over the training curve, in their own colour (RGB of the BGR
+// (14, 127, 255)), in both panels, at their returns: here above the training curve's range, so
+// the y axis reaches them.
+TEST(CurvePlotTest, EvaluationsAreDrawnOnTheCurve) {
+  const auto evaluation_pixels = [](const render::Image& image) {
+    return pixels_of(image, 255, 127, 14);
+  };
+  EXPECT_TRUE(evaluation_pixels(draw_and_save("no_evaluations", realistic_run())).empty());
+  EvaluationPoints evaluations;
+  for (int i = 1; i <= 5; ++i) {
+    evaluations.steps.push_back(20000.0 * i);
+    evaluations.wall_time_s.push_back(20000.0 * i / 240.0);
+    evaluations.mean.push_back(900.0 + i);
+    evaluations.std.push_back(10.0);
+  }
+  const render::Image image = draw_and_save("evaluations", realistic_run(), evaluations);
+  int left = 0;
+  int right = 0;
+  int highest = image.height;
+  for (const auto& [x, y] : evaluation_pixels(image)) {
+    (x < 450 ? left : right) += 1;
+    highest = std::min(highest, y);
+  }
+  EXPECT_GT(left, 5 * 20);
+  EXPECT_GT(right, 5 * 20);
+  // Above every training mean pixel: 900 is above the curve's ~800.
+  int highest_mean = image.height;
+  for (const auto& [x, y] : mean_pixels(image)) highest_mean = std::min(highest_mean, y);
+  EXPECT_LT(highest, highest_mean);
+  evaluations.std.pop_back();
+  EXPECT_THROW(draw_curve(realistic_run(), CurvePlotOptions{}, evaluations), std::invalid_argument);
 }
 
 TEST(CurvePlotTest, NoEpisodeYetDrawsEmptyPanels) {

@@ -138,6 +138,39 @@ TEST(ProgressLineTest, NotATerminalWritesAPlainLineEveryNUpdates) {
   EXPECT_EQ(exact.str(), format_plain_line(status_at(2000)) + "\n");
 }
 
+// A plain line at least every kMaxSilenceS seconds however long an update: ticks within an update
+// write one once that long has passed since the last line (and not before), so does an update
+// that is not the n-th, and so does a note (an evaluation's).
+TEST(ProgressLineTest, PlainLinesComeAtLeastEveryFewSecondsWithinUpdates) {
+  double now = 100.0;
+  std::ostringstream out;
+  ProgressLine progress(out, ProgressLine::Mode::kPlain, 10, 100, [&now] { return now; });
+  now += ProgressLine::kMaxSilenceS - 0.5;
+  EXPECT_FALSE(progress.tick(status_at(10)));
+  EXPECT_EQ(out.str(), "");
+  now += 0.5;
+  EXPECT_TRUE(progress.tick(status_at(20)));
+  EXPECT_EQ(out.str(), format_plain_line(status_at(20)) + "\n");
+  now += 1.0;
+  EXPECT_FALSE(progress.tick(status_at(30)));
+  progress.update(status_at(40));  // not the 10th, and 1 s after the last line
+  EXPECT_EQ(out.str(), format_plain_line(status_at(20)) + "\n");
+  now += ProgressLine::kMaxSilenceS;
+  progress.update(status_at(50));  // not the 10th, but kMaxSilenceS after the last line
+  EXPECT_EQ(out.str(),
+            format_plain_line(status_at(20)) + "\n" + format_plain_line(status_at(50)) + "\n");
+  now += 1.0;
+  EXPECT_FALSE(progress.tick_note("evaluating"));
+  now += ProgressLine::kMaxSilenceS;
+  EXPECT_TRUE(progress.tick_note("evaluating"));
+  EXPECT_THAT(out.str(), HasSubstr("\nevaluating\n"));
+  // A line of the caller's own starts the silence again.
+  now += ProgressLine::kMaxSilenceS;
+  progress.wrote_line();
+  EXPECT_FALSE(progress.tick(status_at(60)));
+  EXPECT_LE(ProgressLine::kMaxSilenceS, 10.0);
+}
+
 TEST(ProgressLineTest, TerminalRedrawsOneLineInPlace) {
   std::ostringstream out;
   ProgressLine progress(out, ProgressLine::Mode::kBar, 5, 80);
