@@ -1,15 +1,15 @@
 """pixelgym from Python: pixel RL environments (Bullet physics, OSMesa rendering) in C++.
 
     import pixelgym
-    env = pixelgym.make("CartPoleSwingup-v0")          # a gymnasium.Env when gymnasium is installed
+    env = pixelgym.make("CartPoleSwingup-v1")          # a gymnasium.Env when gymnasium is installed
     obs, info = env.reset(seed=0)
     obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
 
-    envs = pixelgym.make_vec("CartPoleSwingup-v0", num_envs=8, num_threads=2)  # the C++ thread pool
+    envs = pixelgym.make_vec("CartPoleSwingup-v1", num_envs=8, num_threads=2)  # the C++ thread pool
 
 When gymnasium is importable, ``make`` returns a ``gymnasium.Env`` and ``make_vec`` a
 ``gymnasium.vector.VectorEnv`` with ``gymnasium.spaces`` spaces, and every env is registered with
-gymnasium as ``pixelgym/<ID>`` (``gymnasium.make("pixelgym/CartPoleSwingup-v0")``,
+gymnasium as ``pixelgym/<ID>`` (``gymnasium.make("pixelgym/CartPoleSwingup-v1")``,
 ``gymnasium.make_vec(..., vectorization_mode="vector_entry_point")``). Without gymnasium the same
 classes and methods work, with pixelgym's own space classes. Setting PIXELGYM_NO_GYMNASIUM=1
 makes pixelgym ignore an installed gymnasium.

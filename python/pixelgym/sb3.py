@@ -5,11 +5,11 @@ gymnasium).
     from stable_baselines3.common.vec_env import VecMonitor
     from pixelgym.sb3 import make_sb3_vec
 
-    venv = VecMonitor(make_sb3_vec("CartPoleBalance-v0", num_envs=8, num_threads=2))
+    venv = VecMonitor(make_sb3_vec("CartPoleBalance-v1", num_envs=8, num_threads=2))
     PPO("MultiInputPolicy", venv).learn(10_000)
 
     # The image alone, a uint8 (84, 84, 3) Box, for SB3's CnnPolicy:
-    venv = VecMonitor(make_sb3_vec("CartPoleBalance-v0", num_envs=8, obs_mode="rgb"))
+    venv = VecMonitor(make_sb3_vec("CartPoleBalance-v1", num_envs=8, obs_mode="rgb"))
     PPO("CnnPolicy", venv).learn(10_000)
 
 SB3 does not take a gymnasium.vector.VectorEnv; its own VecEnv protocol resets an ended env in

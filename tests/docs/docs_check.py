@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """The README and docs/ are for a user who has only the repository: this check fails on any line of
-README.md or docs/**/*.md that points outside it, uses an env id for which a newer version is
+README.md, docs/**/*.md or the Python package's modules (python/pixelgym/*.py, whose docstrings
+help() shows) that points outside it, uses an env id for which a newer version is
 registered, or links to a file or heading that is not there.
 
 Rules (each names the page, the line and what it found):
@@ -153,7 +154,9 @@ def main():
         sys.exit(__doc__)
     root, pixelgym = Path(sys.argv[1]).resolve(), sys.argv[2]
     newest = registered_versions(pixelgym)
-    pages = [root / "README.md"] + sorted((root / "docs").rglob("*.md"))
+    # The Python package's docstrings are what help(pixelgym) shows: read as pages too.
+    pages = ([root / "README.md"] + sorted((root / "docs").rglob("*.md"))
+             + sorted((root / "python" / "pixelgym").glob("*.py")))
     problems = [problem for page in pages for problem in check_page(root, page, newest)]
     for problem in problems:
         print(problem)
