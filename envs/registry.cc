@@ -12,6 +12,25 @@ namespace {
 
 constexpr const char* kMaxEpisodeStepsKey = "max_episode_steps";
 
+// `ids` (sorted) with the versions of each name newest first, so that a suggestion among ids
+// equally close names CartPoleSwingup-v1 before -v0.
+std::vector<std::string> newest_versions_first(std::vector<std::string> ids) {
+  const auto split = [](const std::string& id) -> std::pair<std::string, long> {
+    const std::size_t at = id.rfind("-v");
+    if (at == std::string::npos || at + 2 == id.size() ||
+        id.find_first_not_of("0123456789", at + 2) != std::string::npos) {
+      return {id, 0};
+    }
+    return {id.substr(0, at), std::stol(id.substr(at + 2))};
+  };
+  std::stable_sort(ids.begin(), ids.end(), [&](const std::string& a, const std::string& b) {
+    const auto [name_a, version_a] = split(a);
+    const auto [name_b, version_b] = split(b);
+    return name_a != name_b ? name_a < name_b : version_a > version_b;
+  });
+  return ids;
+}
+
 // Gymnasium's make takes render_mode; here every env renders off-screen into "rgb_array" frames,
 // its only mode. "rgb_array" is accepted (and dropped) unless the env declares a render_mode
 // kwarg of its own; any other mode ("human": a window) is refused naming the one offered.
@@ -70,7 +89,7 @@ std::shared_ptr<const EnvSpec> Registry::spec(const std::string& id) const {
   }
   std::string message = "unknown env id \"" + id + "\"";
   const std::vector<std::string> all = registered_ids();
-  const std::string suggestion = did_you_mean(id, all);
+  const std::string suggestion = did_you_mean(id, newest_versions_first(all));
   if (all.empty()) {
     message += "; no envs are registered";
   } else if (!suggestion.empty()) {
@@ -152,7 +171,7 @@ std::vector<std::string> Registry::registered_ids() const {
 }
 
 std::vector<std::string> Registry::closest_ids(const std::string& id, std::size_t count) const {
-  return closest_names(id, registered_ids(), count);
+  return closest_names(id, newest_versions_first(registered_ids()), count);
 }
 
 }  // namespace pixelgym

@@ -334,6 +334,14 @@ const Entry& find_entry(const std::string& name, const std::string& text) {
     closest.push_back(candidate);
   }
   const std::string suggestion = did_you_mean(name, closest);
+  // Each wrapper with the other words it takes, so that a suggested alias is in the list.
+  for (std::string& listed : names) {
+    std::string also;
+    for (const auto& [alias, wrapper] : aliases()) {
+      if (wrapper == listed) also += (also.empty() ? "" : ", ") + alias;
+    }
+    if (!also.empty()) listed += " (also " + also + ")";
+  }
   throw std::invalid_argument("wrapper spec " + quoted(text) + ": unknown wrapper " + quoted(name) +
                               "; " + (suggestion.empty() ? "" : suggestion + " ") +
                               "the wrappers are: " + join_names(names));

@@ -9,6 +9,7 @@
 #include "pixelgym/envs/errors.h"
 #include "pixelgym/envs/spaces/box.h"
 #include "pixelgym/envs/spaces/dict.h"
+#include "pixelgym/envs/suggestions.h"
 
 namespace pixelgym {
 namespace {
@@ -84,10 +85,12 @@ TaskConfig TaskConfig::from_params(const Params& params, const std::vector<std::
   c.obs_mode = params.at("obs_mode").as_string();
   if (c.obs_mode != "pixels+state" && c.obs_mode != "pixels" && c.obs_mode != "rgb" &&
       c.obs_mode != "state") {
+    const std::string suggestion =
+        did_you_mean(c.obs_mode, {"pixels+state", "pixels", "rgb", "state"});
     throw std::invalid_argument(env +
                                 ": obs_mode must be \"pixels+state\", \"pixels\", \"rgb\" or "
                                 "\"state\", got \"" +
-                                c.obs_mode + "\"");
+                                c.obs_mode + "\"" + (suggestion.empty() ? "" : "; " + suggestion));
   }
   const std::int64_t repeat = params.at("action_repeat").as_int();
   if (repeat < 1 || repeat > 1000) {

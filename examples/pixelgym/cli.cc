@@ -50,8 +50,8 @@ CLI::Validator name_in(const std::vector<std::string>& names, const std::string&
       [names, what](std::string& text) -> std::string {
         if (std::find(names.begin(), names.end(), text) != names.end()) return "";
         const std::string suggestion = did_you_mean(text, names);
-        return "unknown " + what + " \"" + text + "\"; " +
-               (suggestion.empty() ? "" : suggestion + " ") + "(the " + what +
+        return "unknown " + what + " \"" + text + "\"" +
+               (suggestion.empty() ? " " : "; " + suggestion + " ") + "(the " + what +
                "s: " + join_names(names) + ")";
       },
       shown + "}");
@@ -170,6 +170,22 @@ std::unique_ptr<Env> make_env(const std::string& id, const std::vector<std::stri
   }
   try {
     return wrappers::apply_wrappers(std::move(env), wraps);
+  } catch (const std::invalid_argument& error) {
+    throw UsageError(error.what());  // names the spec, the wrapper and the argument
+  }
+}
+
+EnvDescription describe_env(const std::string& id, const std::vector<std::string>& sets,
+                            const std::vector<std::string>& wraps) {
+  const Params kwargs = parse_sets(id, sets);
+  EnvDescription description;
+  try {
+    description = describe(id, kwargs);
+  } catch (const std::invalid_argument& error) {
+    throw UsageError(error.what());  // the kwargs: an unknown key, a value out of range
+  }
+  try {
+    return wrappers::describe_wrapped(std::move(description), wraps);
   } catch (const std::invalid_argument& error) {
     throw UsageError(error.what());  // names the spec, the wrapper and the argument
   }

@@ -13,6 +13,7 @@
 #include "pixelgym/envs/array.h"
 #include "pixelgym/envs/env.h"
 #include "pixelgym/envs/params.h"
+#include "pixelgym/envs/registry.h"
 
 namespace pixelgym::cli {
 
@@ -83,6 +84,12 @@ void add_env_options(CLI::App& command, EnvArguments& env);
 /// image) is rethrown as UsageError.
 std::unique_ptr<Env> make_env(const std::string& id, const std::vector<std::string>& sets,
                               const std::vector<std::string>& wraps = {});
+
+/// What `make_env(id, sets, wraps)` would build, from the spec and Registry::describe alone (no
+/// env, Bullet world or GL context): throws UsageError for what make_env refuses as one (an
+/// unknown id or kwarg, a value out of range, a wrapper spec that does not apply).
+EnvDescription describe_env(const std::string& id, const std::vector<std::string>& sets,
+                            const std::vector<std::string>& wraps = {});
 
 /// Checks, before any work, that a video file can be written at `path` (what `option` named):
 /// throws UsageError when `path` is a folder or its parent is a file, std::runtime_error naming the

@@ -136,19 +136,10 @@ std::vector<std::vector<std::string>> observation_rows(const Space& space) {
 
 // From the spec and Registry::describe alone: no env, Bullet world or GL context is built.
 int run_info(const InfoArguments& args) {
-  const Params kwargs = parse_sets(args.id, args.sets);
-  EnvDescription description;
-  try {
-    description = describe(args.id, kwargs);
-  } catch (const std::invalid_argument& error) {
-    throw UsageError(error.what());  // the kwargs: an unknown key, a value out of range
-  }
-  const std::optional<std::int64_t> kwarg_limit = description.max_episode_steps;
-  try {
-    description = wrappers::describe_wrapped(std::move(description), args.wraps);
-  } catch (const std::invalid_argument& error) {
-    throw UsageError(error.what());  // names the spec, the wrapper and the argument
-  }
+  const EnvDescription description = describe_env(args.id, args.sets, args.wraps);
+  // The time limit the kwargs give, before a time_limit wrapper.
+  const std::optional<std::int64_t> kwarg_limit =
+      describe_env(args.id, args.sets).max_episode_steps;
   const auto spec = default_registry().spec(args.id);
   const auto limit = [](const std::optional<std::int64_t>& steps) {
     return steps ? std::to_string(*steps) : std::string("none");
@@ -463,7 +454,7 @@ void declare_bench(CLI::App& bench, BenchArguments& args) {
       "Step an env with seeded random actions (resetting when done) and print steps_per_s= for "
       "physics + render + observation, one env on this thread, or with --num-envs N a vector env "
       "of N (--threads T workers); --set obs_mode=state for physics alone");
-  add_id_argument(bench, args.id, "CartPoleSwingup-v0");
+  add_id_argument(bench, args.id, "CartPoleSwingup-v1");
   add_checked_option(bench, "--steps", args.steps, "Steps to time", integer_in(1));
   add_seed_option(bench, args.seed, "Seed for the reset and the random actions");
   bench

@@ -30,7 +30,7 @@ void declare_record(CLI::App& record, RecordArguments& args) {
   record.description(
       "Run a seeded policy for some episodes and write each as an H.264 .mp4 of render() frames "
       "(RecordVideo); print each file with its frame count and return");
-  add_id_argument(record, args.id, "CartPoleSwingup-v0");
+  add_id_argument(record, args.id, "CartPoleSwingup-v1");
   record
       .add_option("--out", args.out,
                   "Folder for one FOLDER/ID-episode-N.mp4 per episode (created if missing), or a "

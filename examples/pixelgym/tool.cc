@@ -1,4 +1,6 @@
 // The `pixelgym` tool's command line: every subcommand, help, and the exit codes (cli.h).
+#include <algorithm>
+#include <cmath>
 #include <exception>
 #include <iostream>
 #include <string>
@@ -46,30 +48,84 @@ std::string unknown_subcommand(const std::string& word, const std::vector<Comman
     if (synonym == word) suggestion = "did you mean " + name + "?";
   }
   if (suggestion.empty()) suggestion = did_you_mean(word, names);
-  return "unknown subcommand \"" + word + "\"; " + (suggestion.empty() ? "" : suggestion + " ") +
+  return "unknown subcommand \"" + word + "\"" +
+         (suggestion.empty() ? " " : "; " + suggestion + " ") +
          "(subcommands: " + join_names(names) + ")";
 }
 
-// CLI11's "Could not convert: --steps = x" said as the other option errors are: "--steps:
-// expected an integer, got "x"" (the option's type from its type name: INT, FLOAT, UINT64).
-std::string conversion_message(const CLI::App& app, const CLI::ConversionError& error) {
+// A bound of CLI11's Range as a person writes it: "0", "1024", "1e9" (std::to_string's "0.000000"
+// and "1000000000.000000" otherwise).
+std::string bound_text(const std::string& text) {
+  double value = 0.0;
+  try {
+    value = std::stod(text);
+  } catch (const std::exception&) {
+    return text;
+  }
+  if (value != std::floor(value) || std::abs(value) >= 1e18) return text;
+  std::string digits = std::to_string(static_cast<long long>(value));
+  std::size_t zeros = 0;
+  while (zeros + 1 < digits.size() && digits[digits.size() - 1 - zeros] == '0') ++zeros;
+  if (zeros < 6) return digits;
+  return digits.substr(0, digits.size() - zeros) + "e" + std::to_string(zeros);
+}
+
+// CLI11's "Could not convert: --steps = x" and Range's "--minutes: Value abc not in range
+// 0.000000 to 1000000000.000000" said as the other option errors are: "--steps: expected an
+// integer, got "x"", "--minutes: expected a number from 0 to 1e9, got "abc"" (the option's type
+// from its type name: INT, FLOAT, UINT64).
+std::string option_error_message(const CLI::App& app, const CLI::ParseError& error) {
   const std::string what = error.what();
   std::vector<const CLI::App*> apps = {&app};
   for (const CLI::App* chosen : app.get_subcommands()) apps.push_back(chosen);
   for (const CLI::App* in : apps) {
     for (const CLI::Option* option : in->get_options()) {
-      const std::string prefix = "Could not convert: " + option->get_name() + " = ";
-      if (what.rfind(prefix, 0) != 0) continue;
+      const std::string name = option->get_name();
+      const std::string convert = "Could not convert: " + name + " = ";
+      const std::string range = name + ": Value ";
+      std::string got;
+      std::string bounds;
+      if (what.rfind(convert, 0) == 0) {
+        got = what.substr(convert.size());
+      } else if (what.rfind(range, 0) == 0) {
+        const std::size_t at = what.find(" not in range ", range.size());
+        const std::size_t to = what.find(" to ", at == std::string::npos ? 0 : at + 14);
+        if (at == std::string::npos || to == std::string::npos) continue;
+        got = what.substr(range.size(), at - range.size());
+        bounds = " from " + bound_text(what.substr(at + 14, to - at - 14)) + " to " +
+                 bound_text(what.substr(to + 4));
+      } else {
+        continue;
+      }
       std::string type = option->get_type_name();
       type = type.substr(0, type.find(':'));
       const std::string expected = type == "INT" || type == "UINT64" ? "an integer"
                                    : type == "FLOAT"                 ? "a number"
                                                                      : type;
-      return option->get_name() + ": expected " + expected + ", got \"" +
-             what.substr(prefix.size()) + "\"";
+      return name + ": expected " + expected + bounds + ", got \"" + got + "\"";
     }
   }
   return what;
+}
+
+// CLI11's "The following arguments were not expected: 3 --minute", with the chosen subcommand's
+// options closest to each unknown one: "...; --minute: did you mean --minutes?".
+std::string extras_message(const CLI::App& app, const CLI::ExtrasError& error) {
+  const auto chosen = app.get_subcommands();
+  const CLI::App& command = chosen.empty() ? app : *chosen.front();
+  std::vector<std::string> names;
+  for (const CLI::Option* option : command.get_options()) {
+    if (!option->get_lnames().empty()) names.push_back("--" + option->get_lnames().front());
+  }
+  std::string message = error.what();
+  for (const std::string& extra : app.remaining(true)) {
+    if (extra.rfind("--", 0) != 0 || extra.size() < 3) continue;
+    const std::string name = extra.substr(0, extra.find('='));
+    if (std::find(names.begin(), names.end(), name) != names.end()) continue;
+    const std::string suggestion = did_you_mean(name, names);
+    if (!suggestion.empty()) message += "; " + name + ": " + suggestion;
+  }
+  return message;
 }
 
 // The whole tool's help, even while a subcommand (`help`) is chosen.
@@ -128,7 +184,11 @@ int run_tool(int argc, char** argv, const Trainer& trainer) {
   } catch (const CLI::Success& success) {  // --help, --help-all, --version
     return app.exit(success);
   } catch (const CLI::ConversionError& error) {
-    return usage_error(app, conversion_message(app, error));
+    return usage_error(app, option_error_message(app, error));
+  } catch (const CLI::ValidationError& error) {
+    return usage_error(app, option_error_message(app, error));
+  } catch (const CLI::ExtrasError& error) {
+    return usage_error(app, extras_message(app, error));
   } catch (const CLI::ParseError& error) {
     return usage_error(app, error.what());
   } catch (const UsageError& error) {

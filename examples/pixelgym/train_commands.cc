@@ -44,8 +44,8 @@ void add_run_options(CLI::App& train, TrainArguments& args) {
       "their defaults): a recipe's name (e.g. swingup: the configs installed with the tool for "
       "--algo's algorithm, which --list-configs shows), a FILE.json (or any path with a '/'), or "
       "the JSON itself, e.g. "
-      "'{\"gamma\": 0.95}'. ppo: examples/trainer/ppo/ppo.h, PpoConfig. drqv2: "
-      "examples/trainer/drqv2/drqv2.h, DrqV2Config: seed, num_envs (1), "
+      "'{\"gamma\": 0.95}'. --print-config shows every field of --algo's algorithm with the "
+      "value a run would use, --list-configs the recipes. drqv2's: seed, num_envs (1), "
       "total_env_steps (100,000), iteration_env_steps (500, one progress.csv row), "
       "frame_stack (3), replay_capacity (100,000 steps), batch_size (128), n_step "
       "(3), gamma (0.99), learning_rate (0.001), critic_tau (0.01), encoder (mrq, "
@@ -76,8 +76,9 @@ void add_run_options(CLI::App& train, TrainArguments& args) {
                    "1,000,000, drqv2 100,000)");
   train
       .add_option("--minutes", args.minutes,
-                  "Stop after this much wall time, the final checkpoint, evaluation and video "
-                  "included: training stops within an update when the time left is what the "
+                  "Stop after this much wall time (0, the default: no time limit), the final "
+                  "checkpoint, evaluation and video included: training stops within an update when "
+                  "the time left is what the "
                   "final evaluation needs (at most a quarter of it: fewer --eval-episodes, or "
                   "no video, when they do not fit; said in a line and in summary.json); with "
                   "--resume, this much more, and at least one update (without it, a resumed "
@@ -148,15 +149,17 @@ void add_run_setting_options(CLI::App& train, TrainArguments& args) {
   add_checked_option(train, "--eval-episodes", args.eval_episodes,
                      "Seeded episodes of the final evaluation (deterministic actions)",
                      CLI::Range(std::int64_t{1}, std::int64_t{1} << 20));
-  add_checked_option(train, "--eval-every", args.eval_every,
-                     "Evaluate the policy during training each time the env steps pass a "
-                     "multiple of this (0: never; default: a tenth of --steps, ten evaluations), "
-                     "over --eval-every-episodes deterministic episodes with the final "
-                     "evaluation's seeds; each adds a row to eval.csv (steps, wall_time_s, "
-                     "return_mean, return_std, episodes, eval_s). An evaluation is skipped while "
-                     "this process's evaluations have taken more than --eval-max-share of its "
-                     "wall time",
-                     CLI::Range(std::int64_t{0}, std::int64_t{1} << 50));
+  // No default shown: it follows --steps.
+  train
+      .add_option("--eval-every", args.eval_every,
+                  "Evaluate the policy during training each time the env steps pass a "
+                  "multiple of this (default: a tenth of --steps, ten evaluations; 0: never), "
+                  "over --eval-every-episodes deterministic episodes with the final "
+                  "evaluation's seeds; each adds a row to eval.csv (steps, wall_time_s, "
+                  "return_mean, return_std, episodes, eval_s). An evaluation is skipped while "
+                  "this process's evaluations have taken more than --eval-max-share of its "
+                  "wall time")
+      ->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 50));
   add_checked_option(train, "--eval-every-episodes", args.eval_every_episodes,
                      "Episodes of each evaluation during training",
                      CLI::Range(std::int64_t{1}, std::int64_t{1} << 20));
@@ -173,7 +176,7 @@ void declare_train(CLI::App& train, TrainArguments& args) {
       "included) and write a run folder: "
       "config.json, progress.csv, eval.csv, curve.png, checkpoints, and at the end final.mp4 and "
       "summary.json (an evaluation over seeded episodes)");
-  train.add_option("id", args.id, "Env id, e.g. CartPoleBalance-v0 (`pixelgym list` shows them)");
+  train.add_option("id", args.id, "Env id, e.g. CartPoleBalance-v1 (`pixelgym list` shows them)");
   add_env_options(train, args);
   add_run_options(train, args);
   add_run_setting_options(train, args);
@@ -196,6 +199,7 @@ void declare_eval(CLI::App& eval, EvalArguments& args) {
                   "Seed of the first episode (default: as the run's final evaluation, "
                   "summary.json's: the run's --seed + 1000000, so that the returns agree with "
                   "it)")
+      ->default_str("")  // the run's, not 0
       ->each([&args](const std::string&) { args.seed_given = true; });
   eval.add_option("--video", args.video, "Record the first episode to this .mp4");
   eval.add_flag("--stochastic", args.stochastic,

@@ -262,8 +262,10 @@ int run_train(const TrainArguments& args) {
         "train --resume takes the env and settings from the run's config.json: give no id, "
         "--set, --wrap, --algo, --config, --set-algo, --print-config or --out with it");
   }
+  // An unknown id, kwarg or wrapper is refused as `info` refuses it, before any other word (the
+  // run's threads warning) and without building the env.
+  if (args.resume.empty()) describe_env(args.id, args.sets, args.wraps);
   if (args.print_config) {
-    parse_sets(args.id, args.sets);  // an unknown id or kwarg, as the run would refuse it
     const trainer::AlgorithmFactory& algorithm = algorithm_named(args.algo);
     trainer::RunSettings settings = new_run_settings(args, algorithm);
     if (args.minutes > 0.0) settings.minutes = args.minutes;  // as the run records its budget

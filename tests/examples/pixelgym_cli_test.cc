@@ -293,6 +293,16 @@ TEST(PixelgymCliTest, AUsageErrorIsTheErrorAndOneLineToTheHelp) {
   EXPECT_THAT(kwarg.output, HasSubstr("\nRun 'pixelgym snapshot --help' for the options.\n"));
 }
 
+// Each case exits 2 with its message, in two lines: the error and the one to the help.
+void expect_two_line_usage_errors(const std::vector<UsageCase>& cases) {
+  for (const UsageCase& c : cases) {
+    const CliRun result = run(c.arguments);
+    EXPECT_EQ(result.exit_code, 2) << c.arguments << ": " << result.output;
+    EXPECT_THAT(result.output, HasSubstr(c.message)) << c.arguments;
+    EXPECT_EQ(lines(result.output), 2U) << c.arguments << ": " << result.output;
+  }
+}
+
 // Every name a user types is answered with the name it is a typo of, or the word's subcommand:
 // kwargs, wrappers and their parameters, subcommands, algorithms.
 TEST(PixelgymCliTest, MistypedNamesAreAnsweredWithDidYouMean) {
@@ -301,6 +311,10 @@ TEST(PixelgymCliTest, MistypedNamesAreAnsweredWithDidYouMean) {
        "CartPoleSwingup-v0: unknown kwarg \"widht\"; did you mean width? valid kwargs: "},
       {"info CartPoleSwingup-v0 --wrap grayscal",
        "unknown wrapper \"grayscal\"; did you mean grayscale? the wrappers are: "},
+      {"info CartPoleSwingup-v1 --wrap greyscal",
+       "did you mean greyscale? the wrappers are: resize, grayscale (also greyscale, grey, "
+       "gray), "},
+      {"info CartPoleSwingup-v1 --set obs_mode=rbg", "got \"rbg\"; did you mean rgb?\n"},
       {"info CartPoleSwingup-v0 --wrap frame_stack=3,paddin=zero",
        "unknown parameter \"paddin\"; did you mean padding?"},
       {"describe CartPoleSwingup-v0", "unknown subcommand \"describe\"; did you mean info?"},
@@ -313,15 +327,50 @@ TEST(PixelgymCliTest, MistypedNamesAreAnsweredWithDidYouMean) {
       {"info CartPoleSwingup-v0 --wrap resize=64,48",
        "resize's size: expected HEIGHTxWIDTH (e.g. 64x64) or N for NxN, as resize=64x48"},
   };
-  for (const UsageCase& c : cases) {
-    const CliRun result = run(c.arguments);
-    EXPECT_EQ(result.exit_code, 2) << c.arguments << ": " << result.output;
-    EXPECT_THAT(result.output, HasSubstr(c.message)) << c.arguments;
-    EXPECT_EQ(lines(result.output), 2U) << c.arguments << ": " << result.output;
-  }
+  expect_two_line_usage_errors(cases);
   EXPECT_THAT(run("frobnicate").output, Not(HasSubstr("did you mean")));
   EXPECT_THAT(run("train CartPoleSwingup-v0 --algo sac").output,
-              HasSubstr("unknown algorithm \"sac\"; (the algorithms: ppo, drqv2)"));
+              HasSubstr("unknown algorithm \"sac\" (the algorithms: ppo, drqv2)"));
+}
+
+// CLI11's range and unknown-option messages said as the others are: the option, what it expects
+// and what it got; an unknown option is answered with the one it is a typo of.
+TEST(PixelgymCliTest, OutOfRangeAndUnknownOptionsNameWhatWasExpected) {
+  const std::vector<UsageCase> cases = {
+      {"train CartPoleSwingup-v1 --minutes abc",
+       "pixelgym: --minutes: expected a number from 0 to 1e9, got \"abc\"\n"},
+      {"train CartPoleSwingup-v1 --nproc 0",
+       "pixelgym: --nproc: expected an integer from 1 to 1024, got \"0\"\n"},
+      {"train CartPoleSwingup-v1 --eval-every=-5",
+       "pixelgym: --eval-every: expected an integer from 0 to 1125899906842624, got \"-5\"\n"},
+      {"eval runs/x --episodes 0",
+       "pixelgym: --episodes: expected an integer from 1 to 1048576, got \"0\"\n"},
+      {"compare runs/x --out x.png --width 3",
+       "pixelgym: --width: expected an integer from 400 to 8000, got \"3\"\n"},
+      {"train CartPoleSwingup-v1 --minute 3", "; --minute: did you mean --minutes?\n"},
+      {"tets", "pixelgym: unknown subcommand \"tets\" (subcommands: "},
+      {"info cartpoleswingup",
+       "did you mean CartPoleSwingup-v1 or CartPoleSwingup-v0? (`pixelgym list`"},
+  };
+  expect_two_line_usage_errors(cases);
+}
+
+// Help says the defaults that are not a constant in words, not "=0", and names ids that exist.
+TEST(PixelgymCliTest, HelpShowsTheTrueDefaultsAndCurrentIds) {
+  const std::string train = run("train --help").output;
+  EXPECT_THAT(train, Not(HasSubstr("1125899906842624]=0"))) << train;  // --eval-every
+  EXPECT_THAT(train, HasSubstr("default: a tenth of --steps"));
+  EXPECT_THAT(train, HasSubstr("(0, the default: no time limit)"));
+  EXPECT_THAT(train, Not(HasSubstr("ppo.h")));
+  EXPECT_THAT(train, HasSubstr("--print-config shows every field"));
+  const std::string eval = run("eval --help").output;
+  EXPECT_THAT(eval, HasSubstr("--seed UINT64 "));
+  EXPECT_THAT(eval, Not(HasSubstr("--seed UINT64=0")));
+  for (const char* command : {"train", "record", "bench"}) {
+    const std::string help = run(std::string(command) + " --help").output;
+    EXPECT_THAT(help, Not(HasSubstr("-v0 (`pixelgym list`"))) << command;
+    EXPECT_THAT(help, HasSubstr("-v1 (`pixelgym list`")) << command;
+  }
 }
 
 // The docs write "grey" (and "greyscale"): --wrap takes those words for grayscale, and

@@ -1085,30 +1085,75 @@ TEST(TrainCliTest, CompareFallsBackToTheTrainingCurveWithoutEvaluations) {
   fs::remove_all(folder);
 }
 
-// A mistyped env id or kwarg is refused before the run folder is touched: no folder is made,
-// and a folder given with --out is left without a .lock.
+// A mistyped env id, kwarg or wrapper is refused before the run folder is touched, as a usage
+// error whose first line is the error (not the threads warning of a run that never starts): no
+// folder is made, and a folder given with --out is left without a .lock.
 TEST(TrainCliTest, AMistypedIdOrKwargLeavesNoFolderAndNoLock) {
   const fs::path folder = fresh_folder("mistyped");
-  for (const std::string typo : {"CartPoleBalanc-v0", "CartPoleBalance-v0 --set widht=32"}) {
+  const std::vector<std::pair<std::string, std::string>> typos = {
+      {"CartPoleBalanc-v0", "pixelgym: unknown env id \"CartPoleBalanc-v0\""},
+      {"CartPoleBalance-v0 --set widht=32",
+       "pixelgym: CartPoleBalance-v0: unknown kwarg \"widht\""},
+      {"CartPoleBalance-v0 --wrap greyscal", "pixelgym: "},
+      {"CartPoleBalance-v0 --set msaa=3",
+       "pixelgym: CartPoleBalance-v0: msaa must be 0, 2, 4 or 8"},
+  };
+  for (const auto& [typo, first_line] : typos) {
     SCOPED_TRACE(typo);
-    const CliRun fresh =
-        run_cli("train " + typo + " --steps 16 --quiet --out " + (folder / "new").string());
-    EXPECT_NE(fresh.exit_code, 0) << fresh.output;
-    EXPECT_THAT(fresh.output, ::testing::AnyOf(::testing::HasSubstr("\"CartPoleBalanc-v0\""),
-                                               ::testing::HasSubstr("\"widht\"")));
+    // A load that makes the run warn of busy cores, were it to start.
+    const std::string busy = "env -u OMP_NUM_THREADS PIXELGYM_LOADAVG=64";
+    const CliRun fresh = run_cli("train " + typo + " --steps 16 --torch-threads 2 --quiet --out " +
+                                     (folder / "new").string(),
+                                 busy);
+    EXPECT_EQ(fresh.exit_code, 2) << fresh.output;
+    EXPECT_THAT(fresh.output, ::testing::StartsWith(first_line));
+    EXPECT_THAT(fresh.output,
+                ::testing::EndsWith("\nRun 'pixelgym train --help' for the options.\n"));
+    EXPECT_EQ(std::count(fresh.output.begin(), fresh.output.end(), '\n'), 2) << fresh.output;
     EXPECT_FALSE(fs::exists(folder / "new"));
     fs::create_directories(folder / "given");
     const CliRun given =
         run_cli("train " + typo + " --steps 16 --quiet --out " + (folder / "given").string());
-    EXPECT_NE(given.exit_code, 0) << given.output;
+    EXPECT_EQ(given.exit_code, 2) << given.output;
     EXPECT_TRUE(fs::is_empty(folder / "given")) << "a refused run left files in its folder";
+    // --print-config checks what the run would: it prints nothing for settings it refuses.
+    const CliRun printed = run_cli("train " + typo + " --print-config");
+    EXPECT_EQ(printed.exit_code, 2) << printed.output;
+    EXPECT_THAT(printed.output, ::testing::StartsWith(first_line));
+    EXPECT_THAT(printed.output, ::testing::Not(::testing::HasSubstr("{")));
   }
-  // A kwarg the env refuses only once it is built (a value out of range) is refused after the
-  // lock is taken: the lock goes with the refusal.
+  // A kwarg the env refuses only once it is built (msaa=8 where this OpenGL offers less) is
+  // refused after the lock is taken, as a usage error too: the lock goes with the refusal.
   const CliRun built = run_cli(
-      train_arguments(folder, "--steps 16 --set width=1 --out " + (folder / "given").string()));
-  EXPECT_NE(built.exit_code, 0) << built.output;
-  EXPECT_TRUE(fs::is_empty(folder / "given")) << built.output;
+      train_arguments(folder, "--steps 16 --set msaa=8 --out " + (folder / "given").string()),
+      "env -u OMP_NUM_THREADS PIXELGYM_LOADAVG=64");
+  if (built.output.find("is more than this OpenGL offers") != std::string::npos) {
+    EXPECT_EQ(built.exit_code, 2) << built.output;
+    EXPECT_THAT(built.output, ::testing::StartsWith("pixelgym: "));
+    EXPECT_THAT(built.output, ::testing::Not(::testing::HasSubstr("warning:")));
+    EXPECT_TRUE(fs::is_empty(folder / "given")) << built.output;
+  }
+  fs::remove_all(folder);
+}
+
+// A config file that does not exist but names a recipe, and an eval path that is no run, are
+// answered with what was expected.
+TEST(TrainCliTest, MissingConfigFilesAndRunFoldersSayWhatWasExpected) {
+  const CliRun recipe = run_cli("train CartPoleSwingup-v1 --config swingup.json --print-config");
+  EXPECT_EQ(recipe.exit_code, 2) << recipe.output;
+  EXPECT_THAT(recipe.output,
+              ::testing::HasSubstr("cannot read swingup.json (no such file); did you mean the "
+                                   "recipe --config swingup?"));
+  const fs::path folder = fresh_folder("no_run");
+  const CliRun missing = run_cli("eval " + (folder / "none").string());
+  EXPECT_EQ(missing.exit_code, 1) << missing.output;
+  EXPECT_THAT(missing.output, ::testing::HasSubstr("eval: " + (folder / "none").string() +
+                                                   " does not exist; expected a run folder"));
+  const CliRun empty = run_cli("eval " + folder.string());
+  EXPECT_EQ(empty.exit_code, 1) << empty.output;
+  EXPECT_THAT(empty.output, ::testing::HasSubstr("eval: " + folder.string() +
+                                                 " is not a run folder (no checkpoint "
+                                                 "ckpt-*.pgck, config.json or summary.json"));
   fs::remove_all(folder);
 }
 

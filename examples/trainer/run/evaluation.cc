@@ -87,6 +87,11 @@ std::unique_ptr<vector::SyncVectorEnv> evaluation_env(const RunSettings& setting
 // The checkpoint `run_or_checkpoint` names (see evaluate_checkpoint) and the folder of its run.
 std::pair<LoadedCheckpoint, fs::path> find_checkpoint(const fs::path& run_or_checkpoint,
                                                       std::ostream& errors) {
+  if (!fs::exists(run_or_checkpoint)) {
+    throw std::runtime_error("eval: " + run_or_checkpoint.string() +
+                             " does not exist; expected a run folder (`pixelgym train --out`'s) "
+                             "or a checkpoint file (ckpt-*.pgck)");
+  }
   if (!fs::is_directory(run_or_checkpoint)) {
     const fs::path folder =
         run_or_checkpoint.parent_path().empty() ? fs::path(".") : run_or_checkpoint.parent_path();
@@ -98,6 +103,11 @@ std::pair<LoadedCheckpoint, fs::path> find_checkpoint(const fs::path& run_or_che
   CheckpointSearch search = find_latest_checkpoint(run_or_checkpoint);
   for (const auto& skipped : search.skipped) {
     errors << "eval: skipping " << skipped.path.string() << ": " << skipped.reason << "\n";
+  }
+  if (!search.latest && search.skipped.empty() && !fs::exists(run_or_checkpoint / "config.json")) {
+    throw std::runtime_error("eval: " + run_or_checkpoint.string() +
+                             " is not a run folder (no checkpoint ckpt-*.pgck, config.json or "
+                             "summary.json in it)");
   }
   if (!search.latest) {
     throw std::runtime_error("eval: no valid checkpoint in " + run_or_checkpoint.string());

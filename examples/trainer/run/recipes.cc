@@ -58,7 +58,16 @@ std::string config_text(const std::string& value, const std::string& algorithm,
   if (first != std::string::npos && value[first] == '{') return value;
   const bool is_path = value.find('/') != std::string::npos ||
                        (value.size() > 5 && value.compare(value.size() - 5, 5, ".json") == 0);
-  if (is_path) return read_text(value, what);
+  if (is_path) {
+    // swingup.json for the recipe swingup.
+    const std::string stem = fs::path(value).stem().string();
+    if (!fs::exists(value) && fs::is_regular_file(recipe_folder(algorithm) / (stem + ".json"))) {
+      throw std::invalid_argument(what + ": cannot read " + value +
+                                  " (no such file); did you mean the recipe --config " + stem +
+                                  "?");
+    }
+    return read_text(value, what);
+  }
   const fs::path recipe = recipe_folder(algorithm) / (value + ".json");
   if (fs::is_regular_file(recipe)) return read_text(recipe, what);
 

@@ -441,10 +441,10 @@ std::optional<json> TrainingRun::train() {
     // it).
     const bool threads_given = settings_.torch_threads != 0;
     settings_.torch_threads = factory_->set_threads(settings_.torch_threads);
+    // Said once the envs are made: an env the run refuses is its first and only word.
     if (!nothing) {
-      const std::string warning =
+      busy_cores_warning_ =
           busy_cores_warning(settings_.torch_threads, threads_given, cpu_availability());
-      if (!warning.empty()) output_.out << warning << std::endl;
     }
     if (distributed()) send_start(nothing);
     if (nothing) {
@@ -461,7 +461,14 @@ std::optional<json> TrainingRun::train() {
   const bool folder_existed = fs::exists(folder_);
   if (lead() && !lock_) lock_ = RunLock::acquire(folder_, "train");
   try {
-    env_ = make_training_env(settings_, parse_sets_);
+    try {
+      env_ = make_training_env(settings_, parse_sets_);
+    } catch (const std::invalid_argument& error) {
+      // A new run's env config that `make` refuses (msaa more than this OpenGL offers) is the
+      // request's fault; a resumed run's was made before.
+      if (checkpoint_ || restart_) throw;
+      throw RunRequestError(error.what());
+    }
     algorithm_ = factory_->make(*env_, settings_.algorithm_config, communicator_);
   } catch (...) {
     // Refused before anything was written (an env it cannot train on, settings that do not fit
@@ -474,6 +481,7 @@ std::optional<json> TrainingRun::train() {
     throw;
   }
   if (lead()) {
+    if (!busy_cores_warning_.empty()) output_.out << busy_cores_warning_ << std::endl;
     output_.out << "observation: " << observation_summary(env_->single_observation_space())
                 << std::endl;
   }
