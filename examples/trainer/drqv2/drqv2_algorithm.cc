@@ -395,11 +395,11 @@ int DrqV2AlgorithmFactory::set_threads(int requested) const {
 }
 
 std::unique_ptr<trainer::Algorithm> DrqV2AlgorithmFactory::make(
-    vector::VectorEnv& env, const json& config, trainer::Communicator* communicator) const {
-  if (communicator != nullptr && communicator->world_size() > 1) {
+    vector::VectorEnv& env, const json& config, trainer::Communicator& communicator) const {
+  if (communicator.world_size() > 1) {
     throw std::invalid_argument(
         "train --algo drqv2 runs in one process; it was started as " +
-        std::to_string(communicator->world_size()) +
+        std::to_string(communicator.world_size()) +
         " ranks (--nproc or WORLD_SIZE). Data-parallel training is PPO's (--algo ppo)");
   }
   DrqV2Config parsed;

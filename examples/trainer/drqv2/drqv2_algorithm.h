@@ -128,7 +128,7 @@ class DrqV2AlgorithmFactory final : public trainer::AlgorithmFactory {
   /// process (its replay buffer and updates are not shared across ranks).
   std::unique_ptr<trainer::Algorithm> make(
       vector::VectorEnv& env, const nlohmann::json& config,
-      trainer::Communicator* communicator = nullptr) const override;
+      trainer::Communicator& communicator) const override;
   /// An Agent of the config for these spaces with the checkpoint's "agent".
   std::unique_ptr<trainer::Actor> load_actor(
       const Space& observation_space, const Space& action_space, const nlohmann::json& config,

@@ -391,7 +391,10 @@ std::vector<trainer::MemoryUse> memory_estimate(const Space& observation_space,
   };
 }
 
-Trainer::Trainer(vector::VectorEnv& env, PpoConfig config, trainer::Communicator* communicator)
+Trainer::Trainer(vector::VectorEnv& env, PpoConfig config)
+    : Trainer(env, std::move(config), single_process_) {}
+
+Trainer::Trainer(vector::VectorEnv& env, PpoConfig config, trainer::Communicator& communicator)
     : config_(std::move(config)),
       policy_(make_policy(env, config_)),
       optimizer_(std::make_unique<torch::optim::Adam>(
@@ -411,8 +414,8 @@ Trainer::Trainer(vector::VectorEnv& env, PpoConfig config, trainer::Communicator
   normalizer_ =
       std::make_unique<vector::NormalizeReward>(std::move(episodes), config_.gamma, kRewardEpsilon);
   reward_statistics_before_ = normalizer_->statistics();
-  communicator_ = communicator;
-  if (communicator_ == nullptr || communicator_->world_size() == 1) return;
+  communicator_ = &communicator;
+  if (alone()) return;
   const auto rank = static_cast<std::uint64_t>(communicator_->rank());
   sampling_ = at::detail::createCPUGenerator(config_.seed + rank * kRankSeedStride);
   augmentation_ = at::detail::createCPUGenerator(config_.seed + 1 + rank * kRankSeedStride);
@@ -429,8 +432,7 @@ Trainer::Trainer(vector::VectorEnv& env, PpoConfig config, trainer::Communicator
 }
 
 std::uint64_t Trainer::env_seed() const {
-  const std::uint64_t rank =
-      communicator_ == nullptr ? 0 : static_cast<std::uint64_t>(communicator_->rank());
+  const auto rank = static_cast<std::uint64_t>(communicator_->rank());
   return config_.seed + rank * static_cast<std::uint64_t>(config_.num_envs);
 }
 
@@ -446,14 +448,14 @@ std::uint64_t Trainer::parameter_digest() const {
 }
 
 void Trainer::all_reduce(std::vector<double>& values, const std::string& what) {
-  if (communicator_ == nullptr || communicator_->world_size() == 1) return;
+  if (alone()) return;
   const auto start = Clock::now();
   communicator_->all_reduce_sum(values.data(), values.size(), what);
   collective_seconds_ += seconds_since(start);
 }
 
 void Trainer::average_gradients(const MinibatchPosition& at) {
-  if (communicator_ == nullptr || communicator_->world_size() == 1) return;
+  if (alone()) return;
   std::vector<torch::Tensor> gradients;
   for (const torch::Tensor& parameter : policy_->parameters()) {
     if (parameter.grad().defined()) gradients.push_back(parameter.grad());
@@ -481,7 +483,7 @@ void Trainer::average_gradients(const MinibatchPosition& at) {
 void Trainer::merge_statistics(
     const std::map<std::string, wrappers::RunningStatistics>& observations,
     const wrappers::RunningStatistics& rewards) {
-  if (communicator_ == nullptr || communicator_->world_size() == 1) return;
+  if (alone()) return;
   for (const auto& [key, before] : observations) {
     wrappers::RunningStatistics merged = policy_->observation_statistics(key);
     trainer::merge_statistics_across_ranks(*communicator_, before, merged,
@@ -497,7 +499,7 @@ void Trainer::merge_statistics(
 }
 
 bool Trainer::preempted(std::int64_t steps_done) {
-  if (!config_.preempt_stragglers || communicator_ == nullptr || communicator_->world_size() == 1 ||
+  if (!config_.preempt_stragglers || alone() ||
       steps_done >= config_.num_steps ||
       steps_done < preempt_min_steps(config_.num_steps, config_.preempt_min_steps_fraction)) {
     return false;
@@ -533,7 +535,7 @@ void Trainer::replay_env(const std::string& env_action_log) {
   const std::size_t batch_bytes = env_actions.nbytes();
   // Distributed, a rank's own steps are not env_steps_ (every rank's), nor its share when
   // stragglers were preempted: its log holds whole batches.
-  const bool distributed = communicator_ != nullptr && communicator_->world_size() > 1;
+  const bool distributed = !alone();
   const auto batches = distributed ? env_action_log.size() / batch_bytes
                                    : static_cast<std::size_t>(env_steps_ / config_.num_envs);
   if (env_action_log.size() != batches * batch_bytes) {
@@ -556,7 +558,7 @@ void Trainer::replay_env(const std::string& env_action_log) {
 }
 
 bool Trainer::env_action_log_complete() const {
-  if (communicator_ != nullptr && communicator_->world_size() > 1) return log_from_start_;
+  if (!alone()) return log_from_start_;
   const auto batches = static_cast<std::size_t>(env_steps_ / config_.num_envs);
   return env_action_log_.size() == batches * actions_.array().nbytes();
 }
@@ -579,7 +581,7 @@ std::uint64_t Trainer::env_digest() const {
   return digest;
 }
 
-bool Trainer::alone() const { return communicator_ == nullptr || communicator_->world_size() == 1; }
+bool Trainer::alone() const { return communicator_->world_size() == 1; }
 
 RolloutStats Trainer::collect(const trainer::StopCheck& stop) {
   torch::NoGradGuard no_grad;
@@ -655,7 +657,7 @@ RolloutStats Trainer::collect(const trainer::StopCheck& stop) {
   storage_.compute_advantages(config_.gamma, config_.gae_lambda, steps);
   collected_steps_ = steps;
   std::vector<double> rollout_steps{static_cast<double>(steps * envs)};
-  if (config_.preempt_stragglers && communicator_ != nullptr) {
+  if (config_.preempt_stragglers) {
     communicator_->mark_rollout_done(updates_);
   }
   all_reduce(rollout_steps, "the rollout's step count");
@@ -757,7 +759,7 @@ double Trainer::step_minibatch(const UpdateBatch& batch, const torch::Tensor& in
   const torch::Tensor ratio = log_ratio.exp();
   torch::Tensor advantage = batch.advantages.index_select(0, index);
   if (config_.normalize_advantages) {
-    if (communicator_ == nullptr || communicator_->world_size() == 1) {
+    if (alone()) {
       if (advantage.size(0) > 1) {
         advantage = (advantage - advantage.mean()) / (advantage.std() + 1e-8);
       }
@@ -851,7 +853,7 @@ UpdateStats Trainer::update(const trainer::StopCheck& stop_check) {
       }
       double approx_kl = step_minibatch(batch, index, at, stats);
       policy_steps_in_epoch += 1;
-      if (config_.target_kl > 0.0 && communicator_ != nullptr) {
+      if (config_.target_kl > 0.0 && !alone()) {
         // Every rank must stop at the same minibatch: the mean KL over the ranks decides.
         std::vector<double> kl{approx_kl};
         all_reduce(kl, "the approximate KL");
@@ -870,7 +872,7 @@ UpdateStats Trainer::update(const trainer::StopCheck& stop_check) {
   }
   finish_update_stats(stats);
   std::map<std::string, wrappers::RunningStatistics> observations_before;
-  if (communicator_ != nullptr && policy_->config().normalize_observations) {
+  if (!alone() && policy_->config().normalize_observations) {
     for (const PolicyInput& input : policy_->inputs()) {
       try {
         observations_before.emplace(input.key, policy_->observation_statistics(input.key));
@@ -911,7 +913,7 @@ void Trainer::finish_update_stats(UpdateStats& stats) {
                            errors.sum().item<double>(),
                            errors.pow(2).sum().item<double>()};
   all_reduce(sums, "the update's statistics");
-  const double ranks = communicator_ == nullptr ? 1.0 : communicator_->world_size();
+  const double ranks = communicator_->world_size();
   stats.policy_loss = sums[0] / ranks;
   stats.value_loss = sums[1] / ranks;
   stats.entropy = sums[2] / ranks;
@@ -951,7 +953,7 @@ void Trainer::load_rollout(const RolloutStorage& rollout) {
   storage_.advantages.copy_(rollout.advantages);
   storage_.returns.copy_(rollout.returns);
   collected_steps_ = config_.num_steps;
-  const std::int64_t ranks = communicator_ == nullptr ? 1 : communicator_->world_size();
+  const std::int64_t ranks = communicator_->world_size();
   last_rollout_steps_ = config_.num_steps * config_.num_envs * ranks;
   env_steps_ += last_rollout_steps_;
   collected_ = true;

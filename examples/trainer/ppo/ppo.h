@@ -244,9 +244,14 @@ class Trainer {
  public:
   /// Throws std::invalid_argument when config.validate() fails, when the env's autoreset mode
   /// is not SameStep or its num_envs differs from config.num_envs, and as Policy's constructor.
-  /// `communicator` (null: one process) must outlive the trainer; every rank must construct its
-  /// trainer with the same config.
-  Trainer(vector::VectorEnv& env, PpoConfig config, trainer::Communicator* communicator = nullptr);
+  /// This constructor trains in one process (a trainer::SingleProcessCommunicator of its own).
+  Trainer(vector::VectorEnv& env, PpoConfig config);
+  /// As one rank of `communicator`'s run, which must outlive the trainer; every rank must
+  /// construct its trainer with the same config.
+  Trainer(vector::VectorEnv& env, PpoConfig config, trainer::Communicator& communicator);
+  /// Not copied or moved: it points at its own communicator when it trains alone.
+  Trainer(const Trainer&) = delete;
+  Trainer& operator=(const Trainer&) = delete;
 
   /// Steps every env num_steps times with actions sampled from the policy (no gradients),
   /// storing the transitions and the values GAE needs, then computes advantages and returns.
@@ -389,7 +394,9 @@ class Trainer {
   Value actions_;                   // laid out as env_.action_space()
   ObservationTensors current_obs_;  // views of the env's observation batch
   std::string env_action_log_;
-  trainer::Communicator* communicator_ = nullptr;
+  // The one-process communicator, when the trainer was not given one.
+  trainer::SingleProcessCommunicator single_process_;
+  trainer::Communicator* communicator_;  // never null: &single_process_ or the one given
   MinibatchOrder minibatch_order_;
   std::int64_t collected_steps_ = 0;     // steps per env of the last rollout (<= num_steps)
   std::int64_t last_rollout_steps_ = 0;  // env steps of every rank in the last rollout

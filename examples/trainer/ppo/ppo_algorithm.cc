@@ -62,7 +62,7 @@ ActCounts PpoActor::act(const Value& observations, bool deterministic, Value& ac
 }
 
 PpoAlgorithm::PpoAlgorithm(vector::VectorEnv& env, PpoConfig config,
-                           trainer::Communicator* communicator)
+                           trainer::Communicator& communicator)
     : trainer_(env, std::move(config), communicator), actor_(trainer_.policy_ptr()) {}
 
 std::vector<std::string> PpoAlgorithm::rank_blobs() const {
@@ -156,7 +156,7 @@ int set_torch_threads(int requested) {
 }
 
 std::unique_ptr<Algorithm> PpoAlgorithmFactory::make(vector::VectorEnv& env, const json& config,
-                                                     trainer::Communicator* communicator) const {
+                                                     trainer::Communicator& communicator) const {
   return std::make_unique<PpoAlgorithm>(env, config_from_json(config.dump()), communicator);
 }
 

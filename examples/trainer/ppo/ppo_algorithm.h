@@ -38,8 +38,7 @@ class PpoActor final : public trainer::Actor {
 class PpoAlgorithm final : public trainer::Algorithm {
  public:
   /// Throws as Trainer's constructor.
-  PpoAlgorithm(vector::VectorEnv& env, PpoConfig config,
-               trainer::Communicator* communicator = nullptr);
+  PpoAlgorithm(vector::VectorEnv& env, PpoConfig config, trainer::Communicator& communicator);
 
   trainer::IterationStats iterate(const trainer::StopCheck& stop) override;
   std::int64_t env_steps() const override { return trainer_.env_steps(); }
@@ -80,7 +79,7 @@ class PpoAlgorithmFactory final : public trainer::AlgorithmFactory {
   /// Trains distributed (see Trainer) with a communicator of several ranks.
   std::unique_ptr<trainer::Algorithm> make(
       vector::VectorEnv& env, const nlohmann::json& config,
-      trainer::Communicator* communicator = nullptr) const override;
+      trainer::Communicator& communicator) const override;
   /// A Policy of config["policy"] with the checkpoint's "model", in eval mode.
   std::unique_ptr<trainer::Actor> load_actor(
       const Space& observation_space, const Space& action_space, const nlohmann::json& config,

@@ -135,11 +135,12 @@ class AlgorithmFactory {
   /// default; returns the count in use.
   virtual int set_threads(int requested) const = 0;
   /// The algorithm, to train on `env` (SameStep autoreset, config["num_envs"] envs) with
-  /// `config` (as parse_config gives it), as one rank of `communicator`'s run (null: a single
-  /// process; it must outlive the algorithm). Throws std::invalid_argument for an env it cannot
-  /// train on, or a communicator of several ranks when it does not train distributed.
+  /// `config` (as parse_config gives it), as one rank of `communicator`'s run (a
+  /// SingleProcessCommunicator for one process; it must outlive the algorithm). Throws
+  /// std::invalid_argument for an env it cannot train on, or a communicator of several ranks
+  /// when it does not train distributed.
   virtual std::unique_ptr<Algorithm> make(vector::VectorEnv& env, const nlohmann::json& config,
-                                          Communicator* communicator = nullptr) const = 0;
+                                          Communicator& communicator) const = 0;
   /// The policy saved in `checkpoint`, for an env of these spaces, to act only. Throws
   /// std::runtime_error naming checkpoint.path when a blob it needs is not there.
   virtual std::unique_ptr<Actor> load_actor(const Space& observation_space,

@@ -5,6 +5,44 @@
 
 namespace pixelgym::trainer {
 
+void SingleProcessCommunicator::all_reduce_sum(float* /*data*/, std::size_t /*count*/,
+                                               const std::string& /*what*/) {}
+
+void SingleProcessCommunicator::all_reduce_sum(double* /*data*/, std::size_t /*count*/,
+                                               const std::string& /*what*/) {}
+
+void SingleProcessCommunicator::broadcast(float* /*data*/, std::size_t /*count*/,
+                                          const std::string& /*what*/) {}
+
+std::vector<std::uint64_t> SingleProcessCommunicator::all_gather(std::uint64_t value,
+                                                                 const std::string& /*what*/) {
+  return {value};
+}
+
+std::vector<std::string> SingleProcessCommunicator::gather_bytes(const std::string& bytes,
+                                                                 const std::string& /*what*/) {
+  return {bytes};
+}
+
+std::string SingleProcessCommunicator::scatter_bytes(const std::vector<std::string>& per_rank,
+                                                     const std::string& what) {
+  if (per_rank.size() != 1) {
+    throw std::invalid_argument("SingleProcessCommunicator::scatter_bytes (" + what +
+                                "): one part (for rank 0) expected, got " +
+                                std::to_string(per_rank.size()));
+  }
+  return per_rank.front();
+}
+
+int SingleProcessCommunicator::mark_rollout_done(std::int64_t round) {
+  rounds_done_ = std::max(rounds_done_, round);
+  return 1;
+}
+
+int SingleProcessCommunicator::rollouts_done(std::int64_t round) {
+  return round <= rounds_done_ ? 1 : 0;
+}
+
 void merge_statistics_across_ranks(Communicator& communicator,
                                    const wrappers::RunningStatistics& before,
                                    wrappers::RunningStatistics& statistics,

@@ -1,7 +1,7 @@
 // The ranks of a data-parallel training run as the trainer sees them, without torch: the
 // collective operations a run and its algorithm need (sums, broadcast, gathers of digests and of
 // bytes), and straggler bookkeeping. distributed::GlooCommunicator implements it on PyTorch's
-// c10d (Gloo over TCP); a single process passes no communicator at all.
+// c10d (Gloo over TCP); SingleProcessCommunicator is the run of one process (world size 1).
 #pragma once
 
 #include <cstddef>
@@ -56,6 +56,31 @@ class Communicator {
   /// This rank leaves the run normally: the others stop watching it. Not collective; no
   /// collective may follow on this rank.
   virtual void finish() = 0;
+};
+
+/// The communicator of a run of one process: rank 0 of a world of size 1. Its collectives are
+/// what they are with one rank: sums and broadcasts leave the values as they are, gathers return
+/// this process's own, and scatter returns per_rank[0]. Never throws DistributedError.
+class SingleProcessCommunicator final : public Communicator {
+ public:
+  int rank() const override { return 0; }
+  int world_size() const override { return 1; }
+  void all_reduce_sum(float* data, std::size_t count, const std::string& what) override;
+  void all_reduce_sum(double* data, std::size_t count, const std::string& what) override;
+  void broadcast(float* data, std::size_t count, const std::string& what) override;
+  std::vector<std::uint64_t> all_gather(std::uint64_t value, const std::string& what) override;
+  std::vector<std::string> gather_bytes(const std::string& bytes,
+                                        const std::string& what) override;
+  /// Throws std::invalid_argument when `per_rank` does not hold exactly one string.
+  std::string scatter_bytes(const std::vector<std::string>& per_rank,
+                            const std::string& what) override;
+  /// 1 (this process) once `round` is marked, else 0.
+  int mark_rollout_done(std::int64_t round) override;
+  int rollouts_done(std::int64_t round) override;
+  void finish() override {}
+
+ private:
+  std::int64_t rounds_done_ = -1;  // the latest round marked done; -1: none
 };
 
 /// Sums over the ranks of the samples merged into running statistics since they were `before`

@@ -343,10 +343,10 @@ void TrainingRun::distribute(Communicator& communicator) {
   communicator_ = &communicator;
 }
 
-bool TrainingRun::lead() const { return communicator_ == nullptr || communicator_->rank() == 0; }
+bool TrainingRun::lead() const { return communicator_->rank() == 0; }
 
 bool TrainingRun::distributed() const {
-  return communicator_ != nullptr && communicator_->world_size() > 1;
+  return communicator_->world_size() > 1;
 }
 
 void TrainingRun::send_start(bool nothing) {
@@ -420,7 +420,7 @@ std::optional<json> TrainingRun::train() {
     std::optional<RunLock>& lock;
     ~ReleaseLock() { lock.reset(); }
   } release_lock{lock_};
-  const int world = communicator_ == nullptr ? 1 : communicator_->world_size();
+  const int world = communicator_->world_size();
   if (lead()) {
     if (checkpoint_ && settings_.world_size != world) {
       throw RunRequestError(
@@ -448,7 +448,7 @@ std::optional<json> TrainingRun::train() {
     }
     if (distributed()) send_start(nothing);
     if (nothing) {
-      if (communicator_ != nullptr) communicator_->finish();
+      communicator_->finish();
       return std::nullopt;
     }
   } else {
@@ -469,7 +469,7 @@ std::optional<json> TrainingRun::train() {
       if (checkpoint_ || restart_) throw;
       throw RunRequestError(error.what());
     }
-    algorithm_ = factory_->make(*env_, settings_.algorithm_config, communicator_);
+    algorithm_ = factory_->make(*env_, settings_.algorithm_config, *communicator_);
   } catch (...) {
     // Refused before anything was written (an env it cannot train on, settings that do not fit
     // in memory): a new run leaves no folder behind, only the lock it took.
@@ -507,11 +507,11 @@ std::optional<json> TrainingRun::train() {
   if (interrupted_) {
     output_.out << "interrupted at " << algorithm_->env_steps() << " env steps: wrote "
                 << last_checkpoint_.string() << " (no final evaluation)" << std::endl;
-    if (communicator_ != nullptr) communicator_->finish();
+    communicator_->finish();
     return std::nullopt;
   }
   json summary = evaluate_and_summarize();
-  if (communicator_ != nullptr) communicator_->finish();
+  communicator_->finish();
   return summary;
 }
 

@@ -251,7 +251,10 @@ class TrainingRun {
   std::vector<EvalRow> evals_;  // eval.csv's rows
   double eval_seconds_ = 0.0;   // spent in evaluations during training by this process
   std::chrono::steady_clock::time_point start_;
-  Communicator* communicator_ = nullptr;
+  // The communicator of one process, the run's unless distribute or join gives another (on the
+  // heap: a TrainingRun is moved out of create and resume).
+  std::unique_ptr<Communicator> single_process_ = std::make_unique<SingleProcessCommunicator>();
+  Communicator* communicator_ = single_process_.get();  // never null
   std::vector<std::uint64_t> parameter_digests_;  // every rank's, at the last check
   std::optional<RunLock> lock_;                   // the run folder's, from resume or train
   AlgorithmFactories join_algorithms_;            // join: the algorithm rank 0's config names

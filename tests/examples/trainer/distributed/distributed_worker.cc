@@ -117,7 +117,7 @@ int equivalence(distributed::GlooCommunicator& communicator) {
   single.collect();
   // This rank: 4 envs, learning from its half of the same rollout.
   auto env4 = make_env(kEnvsPerRank);
-  Trainer ranked(*env4, config_for(kEnvsPerRank), &communicator);
+  Trainer ranked(*env4, config_for(kEnvsPerRank), communicator);
   RolloutStorage half(ranked.policy(), kSteps, kEnvsPerRank);
   copy_envs(single.storage(), rank * kEnvsPerRank, kEnvsPerRank, half);
   ranked.load_rollout(half);
@@ -187,7 +187,7 @@ int statistics(distributed::GlooCommunicator& communicator) {
 
 int digest_mismatch(distributed::GlooCommunicator& communicator) {
   auto env = make_env(kEnvsPerRank);
-  Trainer ranked(*env, config_for(kEnvsPerRank), &communicator);
+  Trainer ranked(*env, config_for(kEnvsPerRank), communicator);
   if (communicator.rank() == 1) {
     torch::NoGradGuard no_grad;
     ranked.policy().parameters()[0].view(-1)[0].add_(1e-3);
@@ -226,7 +226,7 @@ int preemption(distributed::GlooCommunicator& communicator) {
   config.preempt_min_steps_fraction = 0.25;
   config.num_minibatches = 2;
   config.update_epochs = 1;
-  Trainer ranked(*env, config, &communicator);
+  Trainer ranked(*env, config, communicator);
   constexpr int kIterations = 3;
   std::int64_t local_steps = 0;
   for (int i = 0; i < kIterations; ++i) {

@@ -177,7 +177,7 @@ class CountingFactory final : public AlgorithmFactory {
   }
   int set_threads(int requested) const override { return requested == 0 ? 3 : requested; }
   std::unique_ptr<Algorithm> make(vector::VectorEnv& env, const json& config,
-                                  Communicator* /*communicator*/ = nullptr) const override {
+                                  Communicator& /*communicator*/) const override {
     auto algorithm = std::make_unique<CountingAlgorithm>(env, config);
     algorithm->actor_.sleep_ms = actor_sleep_ms;
     last = algorithm.get();
