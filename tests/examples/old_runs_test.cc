@@ -33,8 +33,8 @@ std::string read_text(const fs::path& path) {
 
 // A scratch copy of the committed run folder `name` (the test data itself is never written).
 fs::path copy_of_run(const std::string& name) {
-  const fs::path copy = fs::temp_directory_path() /
-                        ("pixelgym_old_runs_" + name + "_" + std::to_string(::getpid()));
+  const fs::path copy =
+      fs::temp_directory_path() / ("pixelgym_old_runs_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(copy);
   fs::copy(fs::path(OLD_RUNS_DIR) / name, copy, fs::copy_options::recursive);
   return copy;
@@ -74,21 +74,19 @@ void expect_resumes_and_evaluates_unchanged(const std::string& name,
 }
 
 TEST(OldRunsTest, APpoRunOfBc3ad29ResumesAndEvaluatesUnchanged) {
-  expect_resumes_and_evaluates_unchanged(
-      "ppo-bc3ad29",
-      "episode 0: return=49.0411\nepisode 1: return=49.6917\n"
-      "return_mean=49.3664 return_std=0.325322",
-      "episode 0: return=49.0232\nepisode 1: return=49.6724\n"
-      "return_mean=49.3478 return_std=0.324587");
+  expect_resumes_and_evaluates_unchanged("ppo-bc3ad29",
+                                         "episode 0: return=49.0411\nepisode 1: return=49.6917\n"
+                                         "return_mean=49.3664 return_std=0.325322",
+                                         "episode 0: return=49.0232\nepisode 1: return=49.6724\n"
+                                         "return_mean=49.3478 return_std=0.324587");
 }
 
 TEST(OldRunsTest, ADrqV2RunOfBc3ad29ResumesAndEvaluatesUnchanged) {
-  expect_resumes_and_evaluates_unchanged(
-      "drqv2-bc3ad29",
-      "episode 0: return=48.918\nepisode 1: return=49.7067\n"
-      "return_mean=49.3123 return_std=0.394316",
-      "episode 0: return=47.9797\nepisode 1: return=48.2675\n"
-      "return_mean=48.1236 return_std=0.143901");
+  expect_resumes_and_evaluates_unchanged("drqv2-bc3ad29",
+                                         "episode 0: return=48.918\nepisode 1: return=49.7067\n"
+                                         "return_mean=49.3123 return_std=0.394316",
+                                         "episode 0: return=47.9797\nepisode 1: return=48.2675\n"
+                                         "return_mean=48.1236 return_std=0.143901");
 }
 
 }  // namespace

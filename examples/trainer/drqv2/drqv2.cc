@@ -12,7 +12,6 @@
 #include <stdexcept>
 #include <utility>
 
-#include "examples/trainer/ppo/policy.h"
 #include "examples/trainer/run/config_members.h"
 #include "pixelgym/envs/spaces/box.h"
 #include "pixelgym/envs/spaces/dict.h"
@@ -56,17 +55,7 @@ class CpuAutocast {
   bool previous_ = false;
 };
 
-void orthogonal_init(torch::nn::Module& module, double gain) {
-  for (auto& child : module.modules(/*include_self=*/true)) {
-    if (auto* linear = child->as<torch::nn::Linear>()) {
-      torch::nn::init::orthogonal_(linear->weight, gain);
-      torch::nn::init::zeros_(linear->bias);
-    } else if (auto* conv = child->as<torch::nn::Conv2d>()) {
-      torch::nn::init::orthogonal_(conv->weight, gain);
-      torch::nn::init::zeros_(conv->bias);
-    }
-  }
-}
+using trainer::orthogonal_init;
 
 torch::nn::Sequential make_trunk(std::int64_t in, std::int64_t features) {
   torch::nn::Sequential trunk(torch::nn::Linear(in, features),
@@ -84,46 +73,7 @@ torch::nn::Sequential make_mlp(std::int64_t in, std::int64_t hidden, std::int64_
   return mlp;
 }
 
-std::string shape_text(const Shape& shape) {
-  std::string text = "(";
-  for (std::size_t i = 0; i < shape.size(); ++i) {
-    text += (i ? ", " : "") + std::to_string(shape[i]);
-  }
-  return text + (shape.size() == 1 ? ",)" : ")");
-}
-
 }  // namespace
-
-const char* to_string(EncoderArchitecture architecture) {
-  switch (architecture) {
-    case EncoderArchitecture::kDrqV2:
-      return "drqv2";
-    case EncoderArchitecture::kMrq:
-      return "mrq";
-    case EncoderArchitecture::kFine:
-      return "fine";
-  }
-  return "?";
-}
-
-std::vector<std::int64_t> encoder_strides(EncoderArchitecture architecture) {
-  switch (architecture) {
-    case EncoderArchitecture::kDrqV2:
-      return {2, 1, 1, 1};
-    case EncoderArchitecture::kMrq:
-      return {2, 2, 2, 1};
-    case EncoderArchitecture::kFine:
-      return {2, 2, 1, 1};
-  }
-  return {};
-}
-
-EncoderArchitecture parse_encoder_architecture(const std::string& name) {
-  if (name == "drqv2") return EncoderArchitecture::kDrqV2;
-  if (name == "mrq") return EncoderArchitecture::kMrq;
-  if (name == "fine") return EncoderArchitecture::kFine;
-  throw std::invalid_argument("unknown encoder \"" + name + "\"; known: drqv2, mrq, fine");
-}
 
 void DrqV2Config::validate() const {
   const auto fail = [](const std::string& what) {
@@ -263,92 +213,6 @@ bool cpu_has_bfloat16() {
   return false;
 }
 
-ReplayLayout InputLayout::replay_layout() const {
-  ReplayLayout layout;
-  if (has_image) layout.images.push_back({image_key, stack, height * width * channels});
-  for (std::size_t v = 0; v < vector_keys.size(); ++v) {
-    layout.vectors.push_back({vector_keys[v], vector_sizes[v]});
-  }
-  layout.action_size = action_size;
-  return layout;
-}
-
-InputLayout input_layout(const Space& observation_space, const Space& action_space,
-                         std::int64_t frame_stack, const std::string& env_name) {
-  const std::string where = "drqv2 on " + env_name + ": ";
-  InputLayout input;
-  input.stack = frame_stack;
-  const auto* action_box = dynamic_cast<const spaces::Box*>(&action_space);
-  if (action_box == nullptr || !is_floating(*action_box->dtype())) {
-    throw std::invalid_argument(where +
-                                "the learner acts with continuous (float Box) actions; the "
-                                "action space is " +
-                                action_space.to_string());
-  }
-  input.action_size = static_cast<std::int64_t>(action_box->low().size());
-  for (std::size_t i = 0; i < action_box->low().size(); ++i) {
-    const double low = action_box->low()[i];
-    const double high = action_box->high()[i];
-    if (!std::isfinite(low) || !std::isfinite(high)) {
-      throw std::invalid_argument(where + "the action space must be bounded, got " +
-                                  action_space.to_string());
-    }
-    input.action_low.push_back(static_cast<float>(low));
-    input.action_high.push_back(static_cast<float>(high));
-  }
-  std::vector<std::pair<std::string, const Space*>> keys;
-  if (const auto* dict = dynamic_cast<const spaces::Dict*>(&observation_space)) {
-    for (const auto& [key, space] : dict->entries()) keys.emplace_back(key, space.get());
-  } else {
-    keys.emplace_back("", &observation_space);
-  }
-  for (const auto& [key, space] : keys) {
-    const std::string named = key.empty() ? "the observation" : "key \"" + key + "\"";
-    const auto* box = dynamic_cast<const spaces::Box*>(space);
-    if (box == nullptr) {
-      throw std::invalid_argument(where + named + " must be a Box, got " + space->to_string());
-    }
-    const Shape shape = *box->shape();
-    if (*box->dtype() == DType::kUInt8 && shape.size() >= 2) {
-      if (input.has_image) {
-        throw std::invalid_argument(where + "one image key is supported; " + named +
-                                    " is a second one");
-      }
-      // (stack, H, W[, C]) with a stack; (H, W[, C]) without.
-      const std::size_t first = frame_stack > 1 ? 1 : 0;
-      const bool fits = shape.size() == first + 2 || shape.size() == first + 3;
-      if (!fits || (frame_stack > 1 && shape[0] != frame_stack)) {
-        throw std::invalid_argument(
-            where + "image " + named + " has shape " + shape_text(shape) + "; with frame_stack " +
-            std::to_string(frame_stack) +
-            (frame_stack > 1 ? " it must be a stack of that many frames on a new leading axis, "
-                               "(stack, H, W) or (stack, H, W, C): add --wrap frame_stack=" +
-                                   std::to_string(frame_stack) + " (or set frame_stack 1)"
-                             : std::string(" it must be one frame, (H, W) or (H, W, C)")));
-      }
-      input.has_image = true;
-      input.image_key = key;
-      input.height = shape[first];
-      input.width = shape[first + 1];
-      input.channels = shape.size() == first + 3 ? shape[first + 2] : 1;
-      if (input.height < 16 || input.width < 16) {
-        throw std::invalid_argument(where + "image " + named + " of shape " + shape_text(shape) +
-                                    " is smaller than the encoder's least, 16x16");
-      }
-      continue;
-    }
-    if (*box->dtype() != DType::kFloat32) {
-      throw std::invalid_argument(
-          where + named + " must be a uint8 image or a float32 vector, got " + space->to_string());
-    }
-    std::int64_t size = 1;
-    for (const std::int64_t extent : shape) size *= extent;
-    input.vector_keys.push_back(key);
-    input.vector_sizes.push_back(size);
-  }
-  return input;
-}
-
 // ---- Agent -----------------------------------------------------------------------------------
 
 namespace {
@@ -431,28 +295,10 @@ Agent::Agent(InputLayout input, const DrqV2Config& config)
       channels_last_(config.channels_last) {
   std::int64_t image_features = 0;
   if (input_.has_image) {
-    const std::vector<std::int64_t> strides = encoder_strides(config.encoder);
-    encoder = torch::nn::Sequential();
-    std::int64_t channels = input_.stack * input_.channels;
-    std::int64_t height = input_.height;
-    std::int64_t width = input_.width;
-    for (const std::int64_t stride : strides) {
-      encoder->push_back(
-          torch::nn::Conv2d(torch::nn::Conv2dOptions(channels, 32, 3).stride(stride)));
-      encoder->push_back(torch::nn::ReLU());
-      channels = 32;
-      height = (height - 3) / stride + 1;
-      width = (width - 3) / stride + 1;
-      if (height < 1 || width < 1) {
-        throw std::invalid_argument("drqv2: images of " + std::to_string(input_.height) + "x" +
-                                    std::to_string(input_.width) + " are too small for the " +
-                                    to_string(config.encoder) + " encoder");
-      }
-    }
-    encoder->push_back(torch::nn::Flatten());
-    orthogonal_init(*encoder, std::sqrt(2.0));
-    register_module("encoder", encoder);
-    image_features = channels * height * width;
+    trainer::ConvEncoder conv = trainer::make_conv_encoder(
+        config.encoder, input_.stack * input_.channels, input_.height, input_.width, "drqv2");
+    encoder = register_module("encoder", conv.layers);
+    image_features = conv.features;
   }
   std::int64_t vector_features = 0;
   for (const std::int64_t size : input_.vector_sizes) vector_features += size;
@@ -493,42 +339,6 @@ torch::Tensor Agent::image_input(const torch::Tensor& images) const {
   return frames.permute({0, 1, 4, 2, 3})
       .reshape({batch, channels, input_.height, input_.width})
       .to(torch::kFloat32);
-}
-
-void shift_frames(const std::uint8_t* images, std::uint8_t* shifted, std::int64_t batch,
-                  std::int64_t frames, std::int64_t height, std::int64_t width,
-                  std::int64_t channels, std::int64_t pad, const std::int64_t* shifts) {
-  const std::int64_t row_bytes = width * channels;
-  const std::int64_t frame_bytes = height * row_bytes;
-  for (std::int64_t b = 0; b < batch; ++b) {
-    const std::int64_t dy = shifts[2 * b] - pad;
-    const std::int64_t dx = shifts[2 * b + 1] - pad;
-    // Output column x reads source column clamp(x + dx): the columns in range are one copy,
-    // the ones past an edge repeat the edge pixel. A shift as wide as the image (pad >= width)
-    // leaves no column in range: first == last, and every column repeats an edge.
-    const std::int64_t first = std::clamp<std::int64_t>(-dx, 0, width);  // first x in range
-    const std::int64_t last = std::clamp<std::int64_t>(width - dx, first, width);  // one past it
-    for (std::int64_t f = 0; f < frames; ++f) {
-      const std::uint8_t* source = images + (b * frames + f) * frame_bytes;
-      std::uint8_t* dest = shifted + (b * frames + f) * frame_bytes;
-      for (std::int64_t y = 0; y < height; ++y) {
-        const std::int64_t sy = std::clamp<std::int64_t>(y + dy, 0, height - 1);
-        const std::uint8_t* in = source + sy * row_bytes;
-        std::uint8_t* out = dest + y * row_bytes;
-        for (std::int64_t x = 0; x < first; ++x) {
-          std::memcpy(out + x * channels, in, static_cast<std::size_t>(channels));
-        }
-        if (last > first) {
-          std::memcpy(out + first * channels, in + (first + dx) * channels,
-                      static_cast<std::size_t>((last - first) * channels));
-        }
-        for (std::int64_t x = last; x < width; ++x) {
-          std::memcpy(out + x * channels, in + (width - 1) * channels,
-                      static_cast<std::size_t>(channels));
-        }
-      }
-    }
-  }
 }
 
 torch::Tensor Agent::encode(const torch::Tensor& images, const torch::Tensor& vectors) {

@@ -12,30 +12,28 @@
 #include <string>
 #include <vector>
 
-#include "examples/trainer/drqv2/replay_buffer.h"
 #include "examples/trainer/run/memory_budget.h"
+#include "examples/trainer/torch_common/conv_encoder.h"
+#include "examples/trainer/torch_common/input_layout.h"
+#include "examples/trainer/torch_common/random_shift.h"
+#include "examples/trainer/torch_common/replay_buffer.h"
 #include "pixelgym/envs/space.h"
 
 namespace pixelgym::drqv2 {
 
-/// The convolutional encoder of the image key (32 channels of 3x3 kernels in each layer).
-enum class EncoderArchitecture : std::uint8_t {
-  /// DrQ-v2's: four convolutions of strides 2, 1, 1, 1 (at 64x64: 25x25 cells, 20000 features;
-  /// about 23M multiply-adds per 9-channel sample).
-  kDrqV2,
-  /// MR.Q's (Fujimoto et al. 2025): strides 2, 2, 2, 1 (at 64x64: 5x5 cells, 800 features;
-  /// about 5M multiply-adds per sample).
-  kMrq,
-  /// Between the two: strides 2, 2, 1, 1 (at 64x64: 11x11 cells, 3872 features; about 7M
-  /// multiply-adds per sample), for thin things such as a pole a pixel or two wide.
-  kFine,
-};
-/// "drqv2", "mrq", "fine".
-const char* to_string(EncoderArchitecture architecture);
-/// The strides of the architecture's four 3x3 convolutions.
-std::vector<std::int64_t> encoder_strides(EncoderArchitecture architecture);
-/// The inverse of to_string. Throws std::invalid_argument listing the names.
-EncoderArchitecture parse_encoder_architecture(const std::string& name);
+/// The shared torch layer's encoder, input layout, replay buffer and random shift, by the names
+/// DrQ-v2's code and tests use (examples/trainer/torch_common/).
+using trainer::encoder_strides;
+using trainer::EncoderArchitecture;
+using trainer::input_layout;
+using trainer::InputLayout;
+using trainer::ObservationView;
+using trainer::parse_encoder_architecture;
+using trainer::ReplayBatch;
+using trainer::ReplayBuffer;
+using trainer::ReplayLayout;
+using trainer::shift_frames;
+using trainer::to_string;
 
 /// Every setting of the learner; validate() checks each. Counts of steps are env steps (all
 /// envs together): with action_repeat K each is K control steps. The defaults follow DrQ-v2
@@ -112,36 +110,6 @@ void from_json(const nlohmann::json& json, DrqV2Config& config);
 /// Whether this CPU computes bfloat16 natively (AVX512-BF16 or AMX-BF16).
 bool cpu_has_bfloat16();
 
-/// The observation as the learner reads it: one image key (or none) and vector keys.
-struct InputLayout {
-  /// The image key ("" for a bare Box observation): frames of (H, W, C) (or (H, W): C = 1) in
-  /// stacks of `stack`.
-  bool has_image = false;
-  std::string image_key;
-  std::int64_t stack = 1;
-  std::int64_t height = 0;
-  std::int64_t width = 0;
-  std::int64_t channels = 0;
-  /// Float vector keys and their sizes, in key order.
-  std::vector<std::string> vector_keys;
-  std::vector<std::int64_t> vector_sizes;
-  std::int64_t action_size = 0;
-  /// The Box action's bounds (float32, finite).
-  std::vector<float> action_low;
-  std::vector<float> action_high;
-
-  /// The buffer's layout of this input.
-  ReplayLayout replay_layout() const;
-};
-
-/// The input layout of one env's spaces (`env_name` for the errors). The observation is a Box or
-/// a Dict of Boxes with at most one uint8 image key of shape (frame_stack, H, W[, C]) (or, for
-/// frame_stack 1, (H, W[, C])) and any float32 keys; the action space a bounded float Box.
-/// Throws std::invalid_argument naming the env, the key and the space otherwise (a Discrete
-/// action space among them).
-InputLayout input_layout(const Space& observation_space, const Space& action_space,
-                         std::int64_t frame_stack, const std::string& env_name);
-
 /// The memory a run of `config` on inputs `input` needs, by the member that sets each part
 /// (replay_capacity: the replay buffer; batch_size: the sampled batches, their copies and the
 /// activations kept for backward; hidden_dim and feature_dim: the weights with their gradients,
@@ -168,9 +136,10 @@ class Agent : public torch::nn::Module {
   /// Q1 and Q2 of the critic (or of the target critic) for features and actions in [-1, 1].
   std::pair<torch::Tensor, torch::Tensor> q_values(const torch::Tensor& features,
                                                    const torch::Tensor& actions, bool target);
-  /// Actions in [-1, 1] for a batch of observations (a vector env's, as ppo::observation_tensors
-  /// gives them): the policy's mean when `deterministic` or `noise` is null, else the mean plus
-  /// Gaussian noise of std `noise_std` drawn from `noise`, clamped. Computes no gradients.
+  /// Actions in [-1, 1] for a batch of observations (a vector env's, as
+  /// trainer::observation_tensors gives them): the policy's mean when `deterministic` or `noise` is
+  /// null, else the mean plus Gaussian noise of std `noise_std` drawn from `noise`, clamped.
+  /// Computes no gradients.
   torch::Tensor act(const std::map<std::string, torch::Tensor>& obs, bool deterministic,
                     double noise_std, at::Generator* noise);
   /// Actions in [-1, 1] to the env's bounds (float32), and back.
@@ -193,15 +162,6 @@ class Agent : public torch::nn::Module {
   bool channels_last_ = false;
   torch::Tensor low_, high_;
 };
-
-/// DrQ's random shift on uint8 stacks, as ppo::random_shift does it on float images: `batch`
-/// stacks of `frames` frames of (height, width, channels) bytes; frame f of stack b is padded by
-/// `pad` pixels on each side, repeating its edge pixels, and the window at offset (shifts[2b],
-/// shifts[2b + 1]) (rows, columns; each in [0, 2 pad]) is kept: the same offset for every frame
-/// of a stack. Offset (pad, pad) copies the stack unchanged.
-void shift_frames(const std::uint8_t* images, std::uint8_t* shifted, std::int64_t batch,
-                  std::int64_t frames, std::int64_t height, std::int64_t width,
-                  std::int64_t channels, std::int64_t pad, const std::int64_t* shifts);
 
 /// What one update did.
 struct UpdateStats {

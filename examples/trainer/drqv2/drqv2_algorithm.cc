@@ -10,8 +10,8 @@
 #include <stdexcept>
 #include <utility>
 
-#include "examples/trainer/ppo/policy.h"
-#include "examples/trainer/ppo/ppo_algorithm.h"
+#include "examples/trainer/torch_common/observation_tensors.h"
+#include "examples/trainer/torch_common/torch_state.h"
 #include "pixelgym/envs/vector/vector_wrapper.h"
 
 namespace pixelgym::drqv2 {
@@ -33,27 +33,6 @@ double seconds_since(Clock::time_point start) {
 // The stats key of the learner's own RecordEpisodeStatistics (the env may record "episode").
 const char* const kEpisodeKey = "drqv2_episode";
 
-std::string to_bytes(const std::function<void(std::ostream&)>& save) {
-  std::ostringstream out(std::ios::binary);
-  save(out);
-  return out.str();
-}
-
-const std::string& blob(const LoadedCheckpoint& checkpoint, const std::string& name) {
-  const auto found = checkpoint.blobs.find(name);
-  if (found == checkpoint.blobs.end()) {
-    throw std::runtime_error(checkpoint.path.string() + ": the checkpoint has no \"" + name +
-                             "\" entry");
-  }
-  return found->second;
-}
-
-template <typename T>
-void load_blob(const LoadedCheckpoint& checkpoint, const std::string& name, T& into) {
-  std::istringstream in(blob(checkpoint, name), std::ios::binary);
-  torch::load(into, in);
-}
-
 const DrqV2Config& checked(const DrqV2Config& config, const vector::VectorEnv& env) {
   config.validate();
   if (env.autoreset_mode() != vector::AutoresetMode::kSameStep) {
@@ -66,10 +45,11 @@ const DrqV2Config& checked(const DrqV2Config& config, const vector::VectorEnv& e
     throw std::invalid_argument("drqv2: config num_envs is " + std::to_string(config.num_envs) +
                                 " but the vector env has " + std::to_string(env.num_envs()));
   }
-  trainer::require_memory("drqv2", memory_estimate(input_layout(env.single_observation_space(),
-                                                                env.single_action_space(),
-                                                                config.frame_stack, env.name()),
-                                                   config));
+  trainer::require_memory(
+      "drqv2",
+      memory_estimate(input_layout(env.single_observation_space(), env.single_action_space(),
+                                   config.frame_stack, "drqv2", env.name()),
+                      config));
   return config;
 }
 
@@ -104,11 +84,11 @@ DrqV2Actor::DrqV2Actor(std::shared_ptr<Agent> agent, double stochastic_std, std:
 }
 
 ActCounts DrqV2Actor::act(const Value& observations, bool deterministic, Value& actions) {
-  const torch::Tensor unit =
-      agent_->act(ppo::observation_tensors(observations), deterministic, stochastic_std_, &noise_);
+  const torch::Tensor unit = agent_->act(trainer::observation_tensors(observations), deterministic,
+                                         stochastic_std_, &noise_);
   Array& action = actions.array();
   const torch::Tensor chosen =
-      agent_->env_action(unit).to(ppo::torch_dtype(action.dtype())).contiguous();
+      agent_->env_action(unit).to(trainer::torch_dtype(action.dtype())).contiguous();
   std::memcpy(action.raw_data(), chosen.data_ptr(), action.nbytes());
   // The tanh policy's actions lie within the bounds: none is clipped.
   return {0, unit.numel()};
@@ -120,7 +100,7 @@ DrqV2Algorithm::DrqV2Algorithm(vector::VectorEnv& env, DrqV2Config config)
     : config_(checked(config, env)),
       episodes_(std::make_unique<vector::VectorWrapper>(env), 1, kEpisodeKey),
       learner_(input_layout(env.single_observation_space(), env.single_action_space(),
-                            config_.frame_stack, env.name()),
+                            config_.frame_stack, "drqv2", env.name()),
                config_),
       buffer_(learner_.agent().input().replay_layout(), config_.num_envs, config_.replay_capacity,
               config_.n_step, config_.gamma),
@@ -132,7 +112,7 @@ DrqV2Algorithm::DrqV2Algorithm(vector::VectorEnv& env, DrqV2Config config)
       actor_(learner_.agent_ptr(), config_.noise_end, config_.seed + 4) {}
 
 void DrqV2Algorithm::start() {
-  current_obs_ = ppo::observation_tensors(episodes_.reset(config_.seed).obs);
+  current_obs_ = trainer::observation_tensors(episodes_.reset(config_.seed).obs);
   for (std::int64_t e = 0; e < config_.num_envs; ++e) {
     buffer_.add_first(e, view_row(current_obs_, learner_.agent().input(), e));
   }
@@ -150,7 +130,7 @@ void DrqV2Algorithm::choose_actions(StepTimes& times) {
   }
   Array& action = actions_.array();
   const torch::Tensor chosen =
-      agent.env_action(unit).to(ppo::torch_dtype(action.dtype())).contiguous();
+      agent.env_action(unit).to(trainer::torch_dtype(action.dtype())).contiguous();
   std::memcpy(action.raw_data(), chosen.data_ptr(), action.nbytes());
   env_action_log_.append(static_cast<const char*>(action.raw_data()), action.nbytes());
   times.act += seconds_since(start);
@@ -166,12 +146,12 @@ void DrqV2Algorithm::step_env(std::vector<double>* ended_returns, StepTimes& tim
   Array& action = actions_.array();
   const torch::Tensor unit =
       learner_.agent()
-          .unit_action(ppo::array_tensor(action).reshape({config_.num_envs, -1}))
+          .unit_action(trainer::array_tensor(action).reshape({config_.num_envs, -1}))
           .contiguous();
   const double* rewards = step.rewards.data<double>();
   const bool* terminated = step.terminated.data<bool>();
   const bool* truncated = step.truncated.data<bool>();
-  current_obs_ = ppo::observation_tensors(step.obs);
+  current_obs_ = trainer::observation_tensors(step.obs);
   std::map<std::string, torch::Tensor> final_obs;
   const bool* ended_mask = nullptr;
   if (step.infos.contains("_" + std::string(kEpisodeKey))) {
@@ -183,7 +163,7 @@ void DrqV2Algorithm::step_env(std::vector<double>* ended_returns, StepTimes& tim
       if (!step.infos.contains("final_obs")) {
         throw std::logic_error("drqv2: an episode ended without infos[\"final_obs\"]");
       }
-      final_obs = ppo::observation_tensors(step.infos.at("final_obs"));
+      final_obs = trainer::observation_tensors(step.infos.at("final_obs"));
     }
     buffer_.add_step(e, unit[e].data_ptr<float>(), rewards[e], terminated[e], truncated[e],
                      view_row(ended ? final_obs : current_obs_, input, e));
@@ -272,21 +252,15 @@ std::vector<std::string> DrqV2Algorithm::progress_columns() const {
 }
 
 void DrqV2Algorithm::save(CheckpointBlobs& blobs, json& meta) {
-  blobs["agent"] = to_bytes([&](std::ostream& out) { torch::save(learner_.agent_ptr(), out); });
+  blobs["agent"] = trainer::save_blob(learner_.agent_ptr());
   if (torch::optim::Adam* encoder = learner_.encoder_optimizer()) {
-    blobs["encoder_optimizer"] = to_bytes([&](std::ostream& out) { torch::save(*encoder, out); });
+    blobs["encoder_optimizer"] = trainer::save_blob(*encoder);
   }
-  blobs["actor_optimizer"] =
-      to_bytes([&](std::ostream& out) { torch::save(learner_.actor_optimizer(), out); });
-  blobs["critic_optimizer"] =
-      to_bytes([&](std::ostream& out) { torch::save(learner_.critic_optimizer(), out); });
-  const auto generator = [&](at::Generator& g) {
-    const torch::Tensor state = g.get_state();
-    return to_bytes([&](std::ostream& out) { torch::save(state, out); });
-  };
-  blobs["rng_augmentation"] = generator(augmentation_);
-  blobs["rng_exploration"] = generator(exploration_);
-  blobs["rng_noise"] = generator(noise_);
+  blobs["actor_optimizer"] = trainer::save_blob(learner_.actor_optimizer());
+  blobs["critic_optimizer"] = trainer::save_blob(learner_.critic_optimizer());
+  blobs["rng_augmentation"] = trainer::generator_blob(augmentation_);
+  blobs["rng_exploration"] = trainer::generator_blob(exploration_);
+  blobs["rng_noise"] = trainer::generator_blob(noise_);
   std::ostringstream replay_rng;
   replay_rng << replay_rng_;
   meta["drqv2"] = {{"replay_rng", replay_rng.str()},
@@ -296,20 +270,15 @@ void DrqV2Algorithm::save(CheckpointBlobs& blobs, json& meta) {
 
 void DrqV2Algorithm::restore(const LoadedCheckpoint& checkpoint, const json& meta) {
   std::shared_ptr<Agent> agent = learner_.agent_ptr();
-  load_blob(checkpoint, "agent", agent);
+  trainer::load_blob(checkpoint, "agent", agent);
   if (torch::optim::Adam* encoder = learner_.encoder_optimizer()) {
-    load_blob(checkpoint, "encoder_optimizer", *encoder);
+    trainer::load_blob(checkpoint, "encoder_optimizer", *encoder);
   }
-  load_blob(checkpoint, "actor_optimizer", learner_.actor_optimizer());
-  load_blob(checkpoint, "critic_optimizer", learner_.critic_optimizer());
-  const auto generator = [&](const char* name, at::Generator& g) {
-    torch::Tensor state;
-    load_blob(checkpoint, name, state);
-    g.set_state(state);
-  };
-  generator("rng_augmentation", augmentation_);
-  generator("rng_exploration", exploration_);
-  generator("rng_noise", noise_);
+  trainer::load_blob(checkpoint, "actor_optimizer", learner_.actor_optimizer());
+  trainer::load_blob(checkpoint, "critic_optimizer", learner_.critic_optimizer());
+  trainer::load_generator(checkpoint, "rng_augmentation", augmentation_);
+  trainer::load_generator(checkpoint, "rng_exploration", exploration_);
+  trainer::load_generator(checkpoint, "rng_noise", noise_);
   if (!meta.contains("drqv2")) {
     throw std::runtime_error(checkpoint.path.string() +
                              ": the checkpoint's meta has no \"drqv2\" member");
@@ -391,7 +360,7 @@ json DrqV2AlgorithmFactory::parse_config(const std::string& text) const {
 }
 
 int DrqV2AlgorithmFactory::set_threads(int requested) const {
-  return ppo::set_torch_threads(requested);
+  return trainer::set_torch_threads(requested);
 }
 
 std::unique_ptr<trainer::Algorithm> DrqV2AlgorithmFactory::make(
@@ -413,8 +382,9 @@ std::unique_ptr<trainer::Actor> DrqV2AlgorithmFactory::load_actor(
   DrqV2Config parsed;
   from_json(config, parsed);
   auto agent = std::make_shared<Agent>(
-      input_layout(observation_space, action_space, parsed.frame_stack, "the run's env"), parsed);
-  load_blob(checkpoint, "agent", agent);
+      input_layout(observation_space, action_space, parsed.frame_stack, "drqv2", "the run's env"),
+      parsed);
+  trainer::load_blob(checkpoint, "agent", agent);
   agent->eval();
   return std::make_unique<DrqV2Actor>(std::move(agent), parsed.noise_end, parsed.seed + 4);
 }

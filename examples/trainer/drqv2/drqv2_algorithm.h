@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "examples/trainer/drqv2/drqv2.h"
-#include "examples/trainer/drqv2/replay_buffer.h"
 #include "examples/trainer/run/algorithm.h"
+#include "examples/trainer/torch_common/replay_buffer.h"
 #include "pixelgym/wrappers/vector/record_episode_statistics.h"
 
 namespace pixelgym::drqv2 {
@@ -122,13 +122,12 @@ class DrqV2AlgorithmFactory final : public trainer::AlgorithmFactory {
  public:
   std::string name() const override { return "drqv2"; }
   nlohmann::json parse_config(const std::string& text) const override;
-  /// As ppo::set_torch_threads.
+  /// trainer::set_torch_threads.
   int set_threads(int requested) const override;
   /// Throws std::invalid_argument for a communicator of several ranks: DrQ-v2 trains in one
   /// process (its replay buffer and updates are not shared across ranks).
-  std::unique_ptr<trainer::Algorithm> make(
-      vector::VectorEnv& env, const nlohmann::json& config,
-      trainer::Communicator& communicator) const override;
+  std::unique_ptr<trainer::Algorithm> make(vector::VectorEnv& env, const nlohmann::json& config,
+                                           trainer::Communicator& communicator) const override;
   /// An Agent of the config for these spaces with the checkpoint's "agent".
   std::unique_ptr<trainer::Actor> load_actor(
       const Space& observation_space, const Space& action_space, const nlohmann::json& config,

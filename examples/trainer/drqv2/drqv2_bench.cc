@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "examples/trainer/drqv2/drqv2.h"
-#include "examples/trainer/ppo/ppo_algorithm.h"
 #include "examples/trainer/run/process_tuning.h"
+#include "examples/trainer/torch_common/torch_state.h"
 
 namespace {
 
@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
     }
   }
   pixelgym::trainer::tune_process_for_training();  // as `pixelgym train`: OpenBLAS on 1 thread
-  threads = pixelgym::ppo::set_torch_threads(threads);
+  threads = pixelgym::trainer::set_torch_threads(threads);
   config.batch_size = batch;
   config.frame_stack = stack;
   InputLayout input;

@@ -154,55 +154,6 @@ void require_batch(const PolicyInput& input, const torch::Tensor& batch) {
 
 }  // namespace
 
-torch::ScalarType torch_dtype(DType dtype) {
-  switch (dtype) {
-    case DType::kBool:
-      return torch::kBool;
-    case DType::kUInt8:
-      return torch::kUInt8;
-    case DType::kInt32:
-      return torch::kInt32;
-    case DType::kInt64:
-      return torch::kInt64;
-    case DType::kFloat32:
-      return torch::kFloat32;
-    case DType::kFloat64:
-      return torch::kFloat64;
-  }
-  throw std::invalid_argument("torch_dtype: unknown dtype");
-}
-
-torch::Tensor array_tensor(const Array& array) {
-  const Shape& shape = array.shape();
-  // from_blob takes a non-const pointer; the tensor is documented as read-only.
-  void* data = const_cast<void*>(array.raw_data());
-  return torch::from_blob(
-      data, std::vector<std::int64_t>(shape.begin(), shape.end()), [keep = array](void*) {},
-      torch::TensorOptions().dtype(torch_dtype(array.dtype())));
-}
-
-ObservationTensors observation_tensors(const Value& batch) {
-  ObservationTensors tensors;
-  if (batch.is_array()) {
-    tensors.emplace("", array_tensor(batch.array()));
-    return tensors;
-  }
-  if (!batch.is_dict()) {
-    throw std::invalid_argument("observation_tensors: expected an Array or a Dict of Arrays, got " +
-                                std::string(batch.kind()));
-  }
-  const ValueDict& dict = batch.dict();
-  for (std::size_t i = 0; i < dict.size(); ++i) {
-    const Value& entry = dict.values()[i];
-    if (!entry.is_array()) {
-      throw std::invalid_argument("observation_tensors: key \"" + dict.keys()[i] +
-                                  "\" must be an Array, got " + entry.kind());
-    }
-    tensors.emplace(dict.keys()[i], array_tensor(entry.array()));
-  }
-  return tensors;
-}
-
 const char* to_string(CnnArchitecture architecture) { return cnn_spec(architecture).name; }
 
 CnnArchitecture parse_cnn_architecture(const std::string& name) {
@@ -515,34 +466,6 @@ void Policy::set_observation_statistics(const std::string& key,
     return;
   }
   throw std::out_of_range("Policy: " + describe(key) + " is not a vector key");
-}
-
-torch::Tensor random_shift(const torch::Tensor& images, const torch::Tensor& shifts,
-                           std::int64_t pad) {
-  const std::int64_t b = images.size(0);
-  if (shifts.scalar_type() != torch::kInt64 || shifts.dim() != 2 || shifts.size(0) != b ||
-      shifts.size(1) != 2) {
-    throw std::invalid_argument("random_shift: shifts must be int64 (" + std::to_string(b) +
-                                ", 2), got " + c10::str(shifts.sizes()));
-  }
-  if (pad < 0 || (shifts.numel() > 0 && (shifts.min().item<std::int64_t>() < 0 ||
-                                         shifts.max().item<std::int64_t>() > 2 * pad))) {
-    throw std::invalid_argument("random_shift: offsets must lie in [0, " + std::to_string(2 * pad) +
-                                "]");
-  }
-  const std::int64_t c = images.size(1);
-  const std::int64_t h = images.size(2);
-  const std::int64_t w = images.size(3);
-  // Row r of the output reads padded row r + dy, i.e. source row clamp(r + dy - pad): the same
-  // as replicate padding then cropping, without building the padded image.
-  const torch::Tensor rows =
-      (torch::arange(h, torch::kInt64).unsqueeze(0) + shifts.select(1, 0).unsqueeze(1) - pad)
-          .clamp(0, h - 1);
-  const torch::Tensor cols =
-      (torch::arange(w, torch::kInt64).unsqueeze(0) + shifts.select(1, 1).unsqueeze(1) - pad)
-          .clamp(0, w - 1);
-  const torch::Tensor by_rows = images.gather(2, rows.view({b, 1, h, 1}).expand({b, c, h, w}));
-  return by_rows.gather(3, cols.view({b, 1, 1, w}).expand({b, c, h, w}));
 }
 
 std::int64_t ActResult::clipped_elements() const {

@@ -12,28 +12,22 @@
 #include <utility>
 #include <vector>
 
+#include "examples/trainer/torch_common/observation_tensors.h"
+#include "examples/trainer/torch_common/random_shift.h"
 #include "pixelgym/envs/space.h"
 #include "pixelgym/envs/value.h"
 #include "pixelgym/wrappers/running_statistics.h"
 
 namespace pixelgym::ppo {
 
-/// A batch of observations as tensors, one per key of the observation space (the single key ""
-/// for a bare Box observation), each (B, *shape of the key) in the key's dtype.
-using ObservationTensors = std::map<std::string, torch::Tensor>;
-
-/// The torch dtype that stores a pixelgym dtype (kBool: torch::kBool, one byte per element).
-torch::ScalarType torch_dtype(DType dtype);
-
-/// A CPU tensor viewing `array`'s memory without copying (torch::from_blob); the tensor keeps
-/// the array's storage alive. The memory is not copied, so the tensor sees later writes to it
-/// (a vector env's next step); it must not be written through (a vector env's buffers are its
-/// own).
-torch::Tensor array_tensor(const Array& array);
-/// Every array of a batched observation (a vector env's `obs`, or infos["final_obs"]) viewed as
-/// array_tensor does: a bare Array under key "", a Dict's entries under their keys. Throws
-/// std::invalid_argument for a Tuple or nested Dict.
-ObservationTensors observation_tensors(const Value& batch);
+/// The shared torch layer's observation tensors and random shift, by the names PPO's code and
+/// tests use (examples/trainer/torch_common/).
+using trainer::array_tensor;
+using trainer::observation_tensors;
+using trainer::ObservationTensors;
+using trainer::random_shift;
+using trainer::select_rows;
+using trainer::torch_dtype;
 
 /// The CNN that encodes each image key.
 enum class CnnArchitecture : std::uint8_t {
@@ -254,13 +248,5 @@ class Policy : public torch::nn::Module {
   torch::Tensor action_low_;   // Box: float32 (action_size,), -inf where unbounded
   torch::Tensor action_high_;  // Box: float32 (action_size,), +inf where unbounded
 };
-
-/// DrQ's random shift (Kostrikov et al. 2020), pad 4 and crop, on a float (B, C, H, W) batch:
-/// image b is padded by `pad` pixels on each side by repeating its edge pixels, then the (H, W)
-/// window at offset (shifts[b][0], shifts[b][1]) (rows, columns; each in [0, 2 pad]) is kept.
-/// Offset (pad, pad) gives the image back unchanged. Throws std::invalid_argument when `shifts`
-/// is not int64 (B, 2) or an offset is out of range.
-torch::Tensor random_shift(const torch::Tensor& images, const torch::Tensor& shifts,
-                           std::int64_t pad);
 
 }  // namespace pixelgym::ppo

@@ -11,6 +11,7 @@
 
 #include "examples/trainer/ppo/gae.h"
 #include "examples/trainer/run/config_members.h"
+#include "examples/trainer/torch_common/torch_state.h"
 
 namespace pixelgym::ppo {
 namespace {
@@ -22,13 +23,6 @@ constexpr double kRewardEpsilon = 1e-8;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-// Rows `index` of every tensor of `obs` (dim 0).
-ObservationTensors select_rows(const ObservationTensors& obs, const torch::Tensor& index) {
-  ObservationTensors rows;
-  for (const auto& [key, tensor] : obs) rows.emplace(key, tensor.index_select(0, index));
-  return rows;
 }
 
 // PpoConfig's members and PolicyConfig's (nested in it): errors name PpoConfig.
@@ -436,16 +430,7 @@ std::uint64_t Trainer::env_seed() const {
   return config_.seed + rank * static_cast<std::uint64_t>(config_.num_envs);
 }
 
-std::uint64_t Trainer::parameter_digest() const {
-  std::uint64_t digest = trainer::fnv1a(nullptr, 0);
-  const auto add = [&digest](const torch::Tensor& tensor) {
-    const torch::Tensor contiguous = tensor.detach().contiguous();
-    digest = trainer::fnv1a(contiguous.data_ptr(), contiguous.nbytes(), digest);
-  };
-  for (const torch::Tensor& parameter : policy_->parameters()) add(parameter);
-  for (const torch::Tensor& buffer : policy_->buffers()) add(buffer);
-  return digest;
-}
+std::uint64_t Trainer::parameter_digest() const { return trainer::parameter_digest(*policy_); }
 
 void Trainer::all_reduce(std::vector<double>& values, const std::string& what) {
   if (alone()) return;
@@ -499,8 +484,7 @@ void Trainer::merge_statistics(
 }
 
 bool Trainer::preempted(std::int64_t steps_done) {
-  if (!config_.preempt_stragglers || alone() ||
-      steps_done >= config_.num_steps ||
+  if (!config_.preempt_stragglers || alone() || steps_done >= config_.num_steps ||
       steps_done < preempt_min_steps(config_.num_steps, config_.preempt_min_steps_fraction)) {
     return false;
   }

@@ -1,7 +1,5 @@
 #include "examples/trainer/ppo/ppo_algorithm.h"
 
-#include <sched.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
@@ -10,6 +8,8 @@
 #include <sstream>
 #include <stdexcept>
 #include <utility>
+
+#include "examples/trainer/torch_common/torch_state.h"
 
 namespace pixelgym::ppo {
 
@@ -23,23 +23,6 @@ using trainer::LoadedCheckpoint;
 namespace {
 
 using nlohmann::json;
-
-std::string to_bytes(const std::function<void(std::ostream&)>& save) {
-  std::ostringstream out(std::ios::binary);
-  save(out);
-  return out.str();
-}
-
-template <typename T>
-void load_blob(const LoadedCheckpoint& checkpoint, const std::string& name, T& into) {
-  const auto found = checkpoint.blobs.find(name);
-  if (found == checkpoint.blobs.end()) {
-    throw std::runtime_error(checkpoint.path.string() + ": the checkpoint has no \"" + name +
-                             "\" entry");
-  }
-  std::istringstream in(found->second, std::ios::binary);
-  torch::load(into, in);
-}
 
 }  // namespace
 
@@ -104,12 +87,11 @@ std::vector<std::string> PpoAlgorithm::progress_columns() const {
 }
 
 void PpoAlgorithm::save(CheckpointBlobs& blobs, json& meta) {
-  blobs["model"] = to_bytes([&](std::ostream& out) { torch::save(trainer_.policy_ptr(), out); });
-  blobs["optimizer"] = to_bytes([&](std::ostream& out) { torch::save(trainer_.optimizer(), out); });
+  blobs["model"] = trainer::save_blob(trainer_.policy_ptr());
+  blobs["optimizer"] = trainer::save_blob(trainer_.optimizer());
   const TrainerRngState rng = trainer_.rng_state();
-  blobs["rng_sampling"] = to_bytes([&](std::ostream& out) { torch::save(rng.sampling, out); });
-  blobs["rng_augmentation"] =
-      to_bytes([&](std::ostream& out) { torch::save(rng.augmentation, out); });
+  blobs["rng_sampling"] = trainer::save_blob(rng.sampling);
+  blobs["rng_augmentation"] = trainer::save_blob(rng.augmentation);
   const RewardScaling scaling = trainer_.reward_scaling();
   meta["reward_scaling"] = {{"mean", scaling.statistics.mean[0]},
                             {"var", scaling.statistics.var[0]},
@@ -118,11 +100,11 @@ void PpoAlgorithm::save(CheckpointBlobs& blobs, json& meta) {
 }
 
 void PpoAlgorithm::restore(const LoadedCheckpoint& checkpoint, const json& meta) {
-  load_blob(checkpoint, "model", trainer_.policy_ptr());
-  load_blob(checkpoint, "optimizer", trainer_.optimizer());
+  trainer::load_blob(checkpoint, "model", trainer_.policy_ptr());
+  trainer::load_blob(checkpoint, "optimizer", trainer_.optimizer());
   TrainerRngState rng;
-  load_blob(checkpoint, "rng_sampling", rng.sampling);
-  load_blob(checkpoint, "rng_augmentation", rng.augmentation);
+  trainer::load_blob(checkpoint, "rng_sampling", rng.sampling);
+  trainer::load_blob(checkpoint, "rng_augmentation", rng.augmentation);
   trainer_.set_rng_state(rng);
   const json& scaling_json = meta.at("reward_scaling");
   RewardScaling scaling;
@@ -141,18 +123,8 @@ json PpoAlgorithmFactory::parse_config(const std::string& text) const {
   return json::parse(config_to_json(config_from_json(text)));
 }
 
-int PpoAlgorithmFactory::set_threads(int requested) const { return set_torch_threads(requested); }
-
-int set_torch_threads(int requested) {
-  if (requested == 0 && std::getenv("OMP_NUM_THREADS") != nullptr) return torch::get_num_threads();
-  int threads = requested;
-  if (threads == 0) {
-    cpu_set_t cpus;
-    CPU_ZERO(&cpus);
-    threads = sched_getaffinity(0, sizeof(cpus), &cpus) == 0 ? CPU_COUNT(&cpus) : 1;
-  }
-  torch::set_num_threads(std::max(threads, 1));
-  return torch::get_num_threads();
+int PpoAlgorithmFactory::set_threads(int requested) const {
+  return trainer::set_torch_threads(requested);
 }
 
 std::unique_ptr<Algorithm> PpoAlgorithmFactory::make(vector::VectorEnv& env, const json& config,
@@ -166,7 +138,7 @@ std::unique_ptr<Actor> PpoAlgorithmFactory::load_actor(const Space& observation_
                                                        const LoadedCheckpoint& checkpoint) const {
   auto policy = std::make_shared<Policy>(observation_space, action_space,
                                          config_from_json(config.dump()).policy);
-  load_blob(checkpoint, "model", policy);
+  trainer::load_blob(checkpoint, "model", policy);
   policy->eval();
   return std::make_unique<PpoActor>(std::move(policy));
 }

@@ -64,22 +64,16 @@ class PpoAlgorithm final : public trainer::Algorithm {
   PpoActor actor_;
 };
 
-/// Sets LibTorch's intra-op threads: `requested`, or when 0 one per core this process may run on
-/// (sched_getaffinity); OMP_NUM_THREADS, when set, wins over that default (not over
-/// `requested`). Returns the count in use.
-int set_torch_threads(int requested);
-
 /// PPO's AlgorithmFactory: name "ppo", the config a PpoConfig (to_json / from_json).
 class PpoAlgorithmFactory final : public trainer::AlgorithmFactory {
  public:
   std::string name() const override { return "ppo"; }
   nlohmann::json parse_config(const std::string& text) const override;
-  /// set_torch_threads.
+  /// trainer::set_torch_threads.
   int set_threads(int requested) const override;
   /// Trains distributed (see Trainer) with a communicator of several ranks.
-  std::unique_ptr<trainer::Algorithm> make(
-      vector::VectorEnv& env, const nlohmann::json& config,
-      trainer::Communicator& communicator) const override;
+  std::unique_ptr<trainer::Algorithm> make(vector::VectorEnv& env, const nlohmann::json& config,
+                                           trainer::Communicator& communicator) const override;
   /// A Policy of config["policy"] with the checkpoint's "model", in eval mode.
   std::unique_ptr<trainer::Actor> load_actor(
       const Space& observation_space, const Space& action_space, const nlohmann::json& config,

@@ -69,8 +69,7 @@ class SingleProcessCommunicator final : public Communicator {
   void all_reduce_sum(double* data, std::size_t count, const std::string& what) override;
   void broadcast(float* data, std::size_t count, const std::string& what) override;
   std::vector<std::uint64_t> all_gather(std::uint64_t value, const std::string& what) override;
-  std::vector<std::string> gather_bytes(const std::string& bytes,
-                                        const std::string& what) override;
+  std::vector<std::string> gather_bytes(const std::string& bytes, const std::string& what) override;
   /// Throws std::invalid_argument when `per_rank` does not hold exactly one string.
   std::string scatter_bytes(const std::vector<std::string>& per_rank,
                             const std::string& what) override;

@@ -345,9 +345,7 @@ void TrainingRun::distribute(Communicator& communicator) {
 
 bool TrainingRun::lead() const { return communicator_->rank() == 0; }
 
-bool TrainingRun::distributed() const {
-  return communicator_->world_size() > 1;
-}
+bool TrainingRun::distributed() const { return communicator_->world_size() > 1; }
 
 void TrainingRun::send_start(bool nothing) {
   const int world = communicator_->world_size();

@@ -255,10 +255,10 @@ class TrainingRun {
   // heap: a TrainingRun is moved out of create and resume).
   std::unique_ptr<Communicator> single_process_ = std::make_unique<SingleProcessCommunicator>();
   Communicator* communicator_ = single_process_.get();  // never null
-  std::vector<std::uint64_t> parameter_digests_;  // every rank's, at the last check
-  std::optional<RunLock> lock_;                   // the run folder's, from resume or train
-  AlgorithmFactories join_algorithms_;            // join: the algorithm rank 0's config names
-  std::string busy_cores_warning_;                // said once the envs are made; "" when none
+  std::vector<std::uint64_t> parameter_digests_;        // every rank's, at the last check
+  std::optional<RunLock> lock_;                         // the run folder's, from resume or train
+  AlgorithmFactories join_algorithms_;                  // join: the algorithm rank 0's config names
+  std::string busy_cores_warning_;                      // said once the envs are made; "" when none
   // Progress and budget while training.
   std::optional<ProgressLine> progress_;
   ProgressStatus status_;

@@ -1,7 +1,6 @@
-// DrQ-v2's pieces: its config's JSON form and the errors naming each bad member, the spaces it
-// refuses (a Discrete action space, an image without its frame stack), the random shift on
-// uint8 stacks (the same images as ppo::random_shift, never a pixel from outside the padded
-// window), the target critic's soft update, and an update that learns a fixed batch.
+// DrQ-v2's pieces: its config's JSON form and the errors naming each bad member, the target
+// critic's soft update, and an update that learns a fixed batch. (Its input layout and random
+// shift are the shared torch layer's: tests/examples/trainer/torch_common/shared_layer_test.cc.)
 #include "examples/trainer/drqv2/drqv2.h"
 
 #include <ATen/CPUGeneratorImpl.h>
@@ -15,7 +14,6 @@
 #include <string>
 #include <vector>
 
-#include "examples/trainer/ppo/policy.h"
 #include "pixelgym/envs/spaces/box.h"
 #include "pixelgym/envs/spaces/dict.h"
 #include "pixelgym/envs/spaces/discrete.h"
@@ -100,111 +98,6 @@ spaces::Dict pixel_space(Shape pixels) {
                        {"joint_pos", std::make_shared<spaces::Box>(-1.0, 1.0, Shape{2})}});
 }
 
-TEST(DrqV2InputTest, ReadsStacksAndRefusesWhatItCannotLearnFrom) {
-  const spaces::Box action(-2.0, 2.0, Shape{2});
-  const InputLayout input = input_layout(pixel_space({3, 32, 32}), action, 3, "Env-v0");
-  EXPECT_TRUE(input.has_image);
-  EXPECT_EQ(input.image_key, "pixels");
-  EXPECT_EQ(input.channels, 1);
-  EXPECT_EQ(input.height, 32);
-  EXPECT_EQ(input.vector_keys, (std::vector<std::string>{"joint_pos"}));
-  EXPECT_EQ(input.action_size, 2);
-  EXPECT_EQ(input_layout(pixel_space({3, 32, 32, 3}), action, 3, "Env-v0").channels, 3);
-
-  const auto refused = [](auto call, std::vector<std::string> words) {
-    try {
-      call();
-      ADD_FAILURE() << "accepted";
-    } catch (const std::invalid_argument& error) {
-      for (const std::string& word : words) {
-        EXPECT_NE(std::string(error.what()).find(word), std::string::npos) << error.what();
-      }
-    }
-  };
-  refused(
-      [&] {
-        input_layout(pixel_space({3, 32, 32}), spaces::Discrete(3), 3, "Pole-v0");
-      },
-      {"Pole-v0", "Discrete(3)"});
-  refused(
-      [&] {
-        input_layout(pixel_space({32, 32, 3}), action, 3, "Pole-v0");
-      },
-      {"Pole-v0", "\"pixels\"", "frame_stack=3"});
-  refused(
-      [&] {
-        input_layout(pixel_space({3, 32, 32}), spaces::Box(-INFINITY, INFINITY, Shape{1}), 3,
-                     "P-v0");
-      },
-      {"bounded"});
-}
-
-// Whether `shifted` is `images` (B, frames, H, W, C as `shape` gives them) shifted by `shifts`
-// as ppo::random_shift shifts their float (B, frames C, H, W) form.
-bool equals_ppo_random_shift(std::vector<std::uint8_t> images, std::vector<std::uint8_t> shifted,
-                             const std::vector<std::int64_t>& shifts,
-                             const std::vector<std::int64_t>& shape, std::int64_t pad) {
-  const std::int64_t batch = shape[0];
-  const auto as_chw = [&](std::vector<std::uint8_t>& bytes) {
-    return torch::from_blob(bytes.data(), shape, torch::kUInt8)
-        .permute({0, 1, 4, 2, 3})
-        .reshape({batch, shape[1] * shape[4], shape[2], shape[3]})
-        .to(torch::kFloat32);
-  };
-  const torch::Tensor expected =
-      ppo::random_shift(as_chw(images), torch::tensor(shifts, torch::kInt64).view({batch, 2}), pad);
-  return torch::equal(as_chw(shifted), expected);
-}
-
-TEST(DrqV2AugmentationTest, ShiftsMatchPpoRandomShiftAndStayInsideThePaddedWindow) {
-  const std::int64_t batch = 6, frames = 2, h = 12, w = 10, c = 3, pad = 4;
-  std::mt19937 rng(7);
-  std::vector<std::uint8_t> images(static_cast<std::size_t>(batch * frames * h * w * c));
-  for (auto& v : images) v = static_cast<std::uint8_t>(rng());
-  std::vector<std::int64_t> shifts = {0, 0, 8, 8, 4, 4, 0, 8, 8, 0, 3, 5};
-  std::vector<std::uint8_t> shifted(images.size());
-  shift_frames(images.data(), shifted.data(), batch, frames, h, w, c, pad, shifts.data());
-  EXPECT_TRUE(equals_ppo_random_shift(images, shifted, shifts, {batch, frames, h, w, c}, pad));
-  // Offset (pad, pad) is the identity.
-  const std::size_t stack_bytes = static_cast<std::size_t>(frames * h * w * c);
-  EXPECT_TRUE(std::equal(images.begin() + 2 * stack_bytes, images.begin() + 3 * stack_bytes,
-                         shifted.begin() + 2 * stack_bytes));
-  // Every output pixel of a stack comes from within `pad` rows and columns of its own place.
-  for (std::int64_t b = 0; b < batch; ++b) {
-    for (std::int64_t y = 0; y < h; ++y) {
-      for (std::int64_t x = 0; x < w; ++x) {
-        const std::int64_t sy = std::clamp<std::int64_t>(y + shifts[2 * b] - pad, 0, h - 1);
-        const std::int64_t sx = std::clamp<std::int64_t>(x + shifts[2 * b + 1] - pad, 0, w - 1);
-        EXPECT_LE(std::abs(sy - y), pad);
-        EXPECT_LE(std::abs(sx - x), pad);
-        const std::size_t at = static_cast<std::size_t>((((b * frames) * h + y) * w + x) * c);
-        const std::size_t from = static_cast<std::size_t>((((b * frames) * h + sy) * w + sx) * c);
-        EXPECT_EQ(shifted[at], images[from]);
-      }
-    }
-  }
-}
-
-// A pad wider and taller than the image (shift_pad 65 at 64x64 once wrote out of bounds: the
-// copy's length went negative): shifts past an edge repeat the edge pixel, as replicate padding
-// by that much and cropping does, and as ppo::random_shift computes it.
-TEST(DrqV2AugmentationTest, APadLargerThanTheImageRepeatsTheEdges) {
-  const std::int64_t batch = 7, frames = 2, h = 6, w = 5, c = 1, pad = 13;
-  std::mt19937 rng(11);
-  std::vector<std::uint8_t> images(static_cast<std::size_t>(batch * frames * h * w * c));
-  for (auto& v : images) v = static_cast<std::uint8_t>(rng());
-  // Offsets 0 and 2 pad shift the whole image past an edge; pad - w and pad + w just so.
-  std::vector<std::int64_t> shifts = {0,       0,       2 * pad, 2 * pad, 0,       2 * pad, pad - w,
-                                      pad + w, pad + w, pad - w, pad - 1, pad + 4, pad,     pad};
-  std::vector<std::uint8_t> shifted(images.size(), 0);
-  shift_frames(images.data(), shifted.data(), batch, frames, h, w, c, pad, shifts.data());
-  EXPECT_TRUE(equals_ppo_random_shift(images, shifted, shifts, {batch, frames, h, w, c}, pad));
-  // Offset (0, 0) reads from 13 rows above and columns left of the image: every pixel of the
-  // first frame is the source's top-left one.
-  const std::size_t frame = static_cast<std::size_t>(h * w * c);
-  for (std::size_t i = 0; i < frame; ++i) EXPECT_EQ(shifted[i], images[0]) << i;
-}
-
 // A learner on 32x32 gray stacks of 3 with one state key, and a batch of random transitions.
 struct Fixture {
   InputLayout input;
@@ -212,7 +105,8 @@ struct Fixture {
   ReplayBatch batch;
 
   Fixture() {
-    input = input_layout(pixel_space({3, 32, 32}), spaces::Box(-1.0, 1.0, Shape{1}), 3, "T-v0");
+    input = input_layout(pixel_space({3, 32, 32}), spaces::Box(-1.0, 1.0, Shape{1}), 3, "drqv2",
+                         "T-v0");
     config.batch_size = 16;
     config.hidden_dim = 32;
     config.feature_dim = 16;
@@ -294,7 +188,7 @@ TEST(DrqV2LearnerTest, UpdatesFitAFixedBatchAndAreDeterministic) {
 // (drqv2), 5x5 (mrq), 11x11 (fine), 32 channels each, beside the state key's 2 values.
 TEST(DrqV2LearnerTest, EncodersLeaveTheirDocumentedGrid) {
   const InputLayout input =
-      input_layout(pixel_space({3, 64, 64}), spaces::Box(-1.0, 1.0, Shape{1}), 3, "T-v0");
+      input_layout(pixel_space({3, 64, 64}), spaces::Box(-1.0, 1.0, Shape{1}), 3, "drqv2", "T-v0");
   for (const auto& [architecture, cells] :
        std::vector<std::pair<EncoderArchitecture, std::int64_t>>{
            {EncoderArchitecture::kDrqV2, 25},

@@ -2,7 +2,7 @@
 // start, n-step returns that stop at `terminated` (no bootstrap) and at `truncated` (bootstrap
 // from the episode's last observation), windows not yet complete never sampled, wrap-around at
 // capacity, several envs, and the errors of bad input.
-#include "examples/trainer/drqv2/replay_buffer.h"
+#include "examples/trainer/torch_common/replay_buffer.h"
 
 #include <gtest/gtest.h>
 
@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-namespace pixelgym::drqv2 {
+namespace pixelgym::trainer {
 namespace {
 
 constexpr std::int64_t kStack = 3;
@@ -272,4 +272,4 @@ TEST(ReplayBufferTest, RefusesAStackItCannotRebuildAndBadSettings) {
 }
 
 }  // namespace
-}  // namespace pixelgym::drqv2
+}  // namespace pixelgym::trainer

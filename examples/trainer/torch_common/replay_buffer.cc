@@ -1,4 +1,4 @@
-#include "examples/trainer/drqv2/replay_buffer.h"
+#include "examples/trainer/torch_common/replay_buffer.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <utility>
 
-namespace pixelgym::drqv2 {
+namespace pixelgym::trainer {
 
 ReplayBuffer::ReplayBuffer(ReplayLayout layout, std::int64_t num_envs, std::int64_t capacity,
                            std::int64_t n_step, double gamma)
@@ -283,4 +283,4 @@ std::int64_t ReplayBuffer::bytes() const {
   return per_slot * slots_per_env_ * num_envs_;
 }
 
-}  // namespace pixelgym::drqv2
+}  // namespace pixelgym::trainer

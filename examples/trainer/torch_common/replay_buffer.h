@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-namespace pixelgym::drqv2 {
+namespace pixelgym::trainer {
 
 /// What one observation holds, as the buffer stores it.
 struct ReplayLayout {
@@ -147,4 +147,4 @@ class ReplayBuffer {
   std::int64_t steps_added_ = 0;
 };
 
-}  // namespace pixelgym::drqv2
+}  // namespace pixelgym::trainer
