@@ -21,6 +21,11 @@ install(DIRECTORY engine envs render testing wrappers
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/pixelgym FILES_MATCHING PATTERN "*.h"
         REGEX "/render/(gl|gl_library|gl_object|lod|mesh_arena|render_target|shader_programs|shadow_fit|shadow_pass|texture_cache|transforms)\\.h$"
         EXCLUDE)
+# The trainer's run (pixelgym::trainer_run), included as <pixelgym/trainer/algorithm.h>.
+if(TARGET pixelgym_trainer_run)
+  install(DIRECTORY examples/trainer/run/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/pixelgym/trainer
+          FILES_MATCHING PATTERN "*.h")
+endif()
 install(DIRECTORY assets/ DESTINATION ${PIXELGYM_INSTALL_ASSETS_DIR} PATTERN tools EXCLUDE)
 
 set(pixelgym_cmake_dir ${CMAKE_INSTALL_LIBDIR}/cmake/pixelgym)

@@ -8,8 +8,8 @@
 #include <sstream>
 #include <string>
 
-#include "examples/trainer/run/checkpoint_file.h"
 #include "fuzz/fuzz_input.h"
+#include "pixelgym/trainer/checkpoint_file.h"
 
 namespace {
 

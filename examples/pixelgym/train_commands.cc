@@ -14,11 +14,11 @@
 #include <string>
 #include <vector>
 
-#include "examples/trainer/run/atomic_file.h"
-#include "examples/trainer/run/curve_plot.h"
-#include "examples/trainer/run/progress_csv.h"
-#include "examples/trainer/run/training_run.h"
 #include "pixelgym/render/image_io.h"
+#include "pixelgym/trainer/atomic_file.h"
+#include "pixelgym/trainer/curve_plot.h"
+#include "pixelgym/trainer/progress_csv.h"
+#include "pixelgym/trainer/training_run.h"
 
 namespace pixelgym::cli {
 namespace {

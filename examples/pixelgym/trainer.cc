@@ -20,10 +20,10 @@
 #include "examples/trainer/distributed/gloo_communicator.h"
 #include "examples/trainer/drqv2/drqv2_algorithm.h"
 #include "examples/trainer/ppo/ppo_algorithm.h"
-#include "examples/trainer/run/evaluation.h"
-#include "examples/trainer/run/process_tuning.h"
-#include "examples/trainer/run/recipes.h"
-#include "examples/trainer/run/training_run.h"
+#include "pixelgym/trainer/evaluation.h"
+#include "pixelgym/trainer/process_tuning.h"
+#include "pixelgym/trainer/recipes.h"
+#include "pixelgym/trainer/training_run.h"
 
 namespace pixelgym::cli {
 namespace {

@@ -24,9 +24,9 @@
 #include <vector>
 
 #include "examples/trainer/drqv2/drqv2.h"
-#include "examples/trainer/run/checkpoint_file.h"
-#include "examples/trainer/run/progress_csv.h"
-#include "examples/trainer/run/training_run.h"
+#include "pixelgym/trainer/checkpoint_file.h"
+#include "pixelgym/trainer/progress_csv.h"
+#include "pixelgym/trainer/training_run.h"
 #include "tests/examples/cli_run.h"
 
 namespace pixelgym::testing {

@@ -17,8 +17,8 @@ function(step name)
 endfunction()
 
 step("cmake --install" ${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
-foreach(installed include/pixelgym/envs/registry.h share/pixelgym/assets/cartpole bin/pixelgym
-                  bin/pixelgym-train)
+foreach(installed include/pixelgym/envs/registry.h include/pixelgym/trainer/training_run.h
+                  share/pixelgym/assets/cartpole bin/pixelgym bin/pixelgym-train)
   if(NOT EXISTS ${prefix}/${installed})
     message(FATAL_ERROR "cmake --install did not install ${installed} under ${prefix}")
   endif()
@@ -73,6 +73,21 @@ endif()
 if(NOT step_output MATCHES "consumer ran to the end\n$")
   message(FATAL_ERROR "the consumer did not run to its end")
 endif()
+
+# An Algorithm written outside the tree trains through the installed run: a new run of 400 env
+# steps, then a resume from its checkpoint to 600.
+step("running own_algorithm" ${WORK_DIR}/build/own_algorithm ${WORK_DIR}/own_run)
+message(STATUS "own_algorithm:\n${step_output}")
+if(NOT step_output MATCHES "own algorithm trained: 8 rows, last best_return [-0-9.e+]+, evaluation return_mean [0-9.e+]+\n"
+   OR NOT step_output MATCHES "own algorithm resumed to 600 env steps\n"
+   OR NOT step_output MATCHES "own algorithm ran to the end\n$")
+  message(FATAL_ERROR "own_algorithm did not train and resume through the installed run:\n${step_output}")
+endif()
+foreach(written config.json progress.csv summary.json ckpt-000012.pgck)
+  if(NOT EXISTS ${WORK_DIR}/own_run/${written})
+    message(FATAL_ERROR "own_algorithm's run folder has no ${written}")
+  endif()
+endforeach()
 
 step("the installed pixelgym list" ${prefix}/bin/pixelgym list)
 if(NOT step_output MATCHES "CartPoleSwingup-v0")

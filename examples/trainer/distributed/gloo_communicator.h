@@ -18,7 +18,7 @@
 #include <thread>
 #include <vector>
 
-#include "examples/trainer/run/communicator.h"
+#include "pixelgym/trainer/communicator.h"
 
 namespace c10d {
 class ProcessGroupGloo;

@@ -12,9 +12,9 @@
 #include <stdexcept>
 #include <utility>
 
-#include "examples/trainer/run/config_members.h"
 #include "pixelgym/envs/spaces/box.h"
 #include "pixelgym/envs/spaces/dict.h"
+#include "pixelgym/trainer/config_members.h"
 
 namespace pixelgym::drqv2 {
 namespace {

@@ -12,12 +12,12 @@
 #include <string>
 #include <vector>
 
-#include "examples/trainer/run/memory_budget.h"
 #include "examples/trainer/torch_common/conv_encoder.h"
 #include "examples/trainer/torch_common/input_layout.h"
 #include "examples/trainer/torch_common/random_shift.h"
 #include "examples/trainer/torch_common/replay_buffer.h"
 #include "pixelgym/envs/space.h"
+#include "pixelgym/trainer/memory_budget.h"
 
 namespace pixelgym::drqv2 {
 

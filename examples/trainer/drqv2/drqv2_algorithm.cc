@@ -218,7 +218,7 @@ IterationStats DrqV2Algorithm::iterate(const trainer::StopCheck& stop) {
     if (!stopped && stop) stopped = stop(env_steps_);
   }
   ++iterations_;
-  stats.extra = {
+  stats.metrics = {
       {"critic_loss", mean_or_none(critic_loss, updates)},
       {"actor_loss", mean_or_none(actor_loss, updates)},
       {"q_mean", mean_or_none(q_mean, updates)},
@@ -241,7 +241,7 @@ void DrqV2Algorithm::set_progress(std::int64_t env_steps, std::int64_t updates) 
   iterations_ = updates;
 }
 
-std::vector<std::string> DrqV2Algorithm::progress_columns() const {
+std::vector<std::string> DrqV2Algorithm::metric_names() const {
   return {"critic_loss",   "actor_loss",
           "q_mean",        "target_mean",
           "noise_std",     "gradient_updates",

@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "examples/trainer/drqv2/drqv2.h"
-#include "examples/trainer/run/algorithm.h"
 #include "examples/trainer/torch_common/replay_buffer.h"
+#include "pixelgym/trainer/algorithm.h"
 #include "pixelgym/wrappers/vector/record_episode_statistics.h"
 
 namespace pixelgym::drqv2 {
@@ -58,10 +58,12 @@ class DrqV2Actor final : public trainer::Actor {
 /// and replay_env, which replays the checkpoint's env actions, puts the same transitions back
 /// in the same order, so a resumed run is the run that did not stop.
 ///
-/// progress.csv's extra columns: critic_loss, actor_loss, q_mean, target_mean (means over the
-/// iteration's updates), noise_std, gradient_updates (all so far), updates_per_s (this
-/// iteration's updates over the seconds spent in them), replay_transitions, replay_mb (the
-/// buffer's allocation), and where the iteration's time went: env_s, act_s, sample_s, update_s.
+/// Its metrics (progress.csv's columns after the run's; runs before metrics were named by their
+/// algorithm also have PPO's five loss columns, left empty): critic_loss, actor_loss, q_mean,
+/// target_mean (means over the iteration's updates), noise_std, gradient_updates (all so far),
+/// updates_per_s (this iteration's updates over the seconds spent in them), replay_transitions,
+/// replay_mb (the buffer's allocation), and where the iteration's time went: env_s, act_s,
+/// sample_s, update_s.
 class DrqV2Algorithm final : public trainer::Algorithm {
  public:
   /// Throws std::invalid_argument for a config that fails validate(), an env that does not
@@ -72,7 +74,7 @@ class DrqV2Algorithm final : public trainer::Algorithm {
   std::int64_t env_steps() const override { return env_steps_; }
   std::int64_t updates() const override { return iterations_; }
   void set_progress(std::int64_t env_steps, std::int64_t updates) override;
-  std::vector<std::string> progress_columns() const override;
+  std::vector<std::string> metric_names() const override;
   void save(trainer::CheckpointBlobs& blobs, nlohmann::json& meta) override;
   void restore(const trainer::LoadedCheckpoint& checkpoint, const nlohmann::json& meta) override;
   const std::string& env_action_log() const override { return env_action_log_; }

@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "examples/trainer/drqv2/drqv2.h"
-#include "examples/trainer/run/process_tuning.h"
 #include "examples/trainer/torch_common/torch_state.h"
+#include "pixelgym/trainer/process_tuning.h"
 
 namespace {
 

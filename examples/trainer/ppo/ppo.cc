@@ -10,8 +10,8 @@
 #include <utility>
 
 #include "examples/trainer/ppo/gae.h"
-#include "examples/trainer/run/config_members.h"
 #include "examples/trainer/torch_common/torch_state.h"
+#include "pixelgym/trainer/config_members.h"
 
 namespace pixelgym::ppo {
 namespace {

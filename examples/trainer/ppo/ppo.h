@@ -13,10 +13,10 @@
 #include <vector>
 
 #include "examples/trainer/ppo/policy.h"
-#include "examples/trainer/run/algorithm.h"
-#include "examples/trainer/run/communicator.h"
-#include "examples/trainer/run/memory_budget.h"
 #include "pixelgym/envs/vector/vector_env.h"
+#include "pixelgym/trainer/algorithm.h"
+#include "pixelgym/trainer/communicator.h"
+#include "pixelgym/trainer/memory_budget.h"
 #include "pixelgym/wrappers/running_statistics.h"
 #include "pixelgym/wrappers/vector/normalize_reward.h"
 #include "pixelgym/wrappers/vector/record_episode_statistics.h"

@@ -62,18 +62,18 @@ IterationStats PpoAlgorithm::iterate(const trainer::StopCheck& stop) {
   for (const Episode& episode : rollout.episodes) {
     stats.episode_returns.push_back(episode.episode_return);
   }
-  stats.policy_loss = update.policy_loss;
-  stats.value_loss = update.value_loss;
-  stats.entropy = update.entropy;
-  stats.approx_kl = update.approx_kl;
-  stats.clip_fraction = update.clip_fraction;
-  stats.extra = {{"explained_variance", update.explained_variance},
-                 {"grad_norm", update.grad_norm},
-                 {"learning_rate", update.learning_rate},
-                 {"env_s", rollout.env_seconds},
-                 {"act_s", rollout.policy_seconds},
-                 {"update_s", update_s},
-                 {"allreduce_s", update.allreduce_seconds}};
+  stats.metrics = {{"policy_loss", update.policy_loss},
+                   {"value_loss", update.value_loss},
+                   {"entropy", update.entropy},
+                   {"approx_kl", update.approx_kl},
+                   {"clip_fraction", update.clip_fraction},
+                   {"explained_variance", update.explained_variance},
+                   {"grad_norm", update.grad_norm},
+                   {"learning_rate", update.learning_rate},
+                   {"env_s", rollout.env_seconds},
+                   {"act_s", rollout.policy_seconds},
+                   {"update_s", update_s},
+                   {"allreduce_s", update.allreduce_seconds}};
   return stats;
 }
 
@@ -81,8 +81,9 @@ void PpoAlgorithm::set_progress(std::int64_t env_steps, std::int64_t updates) {
   trainer_.set_progress(env_steps, updates);
 }
 
-std::vector<std::string> PpoAlgorithm::progress_columns() const {
-  return {"explained_variance", "grad_norm",  "learning_rate", "env_s", "act_s",
+std::vector<std::string> PpoAlgorithm::metric_names() const {
+  return {"policy_loss",        "value_loss", "entropy",       "approx_kl", "clip_fraction",
+          "explained_variance", "grad_norm",  "learning_rate", "env_s",     "act_s",
           "update_s",           "allreduce_s"};
 }
 

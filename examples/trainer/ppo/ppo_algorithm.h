@@ -10,7 +10,7 @@
 
 #include "examples/trainer/ppo/policy.h"
 #include "examples/trainer/ppo/ppo.h"
-#include "examples/trainer/run/algorithm.h"
+#include "pixelgym/trainer/algorithm.h"
 
 namespace pixelgym::ppo {
 
@@ -30,7 +30,9 @@ class PpoActor final : public trainer::Actor {
 /// Checkpoint: blobs "model" (the policy's parameters and buffers, torch::save), "optimizer"
 /// (Adam's state), "rng_sampling" and "rng_augmentation" (TrainerRngState), and meta
 /// "reward_scaling" {"mean", "var", "count", "returns"} (RewardScaling; JSON numbers keep a
-/// double exactly). progress.csv's extra columns: explained_variance, grad_norm, learning_rate,
+/// double exactly). Its metrics (progress.csv's columns after the run's): policy_loss,
+/// value_loss, entropy, approx_kl, clip_fraction (UpdateStats), explained_variance, grad_norm,
+/// learning_rate,
 /// and where the iteration's time went: env_s in the vector env's step/reset, act_s in the
 /// policy's forward passes while collecting, update_s in the PPO epochs, and allreduce_s the part
 /// of update_s spent in the collectives of a distributed run (UpdateStats::allreduce_seconds; 0
@@ -44,7 +46,7 @@ class PpoAlgorithm final : public trainer::Algorithm {
   std::int64_t env_steps() const override { return trainer_.env_steps(); }
   std::int64_t updates() const override { return trainer_.updates(); }
   void set_progress(std::int64_t env_steps, std::int64_t updates) override;
-  std::vector<std::string> progress_columns() const override;
+  std::vector<std::string> metric_names() const override;
   void save(trainer::CheckpointBlobs& blobs, nlohmann::json& meta) override;
   void restore(const trainer::LoadedCheckpoint& checkpoint, const nlohmann::json& meta) override;
   const std::string& env_action_log() const override { return trainer_.env_action_log(); }

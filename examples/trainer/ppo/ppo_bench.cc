@@ -20,8 +20,8 @@
 #include <string>
 
 #include "examples/trainer/ppo/policy.h"
-#include "examples/trainer/run/process_tuning.h"
 #include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/trainer/process_tuning.h"
 
 namespace {
 

@@ -1,6 +1,6 @@
 // The learning algorithm as a training run sees it (TrainingRun): what every algorithm offers the
-// run — iterate, its state for checkpoints, its config and progress.csv columns, and an Actor for
-// evaluation — without torch, so that the run stays algorithm- and torch-free.
+// run — iterate, its state for checkpoints, its config and the metrics it reports by name, and an
+// Actor for evaluation — without torch, so that the run stays algorithm- and torch-free.
 #pragma once
 
 #include <cstdint>
@@ -11,12 +11,12 @@
 #include <string>
 #include <vector>
 
-#include "examples/trainer/run/checkpoint_file.h"
-#include "examples/trainer/run/communicator.h"
-#include "examples/trainer/run/progress_csv.h"
 #include "pixelgym/envs/space.h"
 #include "pixelgym/envs/value.h"
 #include "pixelgym/envs/vector/vector_env.h"
+#include "pixelgym/trainer/checkpoint_file.h"
+#include "pixelgym/trainer/communicator.h"
+#include "pixelgym/trainer/progress_csv.h"
 
 namespace pixelgym::trainer {
 
@@ -43,14 +43,9 @@ struct IterationStats {
   /// The returns of the episodes that ended during it (the sum of the rewards the algorithm was
   /// given), in the order they ended.
   std::vector<double> episode_returns;
-  /// progress.csv's loss columns; NaN (ProgressRow::kNone) where the algorithm has no such figure.
-  double policy_loss = ProgressRow::kNone;
-  double value_loss = ProgressRow::kNone;
-  double entropy = ProgressRow::kNone;
-  double approx_kl = ProgressRow::kNone;
-  double clip_fraction = ProgressRow::kNone;
-  /// One value per column of Algorithm::progress_columns(), no others.
-  std::map<std::string, double> extra;
+  /// Its metrics by name, each one of Algorithm::metric_names() (progress.csv's columns after
+  /// the run's); one it leaves out, or NaN (ProgressRow::kNone), is an empty field.
+  std::map<std::string, double> metrics;
 };
 
 /// Asked by an iteration between its small steps (each env step batch, each gradient step), with
@@ -79,8 +74,10 @@ class Algorithm {
   /// Sets both on resume, before restore() and replay_env().
   virtual void set_progress(std::int64_t env_steps, std::int64_t updates) = 0;
 
-  /// The names of its progress.csv columns after the base ones, in order.
-  virtual std::vector<std::string> progress_columns() const = 0;
+  /// The names of the metrics it reports (IterationStats::metrics), in order: progress.csv's
+  /// columns after the run's (progress_base_columns). A resumed run keeps the columns of its
+  /// progress.csv; a metric that is not one of them is refused by name (RunFolder).
+  virtual std::vector<std::string> metric_names() const = 0;
 
   /// Adds its learning state to a checkpoint: blobs of its own (the run writes "config", "meta"
   /// and "env_actions") and members of the checkpoint's meta object (the run writes "env_steps",

@@ -1,4 +1,4 @@
-#include "examples/trainer/run/checkpoint_file.h"
+#include "pixelgym/trainer/checkpoint_file.h"
 
 #include <zlib.h>
 
@@ -8,7 +8,7 @@
 #include <string_view>
 #include <system_error>
 
-#include "examples/trainer/run/atomic_file.h"
+#include "pixelgym/trainer/atomic_file.h"
 
 namespace pixelgym::trainer {
 namespace {

@@ -1,4 +1,4 @@
-#include "examples/trainer/run/code_version.h"
+#include "pixelgym/trainer/code_version.h"
 
 namespace pixelgym::trainer {
 

@@ -1,4 +1,4 @@
-#include "examples/trainer/run/communicator.h"
+#include "pixelgym/trainer/communicator.h"
 
 #include <algorithm>
 #include <sstream>

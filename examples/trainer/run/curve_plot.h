@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "examples/trainer/run/progress_csv.h"
 #include "pixelgym/render/image_io.h"
+#include "pixelgym/trainer/progress_csv.h"
 
 namespace pixelgym::trainer {
 

@@ -1,4 +1,4 @@
-#include "examples/trainer/run/evaluation.h"
+#include "pixelgym/trainer/evaluation.h"
 
 #include <algorithm>
 #include <chrono>

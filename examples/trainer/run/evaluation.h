@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "examples/trainer/run/algorithm.h"
-#include "examples/trainer/run/run_settings.h"
+#include "pixelgym/trainer/algorithm.h"
+#include "pixelgym/trainer/run_settings.h"
 
 namespace pixelgym::trainer {
 

@@ -1,4 +1,4 @@
-#include "examples/trainer/run/memory_budget.h"
+#include "pixelgym/trainer/memory_budget.h"
 
 #include <algorithm>
 #include <limits>

@@ -1,4 +1,4 @@
-#include "examples/trainer/run/observation_summary.h"
+#include "pixelgym/trainer/observation_summary.h"
 
 #include <optional>
 

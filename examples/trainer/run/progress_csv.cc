@@ -1,4 +1,4 @@
-#include "examples/trainer/run/progress_csv.h"
+#include "pixelgym/trainer/progress_csv.h"
 
 #include <algorithm>
 #include <charconv>
@@ -7,7 +7,7 @@
 #include <set>
 #include <stdexcept>
 
-#include "examples/trainer/run/atomic_file.h"
+#include "pixelgym/trainer/atomic_file.h"
 
 namespace pixelgym::trainer {
 namespace {
@@ -40,9 +40,8 @@ std::vector<std::string> split_fields(const std::string& line) {
 }  // namespace
 
 const std::vector<std::string>& progress_base_columns() {
-  static const std::vector<std::string> kColumns = {
-      "steps",       "wall_time_s", "fps",     "episode_return_mean", "episode_return_std",
-      "policy_loss", "value_loss",  "entropy", "approx_kl",           "clip_fraction"};
+  static const std::vector<std::string> kColumns = {"steps", "wall_time_s", "fps",
+                                                    "episode_return_mean", "episode_return_std"};
   return kColumns;
 }
 
@@ -59,51 +58,38 @@ std::vector<double> ProgressTable::column(const std::string& name) const {
   return values;
 }
 
-std::string format_progress_header(const std::vector<std::string>& extra_columns) {
+std::string format_progress_header(const std::vector<std::string>& metric_columns) {
   std::set<std::string> seen(progress_base_columns().begin(), progress_base_columns().end());
-  for (const std::string& name : extra_columns) {
+  for (const std::string& name : metric_columns) {
     if (name.empty() || name.find_first_of(",\"\r\n") != std::string::npos) {
       throw std::invalid_argument(
-          "progress.csv: an extra column name must be non-empty without commas, quotes or line "
+          "progress.csv: a metric column name must be non-empty without commas, quotes or line "
           "breaks, got \"" +
           name + "\"");
     }
     if (!seen.insert(name).second) {
-      throw std::invalid_argument("progress.csv: extra column \"" + name + "\" repeats a column");
+      throw std::invalid_argument("progress.csv: metric column \"" + name + "\" repeats a column");
     }
   }
   std::vector<std::string> columns = progress_base_columns();
-  columns.insert(columns.end(), extra_columns.begin(), extra_columns.end());
+  columns.insert(columns.end(), metric_columns.begin(), metric_columns.end());
   return joined(columns) + "\n";
 }
 
 std::vector<double> progress_values(const ProgressRow& row,
-                                    const std::vector<std::string>& extra_columns) {
-  std::vector<double> values = {static_cast<double>(row.steps),
-                                row.wall_time_s,
-                                row.fps,
-                                row.episode_return_mean,
-                                row.episode_return_std,
-                                row.policy_loss,
-                                row.value_loss,
-                                row.entropy,
-                                row.approx_kl,
-                                row.clip_fraction};
-  bool matches = row.extra.size() == extra_columns.size();
-  for (const std::string& name : extra_columns) {
-    const auto found = row.extra.find(name);
-    if (found == row.extra.end()) {
-      matches = false;
-      break;
+                                    const std::vector<std::string>& metric_columns) {
+  for (const auto& [name, value] : row.metrics) {
+    if (std::find(metric_columns.begin(), metric_columns.end(), name) == metric_columns.end()) {
+      throw std::invalid_argument("progress.csv: metric \"" + name +
+                                  "\" is not a column of the run; its metric columns are {" +
+                                  joined(metric_columns) + "}");
     }
-    values.push_back(found->second);
   }
-  if (!matches) {
-    std::vector<std::string> given;
-    for (const auto& entry : row.extra) given.push_back(entry.first);
-    throw std::invalid_argument("progress.csv: expected the extra columns {" +
-                                joined(extra_columns) + "} declared with the run, got {" +
-                                joined(given) + "}");
+  std::vector<double> values = {static_cast<double>(row.steps), row.wall_time_s, row.fps,
+                                row.episode_return_mean, row.episode_return_std};
+  for (const std::string& name : metric_columns) {
+    const auto found = row.metrics.find(name);
+    values.push_back(found == row.metrics.end() ? ProgressRow::kNone : found->second);
   }
   return values;
 }
@@ -119,8 +105,8 @@ std::string format_progress_values(const std::vector<double>& values) {
 }
 
 std::string format_progress_row(const ProgressRow& row,
-                                const std::vector<std::string>& extra_columns) {
-  return format_progress_values(progress_values(row, extra_columns));
+                                const std::vector<std::string>& metric_columns) {
+  return format_progress_values(progress_values(row, metric_columns));
 }
 
 ProgressTable parse_progress_csv(const std::string& text, const std::string& source) {

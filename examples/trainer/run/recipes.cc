@@ -1,4 +1,4 @@
-#include "examples/trainer/run/recipes.h"
+#include "pixelgym/trainer/recipes.h"
 
 #include <algorithm>
 #include <fstream>

@@ -1,4 +1,4 @@
-#include "examples/trainer/run/run_folder.h"
+#include "pixelgym/trainer/run_folder.h"
 
 #include <fcntl.h>
 #include <sys/file.h>
@@ -11,10 +11,10 @@
 #include <system_error>
 #include <utility>
 
-#include "examples/trainer/run/atomic_file.h"
-#include "examples/trainer/run/checkpoint_file.h"
-#include "examples/trainer/run/code_version.h"
-#include "examples/trainer/run/curve_plot.h"
+#include "pixelgym/trainer/atomic_file.h"
+#include "pixelgym/trainer/checkpoint_file.h"
+#include "pixelgym/trainer/code_version.h"
+#include "pixelgym/trainer/curve_plot.h"
 
 namespace pixelgym::trainer {
 namespace {
@@ -45,17 +45,17 @@ void write_json_atomically(const fs::path& path, const nlohmann::json& json,
   write_file_atomically(path, {text}, what);
 }
 
-RunFolder::RunFolder(fs::path folder, nlohmann::json config, std::vector<std::string> extra_columns,
-                     ProgressTable progress)
+RunFolder::RunFolder(fs::path folder, nlohmann::json config,
+                     std::vector<std::string> metric_columns, ProgressTable progress)
     : folder_(std::move(folder)),
       config_(std::move(config)),
-      extra_columns_(std::move(extra_columns)),
+      metric_columns_(std::move(metric_columns)),
       progress_(std::move(progress)) {}
 
 RunFolder::RunFolder(RunFolder&& other) noexcept
     : folder_(std::move(other.folder_)),
       config_(std::move(other.config_)),
-      extra_columns_(std::move(other.extra_columns_)),
+      metric_columns_(std::move(other.metric_columns_)),
       progress_(std::move(other.progress_)),
       progress_fd_(std::exchange(other.progress_fd_, -1)) {}
 
@@ -64,7 +64,7 @@ RunFolder& RunFolder::operator=(RunFolder&& other) noexcept {
     if (progress_fd_ >= 0) ::close(progress_fd_);
     folder_ = std::move(other.folder_);
     config_ = std::move(other.config_);
-    extra_columns_ = std::move(other.extra_columns_);
+    metric_columns_ = std::move(other.metric_columns_);
     progress_ = std::move(other.progress_);
     progress_fd_ = std::exchange(other.progress_fd_, -1);
   }
@@ -131,7 +131,7 @@ RunLock::~RunLock() {
 }
 
 RunFolder RunFolder::create(const fs::path& folder, nlohmann::json config,
-                            std::vector<std::string> extra_columns) {
+                            std::vector<std::string> metric_columns) {
   if (!config.is_object()) {
     throw std::invalid_argument("RunFolder: the config must be a JSON object, got " +
                                 std::string(config.type_name()));
@@ -141,7 +141,7 @@ RunFolder RunFolder::create(const fs::path& folder, nlohmann::json config,
         "RunFolder: the config must not have a \"code_version\" key (RunFolder adds it), got " +
         config["code_version"].dump());
   }
-  const std::string header = format_progress_header(extra_columns);
+  const std::string header = format_progress_header(metric_columns);
   std::error_code error;
   fs::create_directories(folder, error);
   if (error) {
@@ -159,8 +159,8 @@ RunFolder RunFolder::create(const fs::path& folder, nlohmann::json config,
   write_file_atomically(folder / kProgressName, {header}, "RunFolder");
   ProgressTable progress;
   progress.columns = progress_base_columns();
-  progress.columns.insert(progress.columns.end(), extra_columns.begin(), extra_columns.end());
-  RunFolder run(folder, std::move(config), std::move(extra_columns), std::move(progress));
+  progress.columns.insert(progress.columns.end(), metric_columns.begin(), metric_columns.end());
+  RunFolder run(folder, std::move(config), std::move(metric_columns), std::move(progress));
   run.open_progress();
   return run;
 }
@@ -194,10 +194,10 @@ RunFolder RunFolder::resume(const fs::path& folder, std::int64_t resumed_steps,
     if (row[0] <= static_cast<double>(resumed_steps)) kept.push_back(std::move(row));
   }
   progress.rows = std::move(kept);
-  std::vector<std::string> extra_columns(
+  std::vector<std::string> metric_columns(
       progress.columns.begin() + static_cast<std::ptrdiff_t>(progress_base_columns().size()),
       progress.columns.end());
-  std::string rewritten = format_progress_header(extra_columns);
+  std::string rewritten = format_progress_header(metric_columns);
   for (const std::vector<double>& row : progress.rows) rewritten += format_progress_values(row);
   // Rows after the checkpoint, or a row cut short by a kill: rewrite without them.
   if (rewritten != text) write_file_atomically(progress_path, {rewritten}, "RunFolder");
@@ -210,7 +210,7 @@ RunFolder RunFolder::resume(const fs::path& folder, std::int64_t resumed_steps,
   if (budget.is_object()) entry.update(budget);
   config["resumes"].push_back(std::move(entry));
   write_json_atomically(folder / kConfigName, config, "RunFolder");
-  RunFolder run(folder, std::move(config), std::move(extra_columns), std::move(progress));
+  RunFolder run(folder, std::move(config), std::move(metric_columns), std::move(progress));
   run.open_progress();
   return run;
 }
@@ -232,7 +232,7 @@ void RunFolder::append_progress(const ProgressRow& row) {
         std::to_string(static_cast<std::int64_t>(progress_.rows.back()[0])) + ", got " +
         std::to_string(row.steps));
   }
-  std::vector<double> values = progress_values(row, extra_columns_);
+  std::vector<double> values = progress_values(row, metric_columns_);
   const std::string line = format_progress_values(values);
   // One write: a kill leaves the row whole or absent (a short write is reported, not resumed:
   // the next row would otherwise share its line).

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "examples/trainer/run/curve_plot.h"
-#include "examples/trainer/run/progress_csv.h"
+#include "pixelgym/trainer/curve_plot.h"
+#include "pixelgym/trainer/progress_csv.h"
 
 namespace pixelgym::trainer {
 
@@ -24,16 +24,16 @@ class RunFolder {
  public:
   /// Starts a run in `folder` (created with its parents): writes config.json and the header of
   /// progress.csv. Throws std::invalid_argument when `config` is not an object or already has a
-  /// "code_version" key, or for a bad extra column name (see format_progress_header);
+  /// "code_version" key, or for a bad metric column name (see format_progress_header);
   /// std::runtime_error naming the folder when it already holds a run (a config.json or
   /// progress.csv) or cannot be written.
   static RunFolder create(const std::filesystem::path& folder, nlohmann::json config,
-                          std::vector<std::string> extra_columns = {});
+                          std::vector<std::string> metric_columns = {});
 
   /// Reopens the run in `folder` to continue from a checkpoint taken at `resumed_steps` env
   /// steps: rows of progress.csv after that step were logged after the checkpoint and will be
   /// logged again, so they are dropped (progress.csv is rewritten atomically without them).
-  /// The extra columns are those of progress.csv's header. `budget` (an object, or null) is
+  /// The metric columns are those of progress.csv's header. `budget` (an object, or null) is
   /// merged into the "resumes" entry. Throws std::runtime_error naming the file when config.json
   /// or progress.csv is missing or malformed; std::invalid_argument for a `budget` that is not
   /// an object or null.
@@ -49,13 +49,13 @@ class RunFolder {
   const std::filesystem::path& path() const { return folder_; }
   /// config.json as written (the caller's settings, "code_version", "resumes").
   const nlohmann::json& config() const { return config_; }
-  const std::vector<std::string>& extra_columns() const { return extra_columns_; }
+  const std::vector<std::string>& metric_columns() const { return metric_columns_; }
   /// Every row of progress.csv so far, resumed ones included.
   const ProgressTable& progress() const { return progress_; }
 
   /// Appends `row` to progress.csv with one write (no buffering: on disk when this returns,
   /// short of a crash of the machine). Throws std::invalid_argument when its steps are not above
-  /// the last row's or its extra values do not match the declared columns, std::runtime_error
+  /// the last row's or its metric values do not match the declared columns, std::runtime_error
   /// naming the file when the write fails.
   void append_progress(const ProgressRow& row);
 
@@ -71,12 +71,12 @@ class RunFolder {
 
  private:
   RunFolder(std::filesystem::path folder, nlohmann::json config,
-            std::vector<std::string> extra_columns, ProgressTable progress);
+            std::vector<std::string> metric_columns, ProgressTable progress);
   void open_progress();
 
   std::filesystem::path folder_;
   nlohmann::json config_;
-  std::vector<std::string> extra_columns_;
+  std::vector<std::string> metric_columns_;
   ProgressTable progress_;
   int progress_fd_ = -1;
 };

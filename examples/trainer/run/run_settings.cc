@@ -1,4 +1,4 @@
-#include "examples/trainer/run/run_settings.h"
+#include "pixelgym/trainer/run_settings.h"
 
 #include <fstream>
 #include <stdexcept>

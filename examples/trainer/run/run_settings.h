@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "examples/trainer/run/algorithm.h"
 #include "pixelgym/envs/env.h"
 #include "pixelgym/envs/params.h"
 #include "pixelgym/envs/vector/vector_env.h"
+#include "pixelgym/trainer/algorithm.h"
 
 namespace pixelgym::trainer {
 

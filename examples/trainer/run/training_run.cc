@@ -1,4 +1,4 @@
-#include "examples/trainer/run/training_run.h"
+#include "pixelgym/trainer/training_run.h"
 
 #include <cmath>
 #include <cstring>
@@ -9,11 +9,11 @@
 #include <utility>
 #include <vector>
 
-#include "examples/trainer/run/atomic_file.h"
-#include "examples/trainer/run/curve_plot.h"
-#include "examples/trainer/run/evaluation.h"
-#include "examples/trainer/run/observation_summary.h"
-#include "examples/trainer/run/process_tuning.h"
+#include "pixelgym/trainer/atomic_file.h"
+#include "pixelgym/trainer/curve_plot.h"
+#include "pixelgym/trainer/evaluation.h"
+#include "pixelgym/trainer/observation_summary.h"
+#include "pixelgym/trainer/process_tuning.h"
 
 namespace pixelgym::trainer {
 namespace {
@@ -493,7 +493,7 @@ std::optional<json> TrainingRun::train() {
     run_.emplace(RunFolder::resume(folder_, 0, budget));
   } else if (lead()) {
     run_.emplace(
-        RunFolder::create(folder_, settings_to_json(settings_), algorithm_->progress_columns()));
+        RunFolder::create(folder_, settings_to_json(settings_), algorithm_->metric_names()));
   }
   train_until_spent();
   save_checkpoint();
@@ -679,12 +679,7 @@ ProgressRow TrainingRun::iterate_once(const StopCheck& stop) {
   row.fps = static_cast<double>(algorithm_->env_steps() - steps_before) / seconds;
   row.episode_return_mean = mean_of(returns_);
   row.episode_return_std = std_of(returns_);
-  row.policy_loss = stats.policy_loss;
-  row.value_loss = stats.value_loss;
-  row.entropy = stats.entropy;
-  row.approx_kl = stats.approx_kl;
-  row.clip_fraction = stats.clip_fraction;
-  row.extra = std::move(stats.extra);
+  row.metrics = std::move(stats.metrics);
   if (lead()) run_->append_progress(row);
   return row;
 }

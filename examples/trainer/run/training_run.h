@@ -17,12 +17,12 @@
 #include <utility>
 #include <vector>
 
-#include "examples/trainer/run/algorithm.h"
-#include "examples/trainer/run/checkpoint_file.h"
-#include "examples/trainer/run/evaluation.h"
-#include "examples/trainer/run/progress_line.h"
-#include "examples/trainer/run/run_folder.h"
-#include "examples/trainer/run/run_settings.h"
+#include "pixelgym/trainer/algorithm.h"
+#include "pixelgym/trainer/checkpoint_file.h"
+#include "pixelgym/trainer/evaluation.h"
+#include "pixelgym/trainer/progress_line.h"
+#include "pixelgym/trainer/run_folder.h"
+#include "pixelgym/trainer/run_settings.h"
 
 namespace pixelgym::trainer {
 

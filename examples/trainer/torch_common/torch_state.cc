@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <stdexcept>
 
-#include "examples/trainer/run/communicator.h"
+#include "pixelgym/trainer/communicator.h"
 
 namespace pixelgym::trainer {
 

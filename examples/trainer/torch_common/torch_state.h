@@ -10,7 +10,7 @@
 #include <sstream>
 #include <string>
 
-#include "examples/trainer/run/checkpoint_file.h"
+#include "pixelgym/trainer/checkpoint_file.h"
 
 namespace pixelgym::trainer {
 

@@ -19,7 +19,7 @@
 #include <thread>
 #include <vector>
 
-#include "examples/trainer/run/progress_csv.h"
+#include "pixelgym/trainer/progress_csv.h"
 #include "tests/examples/cli_run.h"
 #include "tests/examples/trainer/distributed/rank_processes.h"
 

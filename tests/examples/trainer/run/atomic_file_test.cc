@@ -1,4 +1,4 @@
-#include "examples/trainer/run/atomic_file.h"
+#include "pixelgym/trainer/atomic_file.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-#include "examples/trainer/run/checkpoint_file.h"
+#include "pixelgym/trainer/checkpoint_file.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -14,7 +14,7 @@
 #include <thread>
 #include <vector>
 
-#include "examples/trainer/run/atomic_file.h"
+#include "pixelgym/trainer/atomic_file.h"
 #include "tests/examples/trainer/run/test_folders.h"
 
 namespace pixelgym::trainer {

@@ -1,5 +1,5 @@
 // SingleProcessCommunicator: the collectives of a world of one rank.
-#include "examples/trainer/run/communicator.h"
+#include "pixelgym/trainer/communicator.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // Reading an algorithm's config members: integers are integers of the member's range, or are
 // refused naming the member, the range and the value (JSON's own conversion truncated 2.9 to 2,
 // wrapped -1 to 2^64 - 1 and left 1e30 undefined).
-#include "examples/trainer/run/config_members.h"
+#include "pixelgym/trainer/config_members.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

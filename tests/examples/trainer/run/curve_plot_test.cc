@@ -1,4 +1,4 @@
-#include "examples/trainer/run/curve_plot.h"
+#include "pixelgym/trainer/curve_plot.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
 // Refusing settings that need more memory than is available: the message names the total, the
 // memory available and where that figure comes from, and the member that takes the most.
-#include "examples/trainer/run/memory_budget.h"
+#include "pixelgym/trainer/memory_budget.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "examples/trainer/run/process_tuning.h"
+#include "pixelgym/trainer/process_tuning.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

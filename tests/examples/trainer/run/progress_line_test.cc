@@ -1,4 +1,4 @@
-#include "examples/trainer/run/progress_line.h"
+#include "pixelgym/trainer/progress_line.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

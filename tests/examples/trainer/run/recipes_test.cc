@@ -1,6 +1,6 @@
 // The trainer's recipes found by name (`train --config swingup`), --config's other forms (a file,
 // inline JSON), and --set-algo's KEY=VALUE applied to a config.
-#include "examples/trainer/run/recipes.h"
+#include "pixelgym/trainer/recipes.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

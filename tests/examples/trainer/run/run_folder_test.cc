@@ -1,4 +1,4 @@
-#include "examples/trainer/run/run_folder.h"
+#include "pixelgym/trainer/run_folder.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "examples/trainer/run/atomic_file.h"
-#include "examples/trainer/run/checkpoint_file.h"
 #include "pixelgym/render/image_io.h"
+#include "pixelgym/trainer/atomic_file.h"
+#include "pixelgym/trainer/checkpoint_file.h"
 #include "tests/examples/trainer/run/test_folders.h"
 
 namespace pixelgym::trainer {
@@ -64,7 +64,7 @@ TEST(RunFolderTest, CreateWritesTheConfigWithTheCodeVersionAndTheCsvHeader) {
   EXPECT_TRUE(config["code_version"]["dirty"].is_boolean());
   EXPECT_EQ(config, run.config());
   EXPECT_EQ(file_text(folder / "progress.csv"), format_progress_header({"lr"}));
-  EXPECT_EQ(run.extra_columns(), std::vector<std::string>{"lr"});
+  EXPECT_EQ(run.metric_columns(), std::vector<std::string>{"lr"});
   EXPECT_TRUE(run.progress().rows.empty());
 }
 
@@ -167,7 +167,7 @@ TEST(RunFolderTest, ResumeDropsRowsAfterTheCheckpointAndAppendsAfterTheRest) {
     RunFolder run = RunFolder::create(folder, sample_config(), {"lr"});
     for (int i = 1; i <= 5; ++i) {
       ProgressRow row = row_at(1000 * i);
-      row.extra = {{"lr", 0.1 * i}};
+      row.metrics = {{"lr", 0.1 * i}};
       run.append_progress(row);
     }
   }
@@ -177,9 +177,9 @@ TEST(RunFolderTest, ResumeDropsRowsAfterTheCheckpointAndAppendsAfterTheRest) {
   RunFolder run = RunFolder::resume(folder, 3000, {{"total_env_steps", 9000}, {"minutes", 2.5}});
   EXPECT_EQ(steps_on_disk(folder), (std::vector<double>{1000, 2000, 3000}));
   EXPECT_EQ(run.progress().rows.size(), 3U);
-  EXPECT_EQ(run.extra_columns(), std::vector<std::string>{"lr"});
+  EXPECT_EQ(run.metric_columns(), std::vector<std::string>{"lr"});
   ProgressRow row = row_at(4000);
-  row.extra = {{"lr", 0.4}};
+  row.metrics = {{"lr", 0.4}};
   EXPECT_THROW(run.append_progress(row_at(3000)), std::invalid_argument);
   run.append_progress(row);
   EXPECT_EQ(steps_on_disk(folder), (std::vector<double>{1000, 2000, 3000, 4000}));

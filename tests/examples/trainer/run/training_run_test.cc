@@ -1,7 +1,7 @@
 // TrainingRun driving an algorithm that is not PPO and needs no torch: a counting algorithm on
 // GridWorld-v0 whose actions follow a fixed pattern, so that the run's budget, checkpoints,
 // resume (replay of the env actions included), evaluation and summary can be checked exactly.
-#include "examples/trainer/run/training_run.h"
+#include "pixelgym/trainer/training_run.h"
 
 #include <gtest/gtest.h>
 
@@ -13,9 +13,9 @@
 #include <thread>
 #include <vector>
 
-#include "examples/trainer/run/checkpoint_file.h"
-#include "examples/trainer/run/progress_csv.h"
 #include "pixelgym/envs/tasks/grid_world.h"
+#include "pixelgym/trainer/checkpoint_file.h"
+#include "pixelgym/trainer/progress_csv.h"
 #include "tests/examples/trainer/run/test_folders.h"
 
 namespace pixelgym::trainer {
@@ -54,7 +54,7 @@ std::int64_t walk_action(std::int64_t t, int i) {
 
 // Steps its env steps_per_iteration times an iteration, env i taking walk_action(t, i) at step
 // t (counted from the first reset); "learns" a counter of its iterations, saved in a blob
-// "counter". Its figures: policy_loss = the counter, extra column "counter" too.
+// "counter". Its metrics: policy_loss = the counter, and "counter" too.
 class CountingAlgorithm final : public Algorithm {
  public:
   CountingAlgorithm(vector::VectorEnv& env, const json& config)
@@ -75,8 +75,8 @@ class CountingAlgorithm final : public Algorithm {
     }
     counter_ += 1;
     updates_ += 1;
-    stats.policy_loss = static_cast<double>(counter_);
-    stats.extra = {{"counter", static_cast<double>(counter_)}};
+    stats.metrics = {{"policy_loss", static_cast<double>(counter_)},
+                     {"counter", static_cast<double>(counter_)}};
     return stats;
   }
   std::int64_t env_steps() const override { return batches_ * env_.num_envs(); }
@@ -86,7 +86,7 @@ class CountingAlgorithm final : public Algorithm {
     updates_ = updates;
     log_complete_ = false;
   }
-  std::vector<std::string> progress_columns() const override { return {"counter"}; }
+  std::vector<std::string> metric_names() const override { return {"policy_loss", "counter"}; }
   void save(CheckpointBlobs& blobs, json& meta) override {
     blobs["counter"] = std::to_string(counter_);
     meta["counter"] = counter_;
