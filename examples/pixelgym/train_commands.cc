@@ -36,7 +36,7 @@ void add_run_options(CLI::App& train, TrainArguments& args) {
                   "random-shift augmentation and scheduled exploration noise; Box actions only, "
                   "and images as --wrap frame_stack=3 stacks). The run's config.json names it; "
                   "--resume and eval read it from there")
-      ->check(name_in({"ppo", "drqv2"}, "algorithm"))
+      ->check(name_in({"ppo", "drqv2", "drq"}, "algorithm"))
       ->each([&args](const std::string&) { args.algo_given = true; });
   train.add_option(
       "--config", args.config_file,
