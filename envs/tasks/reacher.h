@@ -1,4 +1,4 @@
-// ReacherEasy-v0 and ReacherHard-v0: a two-link planar arm reaches a random target.
+// ReacherEasy and ReacherHard, -v0 and -v1: a two-link planar arm reaches a random target.
 #pragma once
 
 #include "pixelgym/envs/registry.h"
@@ -8,15 +8,23 @@ namespace pixelgym {
 
 /// Two 0.12 m links turning about z on the ground (assets/reacher); actions are the two joint
 /// torques, Box(-1, 1, (2,)) times 0.05 N m. Each episode puts a target (a green marker that
-/// nothing touches) at a random place within reach, 0.05 to 0.22 m from the shoulder, and starts
-/// the arm at random angles.
-/// - Reward 1 while the fingertip is within the target radius (Easy 0.05 m, Hard 0.015 m), else 0.
+/// nothing touches) at a random place within reach and starts the arm at random angles.
+/// - Reward 1 while the fingertip is within the reward radius of the target's centre, else 0.
 /// - State: joint_pos (2, rad, wrapped), joint_vel (2), to_target (2, m, target minus fingertip
 ///   in the ground plane). 1000 control steps of 0.02 s. Cameras: "top" (default), "angled".
+/// - Versions. -v0 (assets/reacher/reacher.urdf): undamped joints, 0.05 kg links, the reward
+///   radius is the target's (Easy 0.05 m, Hard 0.015 m), targets 0.05 to 0.22 m from the
+///   shoulder, the wrist starting within +-2.5 rad. -v1 is dm_control's reacher
+///   (suite/reacher.py, reacher.xml) wherever -v0 differed: joints damped with 0.01 N m s/rad and
+///   dm_control's masses (assets/reacher/reacher_v1.urdf), the reward radius the target's plus
+///   the finger's 0.01 m (Easy 0.06 m, Hard 0.025 m), targets 0.05 to 0.20 m from the shoulder,
+///   the wrist starting anywhere in its +-160 degree range. docs/experiments/dm-control-parity.md
+///   compares the two with dm_control line by line.
 class ReacherTask final : public Task {
  public:
-  /// `target_radius_m`: the marker's radius and the reward's bound (0.05 Easy, 0.015 Hard).
-  explicit ReacherTask(double target_radius_m);
+  /// `target_radius_m`: the marker's radius (0.05 Easy, 0.015 Hard); `version` is the id's, 0 or
+  /// 1 (see above).
+  ReacherTask(double target_radius_m, int version);
 
   std::vector<std::string> camera_names() const override { return {"top", "angled"}; }
   SpacePtr action_space() const override;
@@ -38,13 +46,22 @@ class ReacherTask final : public Task {
   /// World position of the target marker's centre, m.
   Eigen::Vector3d target(const engine::World& world) const;
 
+  /// The reward's bound on the fingertip-to-target distance, m: the target radius (-v0), or the
+  /// target radius plus dm_control's finger radius, kFingerRadiusM (-v1).
+  double reward_radius_m() const {
+    return version_ == 0 ? target_radius_m_ : target_radius_m_ + kFingerRadiusM;
+  }
+
   /// Each joint's torque at action 1, N m.
   static constexpr double kMaxTorqueNm = 0.05;
-  /// The registry entries: ReacherEasy-v0 and ReacherHard-v0.
+  /// dm_control's finger radius, m, which its reward adds to the target radius (-v1).
+  static constexpr double kFingerRadiusM = 0.01;
+  /// The registry entries: ReacherEasy and ReacherHard, each -v0 and -v1.
   static std::vector<EnvSpec> specs();
 
  private:
   double target_radius_m_;
+  int version_;
   engine::RobotId robot_;
   int fingertip_link_ = 0;
   engine::BodyId target_body_;
