@@ -18,8 +18,10 @@ namespace pixelgym {
 ///   (suite/reacher.py, reacher.xml) wherever -v0 differed: joints damped with 0.01 N m s/rad and
 ///   dm_control's masses (assets/reacher/reacher_v1.urdf), the reward radius the target's plus
 ///   the finger's 0.01 m (Easy 0.06 m, Hard 0.025 m), targets 0.05 to 0.20 m from the shoulder,
-///   the wrist starting anywhere in its +-160 degree range. docs/experiments/dm-control-parity.md
-///   compares the two with dm_control line by line.
+///   the wrist starting anywhere in its +-160 degree range. -v1 also draws the fingertip for small
+///   grey frames: a white sphere of 0.02 m radius (-v0: red, 0.012 m, the floor's grey level).
+///   docs/experiments/dm-control-parity.md compares the two with dm_control line by line;
+///   docs/experiments/frame-probe.md measures what the frames show.
 class ReacherTask final : public Task {
  public:
   /// `target_radius_m`: the marker's radius (0.05 Easy, 0.015 Hard); `version` is the id's, 0 or

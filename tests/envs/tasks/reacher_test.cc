@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <string>
 
 #include "pixelgym/engine/world.h"
 #include "pixelgym/envs/registry.h"
@@ -158,6 +159,40 @@ TEST(ReacherDynamicsTest, V1JointsAreDampedAsDmControls) {
             << " rad/s\n";
   EXPECT_NEAR(v1, 5.0, 0.5);
   EXPECT_GT(v0, 20.0);
+}
+
+// Pixels of a 64 x 64 anti-aliased frame after reset(seed) whose grey level (0.299 R + 0.587 G +
+// 0.114 B) is at least 230. Apart from -v1's white fingertip, only a rare highlight on the yellow
+// hand is that bright (at 200, v0's hand gave 20 such pixels over the 8 frames below).
+int bright_grey_pixels(const std::string& id, std::uint64_t seed) {
+  auto env = make(id, {{"width", 64}, {"height", 64}, {"obs_mode", "pixels"}, {"msaa", 4}});
+  const Array frame = env->reset(seed).obs.dict().at("pixels").array();
+  const std::uint8_t* p = frame.data<std::uint8_t>();
+  int count = 0;
+  for (int i = 0; i < 64 * 64; ++i) {
+    if (0.299 * p[3 * i] + 0.587 * p[3 * i + 1] + 0.114 * p[3 * i + 2] >= 230.0) ++count;
+  }
+  return count;
+}
+
+// -v0's red fingertip has the floor's grey level and is about a pixel wide at 64 x 64, so grey
+// frames hide it; -v1 draws it white and 0.02 m in radius, a bright spot of several pixels in
+// most frames (fewer where the hand's shadow or the target covers part of it). Over 8 seeds.
+TEST(ReacherDrawingTest, V1FingertipStandsOutInGrey) {
+  int v0 = 0;
+  int v1 = 0;
+  int v1_frames_with_spot = 0;
+  for (std::uint64_t seed = 0; seed < 8; ++seed) {
+    v0 += bright_grey_pixels("ReacherEasy-v0", seed);
+    const int spot = bright_grey_pixels("ReacherEasy-v1", seed);
+    v1 += spot;
+    if (spot >= 3) ++v1_frames_with_spot;
+  }
+  std::cout << "bright grey pixels over 8 frames: v0 " << v0 << ", v1 " << v1 << " ("
+            << v1_frames_with_spot << " frames with a spot of 3 or more)\n";
+  EXPECT_LE(v0, 4);                   // measured: 1
+  EXPECT_GE(v1, 16);                  // measured: 24
+  EXPECT_GE(v1_frames_with_spot, 5);  // measured: 6 of 8
 }
 
 }  // namespace
