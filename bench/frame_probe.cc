@@ -349,9 +349,20 @@ int main(int argc, char** argv) try {
       const torch::Tensor d = torch::remainder(angle - true_angle + kPi, 2 * kPi) - kPi;
       const torch::Tensor deg = d.abs() * (180.0 / kPi);
       const torch::Tensor cart = (p.select(1, 2) - test_y.select(1, 2)).abs();
-      std::printf("  %-4s angle_err_deg median=%.2f p90=%.2f  cart_err_m median=%.4f p90=%.4f\n",
-                  name, percentile(deg, 0.5), percentile(deg, 0.9), percentile(cart, 0.5),
-                  percentile(cart, 0.9));
+      // The same split by where the pole points: above the hinge (|angle| <= 90 degrees, against
+      // the sky) or below it (against the floor, where swing-up starts).
+      const torch::Tensor upper = true_angle.abs() <= kPi / 2;
+      const torch::Tensor deg_upper = deg.masked_select(upper);
+      const torch::Tensor deg_lower = deg.masked_select(~upper);
+      std::printf(
+          "  %-4s angle_err_deg median=%.2f p90=%.2f  cart_err_m median=%.4f p90=%.4f  "
+          "pole_up(%lld frames) angle_err_deg median=%.2f p90=%.2f  pole_down(%lld frames) "
+          "angle_err_deg median=%.2f p90=%.2f\n",
+          name, percentile(deg, 0.5), percentile(deg, 0.9), percentile(cart, 0.5),
+          percentile(cart, 0.9), static_cast<long long>(deg_upper.numel()),
+          percentile(deg_upper, 0.5), percentile(deg_upper, 0.9),
+          static_cast<long long>(deg_lower.numel()), percentile(deg_lower, 0.5),
+          percentile(deg_lower, 0.9));
     } else {
       const auto err = [&](int j) {
         return (p.slice(1, j, j + 2) - test_y.slice(1, j, j + 2)).norm(2, 1);
