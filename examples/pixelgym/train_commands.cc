@@ -31,12 +31,15 @@ namespace fs = std::filesystem;
 void add_run_options(CLI::App& train, TrainArguments& args) {
   train
       .add_option("--algo", args.algo,
-                  "The learning algorithm: ppo (PPO, on-policy; the default) or drqv2 (DrQ-v2: "
-                  "off-policy DDPG with a twin critic, n-step returns from a replay buffer, "
-                  "random-shift augmentation and scheduled exploration noise; Box actions only, "
-                  "and images as --wrap frame_stack=3 stacks). The run's config.json names it; "
+                  "The learning algorithm: ppo (PPO, on-policy; the default), drq (DrQ: "
+                  "off-policy soft actor-critic with a squashed Gaussian policy, clipped double "
+                  "Q, a learned entropy temperature and random-shift augmentation; from the "
+                  "joint state it is SAC) or drqv2 (DrQ-v2: off-policy DDPG with a twin critic, "
+                  "n-step returns from a replay buffer, random-shift augmentation and scheduled "
+                  "exploration noise). drq and drqv2 take Box actions only, and images as --wrap "
+                  "frame_stack=3 stacks. The run's config.json names it; "
                   "--resume and eval read it from there")
-      ->check(name_in({"ppo", "drqv2"}, "algorithm"))
+      ->check(name_in({"ppo", "drqv2", "drq"}, "algorithm"))
       ->each([&args](const std::string&) { args.algo_given = true; });
   train.add_option(
       "--config", args.config_file,
@@ -54,7 +57,11 @@ void add_run_options(CLI::App& train, TrainArguments& args) {
       "noise_schedule_env_steps (25,000), noise_clip (0.3), "
       "actor_preactivation_penalty (0.001), shift_pad (4), "
       "bfloat16 (true: autocast the encoder where the CPU has AVX512-BF16 or AMX), "
-      "channels_last (true). drqv2's replay buffer is not in its checkpoints: "
+      "channels_last (true). drq's: as drqv2's without the noise and the penalty, with "
+      "n_step (1), hidden_depth (2), init_temperature (0.1), target_entropy (null: -|A|), "
+      "actor_update_every (2), target_update_every (2), log_std_min (-10), log_std_max (2), "
+      "augmented_copies (1: shifted copies averaged, DrQ's K = M). Neither replay buffer is "
+      "in the checkpoints: "
       "--resume refills it by replaying the run's env actions, which puts the "
       "same transitions back");
   train
@@ -73,7 +80,7 @@ void add_run_options(CLI::App& train, TrainArguments& args) {
   train.add_option("--steps", args.steps,
                    "Env steps to train for, all envs together; with --set action_repeat=K "
                    "each is K control steps (default: the config's total_env_steps: ppo "
-                   "1,000,000, drqv2 100,000)");
+                   "1,000,000, drq and drqv2 100,000)");
   train
       .add_option("--minutes", args.minutes,
                   "Stop after this much wall time (0, the default: no time limit), the final "
@@ -172,7 +179,7 @@ void add_run_setting_options(CLI::App& train, TrainArguments& args) {
 void declare_train(CLI::App& train, TrainArguments& args) {
   args.command = &train;
   train.description(
-      "Train a policy (PPO, or DrQ-v2 with --algo drqv2) from the env's observations (pixels "
+      "Train a policy (PPO; DrQ with --algo drq, DrQ-v2 with --algo drqv2) from the env's observations (pixels "
       "included) and write a run folder: "
       "config.json, progress.csv, eval.csv, curve.png, checkpoints, and at the end final.mp4 and "
       "summary.json (an evaluation over seeded episodes)");

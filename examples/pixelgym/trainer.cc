@@ -18,6 +18,7 @@
 
 #include "examples/pixelgym/train_commands.h"
 #include "examples/trainer/distributed/gloo_communicator.h"
+#include "examples/trainer/drq/drq_algorithm.h"
 #include "examples/trainer/drqv2/drqv2_algorithm.h"
 #include "examples/trainer/ppo/ppo_algorithm.h"
 #include "pixelgym/trainer/evaluation.h"
@@ -33,7 +34,8 @@ namespace fs = std::filesystem;
 // The algorithms `train --algo` offers, PPO first (the default).
 const ppo::PpoAlgorithmFactory kPpo;
 const drqv2::DrqV2AlgorithmFactory kDrqV2;
-const trainer::AlgorithmFactories kAlgorithms = {&kPpo, &kDrqV2};
+const drq::DrqAlgorithmFactory kDrq;
+const trainer::AlgorithmFactories kAlgorithms = {&kPpo, &kDrqV2, &kDrq};
 
 // Set by the first SIGINT (Ctrl-C) during `train`: the run stops at its next step, checkpoints
 // and says how to resume; a second SIGINT ends the process at once (the default action).

@@ -788,6 +788,55 @@ TEST(TrainCliTest, DrqV2WritesARunThatEvalReadsAndResumesAsIfItHadNotStopped) {
   fs::remove_all(folder);
 }
 
+// DrQ (SAC) on the same machinery: a resumed run restores the update counter that spaces the
+// actor's and the target's updates, the temperature's optimizer and the sampling generator, and
+// continues as the run that did not stop.
+TEST(TrainCliTest, DrqResumesAsIfItHadNotStopped) {
+  const fs::path folder = fresh_folder("drq");
+  std::ofstream(folder / "drq.json")
+      << R"({"seed_env_steps": 24, "iteration_env_steps": 16, "batch_size": 8, "hidden_dim": 16,
+             "feature_dim": 8, "replay_capacity": 400, "actor_update_every": 7})";
+  const auto arguments = [&](const fs::path& run, std::int64_t steps) {
+    return "train CartPoleBalance-v1 --algo drq --set obs_mode=pixels+state --set width=32 "
+           "--set height=32 --set action_repeat=4 --set max_episode_steps=24 --wrap grayscale "
+           "--wrap frame_stack=3 --threads 1 --config " +
+           (folder / "drq.json").string() + " --steps " + std::to_string(steps) +
+           " --checkpoint-every 2 --keep-checkpoints 0 --eval-every 32 --eval-every-episodes 1 "
+           "--eval-max-share 1 --eval-episodes 1 --quiet --out " +
+           run.string();
+  };
+  const fs::path straight = folder / "straight";
+  const CliRun trained = run_cli(arguments(straight, 96));
+  ASSERT_EQ(trained.exit_code, 0) << trained.output;
+  const trainer::ProgressTable progress = trainer::read_progress_csv(straight / "progress.csv");
+  ASSERT_EQ(progress.rows.size(), 6U);
+  EXPECT_TRUE(std::isfinite(progress.column("alpha").back()));
+  EXPECT_TRUE(std::isfinite(progress.column("policy_entropy").back()));
+  const CliRun evaluated = run_cli("eval " + straight.string() + " --episodes 1");
+  ASSERT_EQ(evaluated.exit_code, 0) << evaluated.output;
+
+  // Stopped after 48 steps (about 25 updates: not a multiple of actor_update_every), resumed.
+  const fs::path split = folder / "split";
+  const CliRun first = run_cli(arguments(split, 48));
+  ASSERT_EQ(first.exit_code, 0) << first.output;
+  const CliRun resumed = run_cli("train --resume " + split.string() + " --steps 96 --quiet");
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  for (std::int64_t update = 4; update <= 6; update += 2) {
+    const std::string name = trainer::checkpoint_file_name(update);
+    const trainer::CheckpointBlobs a = trainer::read_checkpoint(straight / name);
+    const trainer::CheckpointBlobs b = trainer::read_checkpoint(split / name);
+    // The optimizers' blobs are not compared: LibTorch keys their state by the parameters'
+    // addresses, which differ between processes. The agent (log_alpha included) is the result.
+    ASSERT_EQ(a.count("alpha_optimizer"), 1U) << name;
+    for (const char* blob :
+         {"agent", "rng_augmentation", "rng_exploration", "rng_sampling", "env_actions"}) {
+      ASSERT_EQ(a.count(blob), 1U) << name << " " << blob;
+      EXPECT_TRUE(a.at(blob) == b.at(blob)) << name << ": \"" << blob << "\" differs";
+    }
+    EXPECT_EQ(json::parse(a.at("meta")).at("drq"), json::parse(b.at("meta")).at("drq"));
+  }
+}
+
 // --config takes a recipe's name, a file or inline JSON, and --set-algo one setting over it, each
 // refused as a config file is (did you mean, expected vs given); --print-config shows the result
 // and trains nothing; --list-configs shows the recipes.

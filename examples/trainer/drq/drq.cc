@@ -1,0 +1,557 @@
+#include "examples/trainer/drq/drq.h"
+
+#include <ATen/autocast_mode.h>
+
+#include <cmath>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+#include "examples/trainer/run/config_members.h"
+
+namespace pixelgym::drq {
+namespace {
+
+constexpr const char* kConfigName = "DrqConfig";
+
+template <typename T>
+void read_member(const nlohmann::json& json, const char* name, T& field) {
+  trainer::read_member(json, name, field, kConfigName);
+}
+
+// Bfloat16 autocast of the CPU's convolutions for the scope of the guard (when `on`).
+class CpuAutocast {
+ public:
+  explicit CpuAutocast(bool on) : on_(on) {
+    if (!on_) return;
+    previous_ = at::autocast::is_cpu_enabled();
+    at::autocast::set_cpu_enabled(true);
+    at::autocast::set_autocast_cpu_dtype(at::kBFloat16);
+    at::autocast::increment_nesting();
+  }
+  ~CpuAutocast() {
+    if (!on_) return;
+    if (at::autocast::decrement_nesting() == 0) at::autocast::clear_cache();
+    at::autocast::set_cpu_enabled(previous_);
+  }
+  CpuAutocast(const CpuAutocast&) = delete;
+  CpuAutocast& operator=(const CpuAutocast&) = delete;
+
+ private:
+  bool on_;
+  bool previous_ = false;
+};
+
+void orthogonal_init(torch::nn::Module& module, double gain) {
+  for (auto& child : module.modules(/*include_self=*/true)) {
+    if (auto* linear = child->as<torch::nn::Linear>()) {
+      torch::nn::init::orthogonal_(linear->weight, gain);
+      torch::nn::init::zeros_(linear->bias);
+    } else if (auto* conv = child->as<torch::nn::Conv2d>()) {
+      torch::nn::init::orthogonal_(conv->weight, gain);
+      torch::nn::init::zeros_(conv->bias);
+    }
+  }
+}
+
+torch::nn::Sequential make_head(std::int64_t in, std::int64_t features) {
+  torch::nn::Sequential head(torch::nn::Linear(in, features),
+                             torch::nn::LayerNorm(torch::nn::LayerNormOptions({features})),
+                             torch::nn::Tanh());
+  orthogonal_init(*head, 1.0);
+  return head;
+}
+
+torch::nn::Sequential make_mlp(std::int64_t in, std::int64_t hidden, std::int64_t depth,
+                               std::int64_t out) {
+  torch::nn::Sequential mlp;
+  std::int64_t width = in;
+  for (std::int64_t layer = 0; layer < depth; ++layer) {
+    mlp->push_back(torch::nn::Linear(width, hidden));
+    mlp->push_back(torch::nn::ReLU());
+    width = hidden;
+  }
+  mlp->push_back(torch::nn::Linear(width, out));
+  orthogonal_init(*mlp, std::sqrt(2.0));
+  return mlp;
+}
+
+void copy_parameters(const torch::nn::Module& from, torch::nn::Module& to) {
+  torch::NoGradGuard no_grad;
+  const auto source = from.parameters();
+  auto destination = to.parameters();
+  for (std::size_t i = 0; i < source.size(); ++i) destination[i].copy_(source[i]);
+}
+
+void soft_update(const torch::nn::Module& from, torch::nn::Module& to, double tau) {
+  torch::NoGradGuard no_grad;
+  const auto source = from.parameters();
+  auto destination = to.parameters();
+  for (std::size_t i = 0; i < source.size(); ++i) destination[i].lerp_(source[i], tau);
+}
+
+template <typename T>
+torch::Tensor view_of(const std::vector<T>& values, std::vector<std::int64_t> shape,
+                      torch::ScalarType type) {
+  return torch::from_blob(const_cast<T*>(values.data()), shape, torch::TensorOptions(type));
+}
+
+torch::Tensor vectors_of(const std::vector<std::vector<float>>& vectors, const InputLayout& input,
+                         std::int64_t batch) {
+  if (vectors.empty()) return {};
+  std::vector<torch::Tensor> parts;
+  for (std::size_t v = 0; v < vectors.size(); ++v) {
+    parts.push_back(view_of(vectors[v], {batch, input.vector_sizes[v]}, torch::kFloat32));
+  }
+  return parts.size() == 1 ? parts[0] : torch::cat(parts, 1);
+}
+
+torch::Tensor beside(const torch::Tensor& head, const torch::Tensor& vectors) {
+  if (!head.defined()) return vectors;
+  if (!vectors.defined()) return head;
+  return torch::cat({head, vectors}, 1);
+}
+
+}  // namespace
+
+void DrqConfig::validate() const {
+  const auto fail = [](const std::string& what) {
+    throw std::invalid_argument(std::string(kConfigName) + ": " + what);
+  };
+  constexpr std::int64_t kMost = std::int64_t{1} << 40;
+  const auto at_least = [&](const char* name, std::int64_t value, std::int64_t minimum) {
+    if (value < minimum || value > kMost) {
+      fail(std::string(name) + " must be from " + std::to_string(minimum) + " to " +
+           std::to_string(kMost) + ", got " + std::to_string(value));
+    }
+  };
+  const auto in_range = [&](const char* name, double value, double low, double high) {
+    if (!(value >= low && value <= high)) {
+      std::ostringstream message;
+      message << name << " must be in [" << low << ", " << high << "], got " << value;
+      fail(message.str());
+    }
+  };
+  at_least("num_envs", num_envs, 1);
+  at_least("total_env_steps", total_env_steps, 1);
+  at_least("iteration_env_steps", iteration_env_steps, 1);
+  if (iteration_env_steps % num_envs != 0) {
+    fail("iteration_env_steps must be a multiple of num_envs (" + std::to_string(num_envs) +
+         "), got " + std::to_string(iteration_env_steps));
+  }
+  at_least("frame_stack", frame_stack, 1);
+  at_least("batch_size", batch_size, 1);
+  at_least("n_step", n_step, 1);
+  at_least("replay_capacity", replay_capacity, num_envs * (n_step + frame_stack + 2));
+  in_range("gamma", gamma, 0.0, 1.0);
+  if (!(learning_rate > 0.0 && std::isfinite(learning_rate))) {
+    fail("learning_rate must be positive, got " + std::to_string(learning_rate));
+  }
+  in_range("init_temperature", init_temperature, 1e-8, 1e8);
+  if (!std::isnan(target_entropy)) in_range("target_entropy", target_entropy, -1e6, 1e6);
+  at_least("actor_update_every", actor_update_every, 1);
+  at_least("target_update_every", target_update_every, 1);
+  in_range("critic_tau", critic_tau, 0.0, 1.0);
+  at_least("feature_dim", feature_dim, 1);
+  at_least("hidden_dim", hidden_dim, 1);
+  at_least("hidden_depth", hidden_depth, 1);
+  in_range("log_std_min", log_std_min, -20.0, 5.0);
+  in_range("log_std_max", log_std_max, log_std_min, 5.0);
+  at_least("seed_env_steps", seed_env_steps, 0);
+  in_range("updates_per_env_step", updates_per_env_step, 0.0, 64.0);
+  in_range("shift_pad", static_cast<double>(shift_pad), 0.0, 65536.0);
+  at_least("augmented_copies", augmented_copies, 1);
+  if (augmented_copies > 8) {
+    fail("augmented_copies must be from 1 to 8, got " + std::to_string(augmented_copies));
+  }
+}
+
+double DrqConfig::entropy_target(std::int64_t action_size) const {
+  return std::isnan(target_entropy) ? -static_cast<double>(action_size) : target_entropy;
+}
+
+void to_json(nlohmann::json& json, const DrqConfig& config) {
+  json = {{"seed", config.seed},
+          {"num_envs", config.num_envs},
+          {"total_env_steps", config.total_env_steps},
+          {"iteration_env_steps", config.iteration_env_steps},
+          {"frame_stack", config.frame_stack},
+          {"replay_capacity", config.replay_capacity},
+          {"batch_size", config.batch_size},
+          {"n_step", config.n_step},
+          {"gamma", config.gamma},
+          {"learning_rate", config.learning_rate},
+          {"init_temperature", config.init_temperature},
+          {"target_entropy", std::isnan(config.target_entropy)
+                                 ? nlohmann::json(nullptr)
+                                 : nlohmann::json(config.target_entropy)},
+          {"actor_update_every", config.actor_update_every},
+          {"target_update_every", config.target_update_every},
+          {"critic_tau", config.critic_tau},
+          {"encoder", drqv2::to_string(config.encoder)},
+          {"feature_dim", config.feature_dim},
+          {"hidden_dim", config.hidden_dim},
+          {"hidden_depth", config.hidden_depth},
+          {"log_std_min", config.log_std_min},
+          {"log_std_max", config.log_std_max},
+          {"seed_env_steps", config.seed_env_steps},
+          {"updates_per_env_step", config.updates_per_env_step},
+          {"shift_pad", config.shift_pad},
+          {"augmented_copies", config.augmented_copies},
+          {"bfloat16", config.bfloat16},
+          {"channels_last", config.channels_last}};
+}
+
+void from_json(const nlohmann::json& json, DrqConfig& config) {
+  nlohmann::json defaults;
+  to_json(defaults, DrqConfig{});
+  std::vector<std::string> known;
+  for (const auto& item : defaults.items()) known.push_back(item.key());
+  trainer::require_known_members(json, known, kConfigName);
+  read_member(json, "seed", config.seed);
+  read_member(json, "num_envs", config.num_envs);
+  read_member(json, "total_env_steps", config.total_env_steps);
+  read_member(json, "iteration_env_steps", config.iteration_env_steps);
+  read_member(json, "frame_stack", config.frame_stack);
+  read_member(json, "replay_capacity", config.replay_capacity);
+  read_member(json, "batch_size", config.batch_size);
+  read_member(json, "n_step", config.n_step);
+  read_member(json, "gamma", config.gamma);
+  read_member(json, "learning_rate", config.learning_rate);
+  read_member(json, "init_temperature", config.init_temperature);
+  if (json.contains("target_entropy") && json.at("target_entropy").is_null()) {
+    config.target_entropy = std::numeric_limits<double>::quiet_NaN();
+  } else {
+    read_member(json, "target_entropy", config.target_entropy);
+  }
+  read_member(json, "actor_update_every", config.actor_update_every);
+  read_member(json, "target_update_every", config.target_update_every);
+  read_member(json, "critic_tau", config.critic_tau);
+  std::string encoder = drqv2::to_string(config.encoder);
+  read_member(json, "encoder", encoder);
+  try {
+    config.encoder = drqv2::parse_encoder_architecture(encoder);
+  } catch (const std::invalid_argument& error) {
+    throw std::invalid_argument(std::string(kConfigName) + ": member \"encoder\": " + error.what());
+  }
+  read_member(json, "feature_dim", config.feature_dim);
+  read_member(json, "hidden_dim", config.hidden_dim);
+  read_member(json, "hidden_depth", config.hidden_depth);
+  read_member(json, "log_std_min", config.log_std_min);
+  read_member(json, "log_std_max", config.log_std_max);
+  read_member(json, "seed_env_steps", config.seed_env_steps);
+  read_member(json, "updates_per_env_step", config.updates_per_env_step);
+  read_member(json, "shift_pad", config.shift_pad);
+  read_member(json, "augmented_copies", config.augmented_copies);
+  read_member(json, "bfloat16", config.bfloat16);
+  read_member(json, "channels_last", config.channels_last);
+  config.validate();
+}
+
+// ---- Agent -----------------------------------------------------------------------------------
+
+Agent::Agent(InputLayout input, const DrqConfig& config)
+    : input_(std::move(input)),
+      log_std_min_(config.log_std_min),
+      log_std_max_(config.log_std_max),
+      autocast_(config.bfloat16 && drqv2::cpu_has_bfloat16()),
+      channels_last_(config.channels_last) {
+  std::int64_t features = 0;
+  if (input_.has_image) {
+    encoder = torch::nn::Sequential();
+    std::int64_t channels = input_.stack * input_.channels;
+    std::int64_t height = input_.height;
+    std::int64_t width = input_.width;
+    for (const std::int64_t stride : drqv2::encoder_strides(config.encoder)) {
+      encoder->push_back(
+          torch::nn::Conv2d(torch::nn::Conv2dOptions(channels, 32, 3).stride(stride)));
+      encoder->push_back(torch::nn::ReLU());
+      channels = 32;
+      height = (height - 3) / stride + 1;
+      width = (width - 3) / stride + 1;
+      if (height < 1 || width < 1) {
+        throw std::invalid_argument("drq: images of " + std::to_string(input_.height) + "x" +
+                                    std::to_string(input_.width) + " are too small for the " +
+                                    drqv2::to_string(config.encoder) + " encoder");
+      }
+    }
+    encoder->push_back(torch::nn::Flatten());
+    orthogonal_init(*encoder, std::sqrt(2.0));
+    register_module("encoder", encoder);
+    const std::int64_t conv_features = channels * height * width;
+    actor_head = register_module("actor_head", make_head(conv_features, config.feature_dim));
+    critic_head = register_module("critic_head", make_head(conv_features, config.feature_dim));
+    target_head = register_module("target_head", make_head(conv_features, config.feature_dim));
+    copy_parameters(*critic_head, *target_head);
+    features += config.feature_dim;
+  }
+  for (const std::int64_t size : input_.vector_sizes) features += size;
+  if (features == 0) throw std::invalid_argument("drq: the observation has no input");
+  const std::int64_t actions = input_.action_size;
+  const std::int64_t hidden = config.hidden_dim;
+  const std::int64_t depth = config.hidden_depth;
+  actor = register_module("actor", make_mlp(features, hidden, depth, 2 * actions));
+  q1 = register_module("q1", make_mlp(features + actions, hidden, depth, 1));
+  q2 = register_module("q2", make_mlp(features + actions, hidden, depth, 1));
+  target_q1 = register_module("target_q1", make_mlp(features + actions, hidden, depth, 1));
+  target_q2 = register_module("target_q2", make_mlp(features + actions, hidden, depth, 1));
+  copy_parameters(*q1, *target_q1);
+  copy_parameters(*q2, *target_q2);
+  for (auto* target : {&target_head, &target_q1, &target_q2}) {
+    if (!*target) continue;
+    for (auto& parameter : (*target)->parameters()) parameter.set_requires_grad(false);
+  }
+  log_alpha = register_parameter(
+      "log_alpha", torch::full({1}, std::log(config.init_temperature), torch::kFloat32));
+  low_ = register_buffer("action_low", torch::tensor(input_.action_low, torch::kFloat32));
+  high_ = register_buffer("action_high", torch::tensor(input_.action_high, torch::kFloat32));
+}
+
+torch::Tensor Agent::image_input(const torch::Tensor& images) const {
+  const std::int64_t batch = images.size(0);
+  const std::int64_t channels = input_.stack * input_.channels;
+  const torch::Tensor frames =
+      images.view({batch, input_.stack, input_.height, input_.width, input_.channels});
+  if (channels_last_) {
+    return frames.permute({0, 2, 3, 1, 4})
+        .reshape({batch, input_.height, input_.width, channels})
+        .to(torch::kFloat32)
+        .permute({0, 3, 1, 2});
+  }
+  return frames.permute({0, 1, 4, 2, 3})
+      .reshape({batch, channels, input_.height, input_.width})
+      .to(torch::kFloat32);
+}
+
+torch::Tensor Agent::convolve(const torch::Tensor& images) {
+  if (!input_.has_image) return {};
+  torch::Tensor x = images / 255.0 - 0.5;
+  if (channels_last_) x = x.contiguous(at::MemoryFormat::ChannelsLast);
+  torch::Tensor h;
+  {
+    const CpuAutocast autocast(autocast_);
+    h = encoder->forward(x);
+  }
+  return h.to(torch::kFloat32);
+}
+
+torch::Tensor Agent::actor_features(const torch::Tensor& conv, const torch::Tensor& vectors) {
+  return beside(conv.defined() ? actor_head->forward(conv) : torch::Tensor(), vectors);
+}
+
+torch::Tensor Agent::critic_features(const torch::Tensor& conv, const torch::Tensor& vectors,
+                                     bool target) {
+  if (!conv.defined()) return vectors;
+  return beside((target ? target_head : critic_head)->forward(conv), vectors);
+}
+
+torch::Tensor Agent::mean_action(const torch::Tensor& features) {
+  return torch::tanh(actor->forward(features).chunk(2, 1)[0]);
+}
+
+PolicySample Agent::sample(const torch::Tensor& features, at::Generator& generator) {
+  const auto parts = actor->forward(features).chunk(2, 1);
+  const torch::Tensor& mean = parts[0];
+  const torch::Tensor log_std =
+      log_std_min_ + 0.5 * (log_std_max_ - log_std_min_) * (torch::tanh(parts[1]) + 1.0);
+  const torch::Tensor eps = torch::randn(mean.sizes(), generator, mean.options());
+  const torch::Tensor x = mean + eps * log_std.exp();
+  // log N(x; mean, std) - log(1 - tanh(x)^2), the latter as 2 (log 2 - x - softplus(-2x)).
+  const double half_log_2pi = 0.5 * std::log(2.0 * M_PI);
+  const torch::Tensor gaussian = -0.5 * eps.square() - log_std - half_log_2pi;
+  const torch::Tensor squash = 2.0 * (std::log(2.0) - x - torch::softplus(-2.0 * x));
+  return {torch::tanh(x), (gaussian - squash).sum(1)};
+}
+
+std::pair<torch::Tensor, torch::Tensor> Agent::q_values(const torch::Tensor& features,
+                                                        const torch::Tensor& actions, bool target) {
+  const torch::Tensor input = torch::cat({features, actions}, 1);
+  return {(target ? target_q1 : q1)->forward(input).squeeze(1),
+          (target ? target_q2 : q2)->forward(input).squeeze(1)};
+}
+
+torch::Tensor Agent::act(const std::map<std::string, torch::Tensor>& obs, bool deterministic,
+                         at::Generator* generator) {
+  torch::NoGradGuard no_grad;
+  torch::Tensor images;
+  std::int64_t batch = 0;
+  if (input_.has_image) {
+    const torch::Tensor& stacked = obs.at(input_.image_key);
+    batch = stacked.size(0);
+    images = image_input(stacked.reshape({batch, -1}).contiguous());
+  }
+  torch::Tensor vectors;
+  if (!input_.vector_keys.empty()) {
+    std::vector<torch::Tensor> parts;
+    for (const std::string& key : input_.vector_keys) {
+      const torch::Tensor& value = obs.at(key);
+      batch = value.size(0);
+      parts.push_back(value.reshape({batch, -1}).to(torch::kFloat32));
+    }
+    vectors = parts.size() == 1 ? parts[0] : torch::cat(parts, 1);
+  }
+  const torch::Tensor features = actor_features(convolve(images), vectors);
+  if (deterministic || generator == nullptr) return mean_action(features);
+  return sample(features, *generator).action;
+}
+
+torch::Tensor Agent::env_action(const torch::Tensor& actions) const {
+  return low_ + (actions + 1.0) * 0.5 * (high_ - low_);
+}
+
+torch::Tensor Agent::unit_action(const torch::Tensor& env_actions) const {
+  return ((env_actions.to(torch::kFloat32) - low_) / (high_ - low_) * 2.0 - 1.0).clamp(-1.0, 1.0);
+}
+
+// ---- Learner ---------------------------------------------------------------------------------
+
+namespace {
+
+std::shared_ptr<Agent> make_agent(InputLayout input, const DrqConfig& config) {
+  config.validate();
+  torch::manual_seed(config.seed);
+  return std::make_shared<Agent>(std::move(input), config);
+}
+
+std::vector<torch::Tensor> parameters_of(std::initializer_list<torch::nn::Module*> modules) {
+  std::vector<torch::Tensor> parameters;
+  for (torch::nn::Module* module : modules) {
+    if (module == nullptr) continue;
+    for (auto& parameter : module->parameters()) parameters.push_back(parameter);
+  }
+  return parameters;
+}
+
+}  // namespace
+
+Learner::Learner(InputLayout input, DrqConfig config)
+    : config_(std::move(config)), agent_(make_agent(std::move(input), config_)) {
+  Agent& agent = *agent_;
+  target_entropy_ = config_.entropy_target(agent.input().action_size);
+  const auto adam = [&](std::vector<torch::Tensor> parameters) {
+    return std::make_unique<torch::optim::Adam>(std::move(parameters),
+                                                torch::optim::AdamOptions(config_.learning_rate));
+  };
+  critic_optimizer_ = adam(parameters_of({agent.encoder ? agent.encoder.ptr().get() : nullptr,
+                                          agent.critic_head ? agent.critic_head.ptr().get() : nullptr,
+                                          agent.q1.ptr().get(), agent.q2.ptr().get()}));
+  actor_optimizer_ = adam(parameters_of(
+      {agent.actor_head ? agent.actor_head.ptr().get() : nullptr, agent.actor.ptr().get()}));
+  alpha_optimizer_ = adam({agent.log_alpha});
+}
+
+UpdateStats Learner::update(const ReplayBatch& batch, at::Generator& augmentation,
+                            at::Generator& sampling) {
+  Agent& agent = *agent_;
+  const InputLayout& input = agent.input();
+  const std::int64_t size = batch.size;
+  const std::int64_t copies = input.has_image ? config_.augmented_copies : 1;
+  const auto shifted = [&](const std::vector<std::uint8_t>& stacks) {
+    const std::int64_t bytes = input.stack * input.height * input.width * input.channels;
+    if (config_.shift_pad == 0) {
+      return agent.image_input(view_of(stacks, {size, bytes}, torch::kUInt8));
+    }
+    const std::int64_t pad = config_.shift_pad;
+    const torch::Tensor shifts =
+        torch::randint(0, 2 * pad + 1, {size, 2}, augmentation, torch::kInt64);
+    shifted_.resize(stacks.size());
+    drqv2::shift_frames(stacks.data(), shifted_.data(), size, input.stack, input.height,
+                        input.width, input.channels, pad, shifts.data_ptr<std::int64_t>());
+    // image_input copies (to float), so shifted_ may be reused by the next call.
+    return agent.image_input(view_of(shifted_, {size, bytes}, torch::kUInt8));
+  };
+  const torch::Tensor vectors = vectors_of(batch.vectors, input, size);
+  const torch::Tensor next_vectors = vectors_of(batch.next_vectors, input, size);
+  const torch::Tensor actions = view_of(batch.actions, {size, input.action_size}, torch::kFloat32);
+  const torch::Tensor rewards = view_of(batch.rewards, {size}, torch::kFloat32);
+  const torch::Tensor discounts = view_of(batch.discounts, {size}, torch::kFloat32);
+  const torch::Tensor alpha = agent.log_alpha.exp().detach();
+
+  // The target: the mean over the shifted copies of the next observation of the target critic's
+  // soft value at the policy's sample.
+  torch::Tensor target;
+  {
+    torch::NoGradGuard no_grad;
+    torch::Tensor sum;
+    for (std::int64_t k = 0; k < copies; ++k) {
+      const torch::Tensor conv =
+          input.has_image ? agent.convolve(shifted(batch.next_images[0])) : torch::Tensor();
+      const PolicySample next = agent.sample(agent.actor_features(conv, next_vectors), sampling);
+      const auto [target_q1, target_q2] =
+          agent.q_values(agent.critic_features(conv, next_vectors, true), next.action, true);
+      const torch::Tensor value = torch::min(target_q1, target_q2) - alpha * next.log_prob;
+      sum = k == 0 ? value : sum + value;
+    }
+    target = rewards + discounts * sum / static_cast<double>(copies);
+  }
+  // The critic, on each shifted copy of the observation.
+  torch::Tensor critic_loss;
+  torch::Tensor first_conv;
+  double q_sum = 0.0;
+  for (std::int64_t k = 0; k < copies; ++k) {
+    const torch::Tensor conv =
+        input.has_image ? agent.convolve(shifted(batch.images[0])) : torch::Tensor();
+    if (k == 0) first_conv = conv;
+    const auto [q1, q2] = agent.q_values(agent.critic_features(conv, vectors, false), actions, false);
+    const torch::Tensor loss = torch::mse_loss(q1, target) + torch::mse_loss(q2, target);
+    critic_loss = k == 0 ? loss : critic_loss + loss;
+    q_sum += q1.mean().item<double>();
+  }
+  UpdateStats stats;
+  stats.critic_loss = critic_loss.item<double>();
+  stats.q_mean = q_sum / static_cast<double>(copies);
+  stats.target_mean = target.mean().item<double>();
+  stats.alpha = alpha.item<double>();
+  stats.actor_loss = std::numeric_limits<double>::quiet_NaN();
+  stats.entropy = std::numeric_limits<double>::quiet_NaN();
+  if (!std::isfinite(stats.critic_loss)) {
+    throw std::runtime_error("drq: the critic loss is not finite (" +
+                             std::to_string(stats.critic_loss) + ", Q mean " +
+                             std::to_string(stats.q_mean) + "): no step taken");
+  }
+  critic_optimizer_->zero_grad();
+  critic_loss.backward();
+  critic_optimizer_->step();
+
+  // The actor and the temperature, on the first copy's encoder output (which the actor does not
+  // train; it is the one from before the critic's step, as DrQ-v2 reuses it).
+  if (updates_ % config_.actor_update_every == 0) {
+    const torch::Tensor conv = first_conv.defined() ? first_conv.detach() : torch::Tensor();
+    const PolicySample policy = agent.sample(agent.actor_features(conv, vectors), sampling);
+    torch::Tensor critic_input;
+    {
+      // The critic's head is not trained by the actor: its output is a constant here.
+      torch::NoGradGuard no_grad;
+      critic_input = agent.critic_features(conv, vectors, false);
+    }
+    const auto [actor_q1, actor_q2] = agent.q_values(critic_input, policy.action, false);
+    const torch::Tensor actor_loss =
+        (alpha * policy.log_prob - torch::min(actor_q1, actor_q2)).mean();
+    stats.actor_loss = actor_loss.item<double>();
+    if (!std::isfinite(stats.actor_loss)) {
+      throw std::runtime_error("drq: the actor loss is not finite (" +
+                               std::to_string(stats.actor_loss) + "): no step taken");
+    }
+    actor_optimizer_->zero_grad();
+    actor_loss.backward();
+    actor_optimizer_->step();
+    const torch::Tensor log_prob = policy.log_prob.detach();
+    stats.entropy = -log_prob.mean().item<double>();
+    const torch::Tensor alpha_loss =
+        (agent.log_alpha.exp() * (-log_prob - target_entropy_)).mean();
+    alpha_optimizer_->zero_grad();
+    alpha_loss.backward();
+    alpha_optimizer_->step();
+  }
+  if (updates_ % config_.target_update_every == 0) {
+    if (agent.critic_head) soft_update(*agent.critic_head, *agent.target_head, config_.critic_tau);
+    soft_update(*agent.q1, *agent.target_q1, config_.critic_tau);
+    soft_update(*agent.q2, *agent.target_q2, config_.critic_tau);
+  }
+  ++updates_;
+  return stats;
+}
+
+}  // namespace pixelgym::drq

@@ -1,0 +1,187 @@
+// DrQ (Kostrikov, Yarats and Fergus 2020): soft actor-critic from pixels, regularized by random
+// shifts of the images. A squashed Gaussian actor, clipped double Q with a target critic, a
+// learned entropy temperature, and K random shifts of current and next observations averaged.
+// The config, the networks and one update.
+#pragma once
+
+#include <torch/torch.h>
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <nlohmann/json_fwd.hpp>
+#include <string>
+#include <vector>
+
+#include "examples/trainer/drqv2/drqv2.h"
+#include "examples/trainer/drqv2/replay_buffer.h"
+
+namespace pixelgym::drq {
+
+using drqv2::EncoderArchitecture;
+using drqv2::InputLayout;
+using drqv2::ReplayBatch;
+
+/// Every setting of the learner; validate() checks each. Counts of steps are env steps (all envs
+/// together): with action_repeat K each is K control steps. The defaults are DrQ's published
+/// ones (its config.yaml: learning rate 1e-3, batch 128 (512 in the paper), initial
+/// temperature 0.1, target entropy -|A|, actor and target updates every second update, tau 0.01,
+/// features 50, log std in [-10, 2], 1000 seed steps, one update per env step, pad 4, 3 frames)
+/// except where a CPU needs less: hidden 256 (DrQ: 1024), MR.Q's encoder (DrQ: strides
+/// 2, 1, 1, 1) and one shifted copy (DrQ: K = M = 2); docs/experiments/drq.md measures each.
+struct DrqConfig {
+  /// Seeds torch (weights), the replay sampling, the exploration, the augmentation and the envs
+  /// (env i resets with seed + i).
+  std::uint64_t seed = 0;
+  std::int64_t num_envs = 1;
+  std::int64_t total_env_steps = 100'000;
+  /// Env steps per iteration (a progress.csv row). A multiple of num_envs.
+  std::int64_t iteration_env_steps = 500;
+  /// Frames in each observation's stack (--wrap frame_stack=K; 1: single frames).
+  std::int64_t frame_stack = 3;
+  std::int64_t replay_capacity = 100'000;
+  std::int64_t batch_size = 128;
+  /// Steps of the return before bootstrapping (DrQ: 1).
+  std::int64_t n_step = 1;
+  double gamma = 0.99;
+  /// Adam's learning rate of the critic (with the encoder), the actor and the temperature.
+  double learning_rate = 1e-3;
+  /// The entropy temperature alpha starts here and is learned towards target_entropy (NaN: -|A|,
+  /// SAC's choice).
+  double init_temperature = 0.1;
+  double target_entropy = std::numeric_limits<double>::quiet_NaN();
+  /// The actor and the temperature are updated every actor_update_every updates; the target
+  /// critic moves critic_tau towards the critic every target_update_every updates.
+  std::int64_t actor_update_every = 2;
+  std::int64_t target_update_every = 2;
+  double critic_tau = 0.01;
+  /// The encoder (images only), the width of each network's head (Linear, LayerNorm, tanh over
+  /// the encoder's features) and of the MLPs' hidden_depth hidden layers.
+  EncoderArchitecture encoder = EncoderArchitecture::kMrq;
+  std::int64_t feature_dim = 50;
+  std::int64_t hidden_dim = 256;
+  std::int64_t hidden_depth = 2;
+  /// The actor's log standard deviation is squashed into [log_std_min, log_std_max].
+  double log_std_min = -10.0;
+  double log_std_max = 2.0;
+  /// Env steps of uniformly random actions before the policy acts (and learning starts).
+  std::int64_t seed_env_steps = 1000;
+  /// Updates per env step (all envs together); fractions carry over.
+  double updates_per_env_step = 1.0;
+  /// Random shifts by up to shift_pad pixels (0: none), and how many shifted copies of each
+  /// observation and next observation an update averages its target and loss over (DrQ's K and
+  /// M, equal here).
+  std::int64_t shift_pad = 4;
+  std::int64_t augmented_copies = 1;
+  /// bfloat16 autocast of the encoder where the CPU has it; channels-last images.
+  bool bfloat16 = true;
+  bool channels_last = true;
+
+  /// Throws std::invalid_argument naming the first member out of range and its value.
+  void validate() const;
+  /// target_entropy, or -action_size when it is NaN.
+  double entropy_target(std::int64_t action_size) const;
+};
+
+/// JSON form: one member per field (target_entropy null for NaN). from_json takes any subset and
+/// throws std::invalid_argument for an unknown member, a wrong type or a config failing
+/// validate().
+void to_json(nlohmann::json& json, const DrqConfig& config);
+void from_json(const nlohmann::json& json, DrqConfig& config);
+
+/// A squashed Gaussian's sample: the action in [-1, 1] and its log-probability (summed over the
+/// action's elements, with tanh's change of variables).
+struct PolicySample {
+  torch::Tensor action;
+  torch::Tensor log_prob;
+};
+
+/// The encoder (shared by actor and critic, trained by the critic), the actor, the critic and the
+/// target critic. From images each network reads the encoder's features through a head of its
+/// own (Linear, LayerNorm, tanh to feature_dim), the vector keys beside them; from vectors
+/// alone it reads them directly, as SAC from state does. Built from torch's default generator
+/// (call torch::manual_seed first); orthogonal weights and zero biases.
+class Agent : public torch::nn::Module {
+ public:
+  Agent(InputLayout input, const DrqConfig& config);
+
+  /// Images uint8 (B, stack * H * W * C) to float (B, stack C, H, W).
+  torch::Tensor image_input(const torch::Tensor& images) const;
+  /// The encoder over float images in [0, 255] (undefined when there is no image).
+  torch::Tensor convolve(const torch::Tensor& images);
+  /// The actor's, the critic's or the target critic's input: its head over the encoder's output
+  /// beside the vectors (either may be undefined).
+  torch::Tensor actor_features(const torch::Tensor& conv, const torch::Tensor& vectors);
+  torch::Tensor critic_features(const torch::Tensor& conv, const torch::Tensor& vectors,
+                                bool target);
+  /// The policy's mean action (tanh of the Gaussian's mean), and a reparameterized sample.
+  torch::Tensor mean_action(const torch::Tensor& features);
+  PolicySample sample(const torch::Tensor& features, at::Generator& generator);
+  /// Q1 and Q2 (B) of the critic or the target critic.
+  std::pair<torch::Tensor, torch::Tensor> q_values(const torch::Tensor& features,
+                                                   const torch::Tensor& actions, bool target);
+  /// Actions in [-1, 1] for a batch of a vector env's observations: the mean when
+  /// `deterministic` or `generator` is null, else a sample. Computes no gradients.
+  torch::Tensor act(const std::map<std::string, torch::Tensor>& obs, bool deterministic,
+                    at::Generator* generator);
+  /// Actions in [-1, 1] to the env's bounds (float32), and back.
+  torch::Tensor env_action(const torch::Tensor& actions) const;
+  torch::Tensor unit_action(const torch::Tensor& env_actions) const;
+
+  const InputLayout& input() const { return input_; }
+  bool autocast() const { return autocast_; }
+
+  torch::nn::Sequential encoder{nullptr};
+  torch::nn::Sequential actor_head{nullptr}, critic_head{nullptr}, target_head{nullptr};
+  torch::nn::Sequential actor{nullptr}, q1{nullptr}, q2{nullptr}, target_q1{nullptr},
+      target_q2{nullptr};
+  torch::Tensor log_alpha;
+
+ private:
+  InputLayout input_;
+  double log_std_min_, log_std_max_;
+  bool autocast_ = false;
+  bool channels_last_ = false;
+  torch::Tensor low_, high_;
+};
+
+/// What one update did (NaN where a part was not updated).
+struct UpdateStats {
+  double critic_loss = 0.0;
+  double actor_loss = 0.0;
+  double alpha = 0.0;
+  double entropy = 0.0;  // minus the mean log-probability of the actor's samples
+  double q_mean = 0.0;
+  double target_mean = 0.0;
+};
+
+/// The learner: an Agent, its Adams (critic with encoder, actor, temperature) and the update.
+class Learner {
+ public:
+  /// Seeds torch with config.seed before building the agent.
+  Learner(InputLayout input, DrqConfig config);
+
+  /// One update from `batch`: generators for the shifts and the policy's samples. Throws
+  /// std::runtime_error naming the loss when one is not finite; no step is taken then.
+  UpdateStats update(const ReplayBatch& batch, at::Generator& augmentation,
+                     at::Generator& sampling);
+
+  Agent& agent() { return *agent_; }
+  const std::shared_ptr<Agent>& agent_ptr() const { return agent_; }
+  torch::optim::Adam& critic_optimizer() { return *critic_optimizer_; }
+  torch::optim::Adam& actor_optimizer() { return *actor_optimizer_; }
+  torch::optim::Adam& alpha_optimizer() { return *alpha_optimizer_; }
+  std::int64_t updates() const { return updates_; }
+  void set_updates(std::int64_t updates) { updates_ = updates; }
+  const DrqConfig& config() const { return config_; }
+
+ private:
+  DrqConfig config_;
+  std::shared_ptr<Agent> agent_;
+  std::unique_ptr<torch::optim::Adam> critic_optimizer_, actor_optimizer_, alpha_optimizer_;
+  std::vector<std::uint8_t> shifted_;
+  std::int64_t updates_ = 0;
+  double target_entropy_ = 0.0;
+};
+
+}  // namespace pixelgym::drq
