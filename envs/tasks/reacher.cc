@@ -93,7 +93,8 @@ std::vector<EnvSpec> ReacherTask::specs() {
           std::string(name) + "-v" + std::to_string(version),
           std::string("two-link arm reaches a random ") + (radius > 0.02 ? "large" : "small") +
               " target; torques in [-1, 1]" +
-              (version == 1 ? "; dm_control's damping, masses and reward radius" : ""),
+              (version == 1 ? "; dm_control's damping, masses and reward radius; a white fingertip"
+                            : ""),
           [target_radius, version](const Params&) {
             return std::make_unique<ReacherTask>(target_radius, version);
           }));

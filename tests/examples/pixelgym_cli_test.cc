@@ -668,10 +668,11 @@ TEST(PixelgymCliTest, BadWrapSpecIsAUsageErrorNamingWrapperArgumentAndExpectatio
 
 // --- inspect ---
 
-const std::vector<std::string> kAssetUrdfs = {
-    "acrobot/acrobot.urdf",      "arm/arm.urdf",           "cartpole/cartpole.urdf",
-    "cartpole/cartpole_v1.urdf", "objects/cube.urdf",      "objects/table.urdf",
-    "objects/target.urdf",       "pendulum/pendulum.urdf", "reacher/reacher.urdf"};
+const std::vector<std::string> kAssetUrdfs = {"acrobot/acrobot.urdf",   "arm/arm.urdf",
+                                              "cartpole/cartpole.urdf", "cartpole/cartpole_v1.urdf",
+                                              "objects/cube.urdf",      "objects/table.urdf",
+                                              "objects/target.urdf",    "pendulum/pendulum.urdf",
+                                              "reacher/reacher.urdf",   "reacher/reacher_v1.urdf"};
 
 TEST(PixelgymCliTest, InspectWorksOnEveryAsset) {
   std::set<std::string> found;
