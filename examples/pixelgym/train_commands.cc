@@ -179,7 +179,8 @@ void add_run_setting_options(CLI::App& train, TrainArguments& args) {
 void declare_train(CLI::App& train, TrainArguments& args) {
   args.command = &train;
   train.description(
-      "Train a policy (PPO; DrQ with --algo drq, DrQ-v2 with --algo drqv2) from the env's observations (pixels "
+      "Train a policy (PPO; DrQ with --algo drq, DrQ-v2 with --algo drqv2) from the env's "
+      "observations (pixels "
       "included) and write a run folder: "
       "config.json, progress.csv, eval.csv, curve.png, checkpoints, and at the end final.mp4 and "
       "summary.json (an evaluation over seeded episodes)");

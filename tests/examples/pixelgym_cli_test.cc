@@ -323,14 +323,15 @@ TEST(PixelgymCliTest, MistypedNamesAreAnsweredWithDidYouMean) {
       {"video CartPoleSwingup-v0", "unknown subcommand \"video\"; did you mean record?"},
       {"help describe", "help: unknown subcommand \"describe\"; did you mean info?"},
       {"train CartPoleSwingup-v0 --algo drqv3",
-       "--algo: unknown algorithm \"drqv3\"; did you mean drqv2? (the algorithms: ppo, drqv2)"},
+       "--algo: unknown algorithm \"drqv3\"; did you mean drqv2 or drq? (the algorithms: ppo, "
+       "drqv2, drq)"},
       {"info CartPoleSwingup-v0 --wrap resize=64,48",
        "resize's size: expected HEIGHTxWIDTH (e.g. 64x64) or N for NxN, as resize=64x48"},
   };
   expect_two_line_usage_errors(cases);
   EXPECT_THAT(run("frobnicate").output, Not(HasSubstr("did you mean")));
   EXPECT_THAT(run("train CartPoleSwingup-v0 --algo sac").output,
-              HasSubstr("unknown algorithm \"sac\" (the algorithms: ppo, drqv2)"));
+              HasSubstr("unknown algorithm \"sac\" (the algorithms: ppo, drqv2, drq)"));
 }
 
 // CLI11's range and unknown-option messages said as the others are: the option, what it expects

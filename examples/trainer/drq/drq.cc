@@ -9,7 +9,9 @@
 #include <stdexcept>
 #include <utility>
 
-#include "examples/trainer/run/config_members.h"
+#include "examples/trainer/torch_common/off_policy_networks.h"
+#include "examples/trainer/torch_common/random_shift.h"
+#include "pixelgym/trainer/config_members.h"
 
 namespace pixelgym::drq {
 namespace {
@@ -21,40 +23,10 @@ void read_member(const nlohmann::json& json, const char* name, T& field) {
   trainer::read_member(json, name, field, kConfigName);
 }
 
-// Bfloat16 autocast of the CPU's convolutions for the scope of the guard (when `on`).
-class CpuAutocast {
- public:
-  explicit CpuAutocast(bool on) : on_(on) {
-    if (!on_) return;
-    previous_ = at::autocast::is_cpu_enabled();
-    at::autocast::set_cpu_enabled(true);
-    at::autocast::set_autocast_cpu_dtype(at::kBFloat16);
-    at::autocast::increment_nesting();
-  }
-  ~CpuAutocast() {
-    if (!on_) return;
-    if (at::autocast::decrement_nesting() == 0) at::autocast::clear_cache();
-    at::autocast::set_cpu_enabled(previous_);
-  }
-  CpuAutocast(const CpuAutocast&) = delete;
-  CpuAutocast& operator=(const CpuAutocast&) = delete;
-
- private:
-  bool on_;
-  bool previous_ = false;
-};
-
-void orthogonal_init(torch::nn::Module& module, double gain) {
-  for (auto& child : module.modules(/*include_self=*/true)) {
-    if (auto* linear = child->as<torch::nn::Linear>()) {
-      torch::nn::init::orthogonal_(linear->weight, gain);
-      torch::nn::init::zeros_(linear->bias);
-    } else if (auto* conv = child->as<torch::nn::Conv2d>()) {
-      torch::nn::init::orthogonal_(conv->weight, gain);
-      torch::nn::init::zeros_(conv->bias);
-    }
-  }
-}
+using trainer::copy_parameters;
+using trainer::CpuAutocast;
+using trainer::orthogonal_init;
+using trainer::soft_update;
 
 torch::nn::Sequential make_head(std::int64_t in, std::int64_t features) {
   torch::nn::Sequential head(torch::nn::Linear(in, features),
@@ -76,20 +48,6 @@ torch::nn::Sequential make_mlp(std::int64_t in, std::int64_t hidden, std::int64_
   mlp->push_back(torch::nn::Linear(width, out));
   orthogonal_init(*mlp, std::sqrt(2.0));
   return mlp;
-}
-
-void copy_parameters(const torch::nn::Module& from, torch::nn::Module& to) {
-  torch::NoGradGuard no_grad;
-  const auto source = from.parameters();
-  auto destination = to.parameters();
-  for (std::size_t i = 0; i < source.size(); ++i) destination[i].copy_(source[i]);
-}
-
-void soft_update(const torch::nn::Module& from, torch::nn::Module& to, double tau) {
-  torch::NoGradGuard no_grad;
-  const auto source = from.parameters();
-  auto destination = to.parameters();
-  for (std::size_t i = 0; i < source.size(); ++i) destination[i].lerp_(source[i], tau);
 }
 
 template <typename T>
@@ -173,35 +131,35 @@ double DrqConfig::entropy_target(std::int64_t action_size) const {
 }
 
 void to_json(nlohmann::json& json, const DrqConfig& config) {
-  json = {{"seed", config.seed},
-          {"num_envs", config.num_envs},
-          {"total_env_steps", config.total_env_steps},
-          {"iteration_env_steps", config.iteration_env_steps},
-          {"frame_stack", config.frame_stack},
-          {"replay_capacity", config.replay_capacity},
-          {"batch_size", config.batch_size},
-          {"n_step", config.n_step},
-          {"gamma", config.gamma},
-          {"learning_rate", config.learning_rate},
-          {"init_temperature", config.init_temperature},
-          {"target_entropy", std::isnan(config.target_entropy)
-                                 ? nlohmann::json(nullptr)
-                                 : nlohmann::json(config.target_entropy)},
-          {"actor_update_every", config.actor_update_every},
-          {"target_update_every", config.target_update_every},
-          {"critic_tau", config.critic_tau},
-          {"encoder", drqv2::to_string(config.encoder)},
-          {"feature_dim", config.feature_dim},
-          {"hidden_dim", config.hidden_dim},
-          {"hidden_depth", config.hidden_depth},
-          {"log_std_min", config.log_std_min},
-          {"log_std_max", config.log_std_max},
-          {"seed_env_steps", config.seed_env_steps},
-          {"updates_per_env_step", config.updates_per_env_step},
-          {"shift_pad", config.shift_pad},
-          {"augmented_copies", config.augmented_copies},
-          {"bfloat16", config.bfloat16},
-          {"channels_last", config.channels_last}};
+  json = {
+      {"seed", config.seed},
+      {"num_envs", config.num_envs},
+      {"total_env_steps", config.total_env_steps},
+      {"iteration_env_steps", config.iteration_env_steps},
+      {"frame_stack", config.frame_stack},
+      {"replay_capacity", config.replay_capacity},
+      {"batch_size", config.batch_size},
+      {"n_step", config.n_step},
+      {"gamma", config.gamma},
+      {"learning_rate", config.learning_rate},
+      {"init_temperature", config.init_temperature},
+      {"target_entropy", std::isnan(config.target_entropy) ? nlohmann::json(nullptr)
+                                                           : nlohmann::json(config.target_entropy)},
+      {"actor_update_every", config.actor_update_every},
+      {"target_update_every", config.target_update_every},
+      {"critic_tau", config.critic_tau},
+      {"encoder", trainer::to_string(config.encoder)},
+      {"feature_dim", config.feature_dim},
+      {"hidden_dim", config.hidden_dim},
+      {"hidden_depth", config.hidden_depth},
+      {"log_std_min", config.log_std_min},
+      {"log_std_max", config.log_std_max},
+      {"seed_env_steps", config.seed_env_steps},
+      {"updates_per_env_step", config.updates_per_env_step},
+      {"shift_pad", config.shift_pad},
+      {"augmented_copies", config.augmented_copies},
+      {"bfloat16", config.bfloat16},
+      {"channels_last", config.channels_last}};
 }
 
 void from_json(const nlohmann::json& json, DrqConfig& config) {
@@ -229,10 +187,10 @@ void from_json(const nlohmann::json& json, DrqConfig& config) {
   read_member(json, "actor_update_every", config.actor_update_every);
   read_member(json, "target_update_every", config.target_update_every);
   read_member(json, "critic_tau", config.critic_tau);
-  std::string encoder = drqv2::to_string(config.encoder);
+  std::string encoder = trainer::to_string(config.encoder);
   read_member(json, "encoder", encoder);
   try {
-    config.encoder = drqv2::parse_encoder_architecture(encoder);
+    config.encoder = trainer::parse_encoder_architecture(encoder);
   } catch (const std::invalid_argument& error) {
     throw std::invalid_argument(std::string(kConfigName) + ": member \"encoder\": " + error.what());
   }
@@ -256,31 +214,14 @@ Agent::Agent(InputLayout input, const DrqConfig& config)
     : input_(std::move(input)),
       log_std_min_(config.log_std_min),
       log_std_max_(config.log_std_max),
-      autocast_(config.bfloat16 && drqv2::cpu_has_bfloat16()),
+      autocast_(config.bfloat16 && trainer::cpu_has_bfloat16()),
       channels_last_(config.channels_last) {
   std::int64_t features = 0;
   if (input_.has_image) {
-    encoder = torch::nn::Sequential();
-    std::int64_t channels = input_.stack * input_.channels;
-    std::int64_t height = input_.height;
-    std::int64_t width = input_.width;
-    for (const std::int64_t stride : drqv2::encoder_strides(config.encoder)) {
-      encoder->push_back(
-          torch::nn::Conv2d(torch::nn::Conv2dOptions(channels, 32, 3).stride(stride)));
-      encoder->push_back(torch::nn::ReLU());
-      channels = 32;
-      height = (height - 3) / stride + 1;
-      width = (width - 3) / stride + 1;
-      if (height < 1 || width < 1) {
-        throw std::invalid_argument("drq: images of " + std::to_string(input_.height) + "x" +
-                                    std::to_string(input_.width) + " are too small for the " +
-                                    drqv2::to_string(config.encoder) + " encoder");
-      }
-    }
-    encoder->push_back(torch::nn::Flatten());
-    orthogonal_init(*encoder, std::sqrt(2.0));
-    register_module("encoder", encoder);
-    const std::int64_t conv_features = channels * height * width;
+    trainer::ConvEncoder conv = trainer::make_conv_encoder(
+        config.encoder, input_.stack * input_.channels, input_.height, input_.width, "drq");
+    encoder = register_module("encoder", conv.layers);
+    const std::int64_t conv_features = conv.features;
     actor_head = register_module("actor_head", make_head(conv_features, config.feature_dim));
     critic_head = register_module("critic_head", make_head(conv_features, config.feature_dim));
     target_head = register_module("target_head", make_head(conv_features, config.feature_dim));
@@ -434,9 +375,10 @@ Learner::Learner(InputLayout input, DrqConfig config)
     return std::make_unique<torch::optim::Adam>(std::move(parameters),
                                                 torch::optim::AdamOptions(config_.learning_rate));
   };
-  critic_optimizer_ = adam(parameters_of({agent.encoder ? agent.encoder.ptr().get() : nullptr,
-                                          agent.critic_head ? agent.critic_head.ptr().get() : nullptr,
-                                          agent.q1.ptr().get(), agent.q2.ptr().get()}));
+  critic_optimizer_ =
+      adam(parameters_of({agent.encoder ? agent.encoder.ptr().get() : nullptr,
+                          agent.critic_head ? agent.critic_head.ptr().get() : nullptr,
+                          agent.q1.ptr().get(), agent.q2.ptr().get()}));
   actor_optimizer_ = adam(parameters_of(
       {agent.actor_head ? agent.actor_head.ptr().get() : nullptr, agent.actor.ptr().get()}));
   alpha_optimizer_ = adam({agent.log_alpha});
@@ -457,8 +399,8 @@ UpdateStats Learner::update(const ReplayBatch& batch, at::Generator& augmentatio
     const torch::Tensor shifts =
         torch::randint(0, 2 * pad + 1, {size, 2}, augmentation, torch::kInt64);
     shifted_.resize(stacks.size());
-    drqv2::shift_frames(stacks.data(), shifted_.data(), size, input.stack, input.height,
-                        input.width, input.channels, pad, shifts.data_ptr<std::int64_t>());
+    trainer::shift_frames(stacks.data(), shifted_.data(), size, input.stack, input.height,
+                          input.width, input.channels, pad, shifts.data_ptr<std::int64_t>());
     // image_input copies (to float), so shifted_ may be reused by the next call.
     return agent.image_input(view_of(shifted_, {size, bytes}, torch::kUInt8));
   };
@@ -494,7 +436,8 @@ UpdateStats Learner::update(const ReplayBatch& batch, at::Generator& augmentatio
     const torch::Tensor conv =
         input.has_image ? agent.convolve(shifted(batch.images[0])) : torch::Tensor();
     if (k == 0) first_conv = conv;
-    const auto [q1, q2] = agent.q_values(agent.critic_features(conv, vectors, false), actions, false);
+    const auto [q1, q2] =
+        agent.q_values(agent.critic_features(conv, vectors, false), actions, false);
     const torch::Tensor loss = torch::mse_loss(q1, target) + torch::mse_loss(q2, target);
     critic_loss = k == 0 ? loss : critic_loss + loss;
     q_sum += q1.mean().item<double>();
@@ -539,8 +482,7 @@ UpdateStats Learner::update(const ReplayBatch& batch, at::Generator& augmentatio
     actor_optimizer_->step();
     const torch::Tensor log_prob = policy.log_prob.detach();
     stats.entropy = -log_prob.mean().item<double>();
-    const torch::Tensor alpha_loss =
-        (agent.log_alpha.exp() * (-log_prob - target_entropy_)).mean();
+    const torch::Tensor alpha_loss = (agent.log_alpha.exp() * (-log_prob - target_entropy_)).mean();
     alpha_optimizer_->zero_grad();
     alpha_loss.backward();
     alpha_optimizer_->step();

@@ -7,20 +7,24 @@
 #include <torch/torch.h>
 
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <memory>
 #include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
 
-#include "examples/trainer/drqv2/drqv2.h"
-#include "examples/trainer/drqv2/replay_buffer.h"
+#include "examples/trainer/torch_common/conv_encoder.h"
+#include "examples/trainer/torch_common/input_layout.h"
+#include "examples/trainer/torch_common/replay_buffer.h"
 
 namespace pixelgym::drq {
 
-using drqv2::EncoderArchitecture;
-using drqv2::InputLayout;
-using drqv2::ReplayBatch;
+using trainer::EncoderArchitecture;
+using trainer::InputLayout;
+using trainer::ObservationView;
+using trainer::ReplayBatch;
+using trainer::ReplayBuffer;
 
 /// Every setting of the learner; validate() checks each. Counts of steps are env steps (all envs
 /// together): with action_repeat K each is K control steps. The defaults are DrQ's published

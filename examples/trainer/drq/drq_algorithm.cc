@@ -10,8 +10,9 @@
 #include <stdexcept>
 #include <utility>
 
-#include "examples/trainer/ppo/policy.h"
-#include "examples/trainer/ppo/ppo_algorithm.h"
+#include "examples/trainer/torch_common/observation_tensors.h"
+#include "examples/trainer/torch_common/off_policy_networks.h"
+#include "examples/trainer/torch_common/torch_state.h"
 #include "pixelgym/envs/vector/vector_wrapper.h"
 
 namespace pixelgym::drq {
@@ -33,27 +34,6 @@ double seconds_since(Clock::time_point start) {
 // The stats key of the learner's own RecordEpisodeStatistics (the env may record "episode").
 const char* const kEpisodeKey = "drq_episode";
 
-std::string to_bytes(const std::function<void(std::ostream&)>& save) {
-  std::ostringstream out(std::ios::binary);
-  save(out);
-  return out.str();
-}
-
-const std::string& blob(const LoadedCheckpoint& checkpoint, const std::string& name) {
-  const auto found = checkpoint.blobs.find(name);
-  if (found == checkpoint.blobs.end()) {
-    throw std::runtime_error(checkpoint.path.string() + ": the checkpoint has no \"" + name +
-                             "\" entry");
-  }
-  return found->second;
-}
-
-template <typename T>
-void load_blob(const LoadedCheckpoint& checkpoint, const std::string& name, T& into) {
-  std::istringstream in(blob(checkpoint, name), std::ios::binary);
-  torch::load(into, in);
-}
-
 const DrqConfig& checked(const DrqConfig& config, const vector::VectorEnv& env) {
   config.validate();
   if (env.autoreset_mode() != vector::AutoresetMode::kSameStep) {
@@ -66,18 +46,12 @@ const DrqConfig& checked(const DrqConfig& config, const vector::VectorEnv& env) 
     throw std::invalid_argument("drq: config num_envs is " + std::to_string(config.num_envs) +
                                 " but the vector env has " + std::to_string(env.num_envs()));
   }
-  drqv2::DrqV2Config sizes;
-  sizes.replay_capacity = config.replay_capacity;
-  sizes.batch_size = config.batch_size * config.augmented_copies;
-  sizes.hidden_dim = config.hidden_dim;
-  sizes.feature_dim = config.feature_dim;
-  sizes.encoder = config.encoder;
-  sizes.frame_stack = config.frame_stack;
   trainer::require_memory(
-      "drq", drqv2::memory_estimate(drqv2::input_layout(env.single_observation_space(),
-                                                        env.single_action_space(),
-                                                        config.frame_stack, env.name()),
-                                    sizes));
+      "drq", trainer::off_policy_memory_estimate(
+                 trainer::input_layout(env.single_observation_space(), env.single_action_space(),
+                                       config.frame_stack, "drq", env.name()),
+                 {config.replay_capacity, config.batch_size * config.augmented_copies,
+                  config.hidden_dim, config.feature_dim, config.encoder}));
   return config;
 }
 
@@ -111,10 +85,10 @@ DrqActor::DrqActor(std::shared_ptr<Agent> agent, std::uint64_t seed)
 
 ActCounts DrqActor::act(const Value& observations, bool deterministic, Value& actions) {
   const torch::Tensor unit =
-      agent_->act(ppo::observation_tensors(observations), deterministic, &sampling_);
+      agent_->act(trainer::observation_tensors(observations), deterministic, &sampling_);
   Array& action = actions.array();
   const torch::Tensor chosen =
-      agent_->env_action(unit).to(ppo::torch_dtype(action.dtype())).contiguous();
+      agent_->env_action(unit).to(trainer::torch_dtype(action.dtype())).contiguous();
   std::memcpy(action.raw_data(), chosen.data_ptr(), action.nbytes());
   // The tanh policy's actions lie within the bounds: none is clipped.
   return {0, unit.numel()};
@@ -125,8 +99,8 @@ ActCounts DrqActor::act(const Value& observations, bool deterministic, Value& ac
 DrqAlgorithm::DrqAlgorithm(vector::VectorEnv& env, DrqConfig config)
     : config_(checked(config, env)),
       episodes_(std::make_unique<vector::VectorWrapper>(env), 1, kEpisodeKey),
-      learner_(drqv2::input_layout(env.single_observation_space(), env.single_action_space(),
-                            config_.frame_stack, env.name()),
+      learner_(trainer::input_layout(env.single_observation_space(), env.single_action_space(),
+                                     config_.frame_stack, "drq", env.name()),
                config_),
       buffer_(learner_.agent().input().replay_layout(), config_.num_envs, config_.replay_capacity,
               config_.n_step, config_.gamma),
@@ -138,7 +112,7 @@ DrqAlgorithm::DrqAlgorithm(vector::VectorEnv& env, DrqConfig config)
       actor_(learner_.agent_ptr(), config_.seed + 4) {}
 
 void DrqAlgorithm::start() {
-  current_obs_ = ppo::observation_tensors(episodes_.reset(config_.seed).obs);
+  current_obs_ = trainer::observation_tensors(episodes_.reset(config_.seed).obs);
   for (std::int64_t e = 0; e < config_.num_envs; ++e) {
     buffer_.add_first(e, view_row(current_obs_, learner_.agent().input(), e));
   }
@@ -156,7 +130,7 @@ void DrqAlgorithm::choose_actions(StepTimes& times) {
   }
   Array& action = actions_.array();
   const torch::Tensor chosen =
-      agent.env_action(unit).to(ppo::torch_dtype(action.dtype())).contiguous();
+      agent.env_action(unit).to(trainer::torch_dtype(action.dtype())).contiguous();
   std::memcpy(action.raw_data(), chosen.data_ptr(), action.nbytes());
   env_action_log_.append(static_cast<const char*>(action.raw_data()), action.nbytes());
   times.act += seconds_since(start);
@@ -172,12 +146,12 @@ void DrqAlgorithm::step_env(std::vector<double>* ended_returns, StepTimes& times
   Array& action = actions_.array();
   const torch::Tensor unit =
       learner_.agent()
-          .unit_action(ppo::array_tensor(action).reshape({config_.num_envs, -1}))
+          .unit_action(trainer::array_tensor(action).reshape({config_.num_envs, -1}))
           .contiguous();
   const double* rewards = step.rewards.data<double>();
   const bool* terminated = step.terminated.data<bool>();
   const bool* truncated = step.truncated.data<bool>();
-  current_obs_ = ppo::observation_tensors(step.obs);
+  current_obs_ = trainer::observation_tensors(step.obs);
   std::map<std::string, torch::Tensor> final_obs;
   const bool* ended_mask = nullptr;
   if (step.infos.contains("_" + std::string(kEpisodeKey))) {
@@ -189,7 +163,7 @@ void DrqAlgorithm::step_env(std::vector<double>* ended_returns, StepTimes& times
       if (!step.infos.contains("final_obs")) {
         throw std::logic_error("drq: an episode ended without infos[\"final_obs\"]");
       }
-      final_obs = ppo::observation_tensors(step.infos.at("final_obs"));
+      final_obs = trainer::observation_tensors(step.infos.at("final_obs"));
     }
     buffer_.add_step(e, unit[e].data_ptr<float>(), rewards[e], terminated[e], truncated[e],
                      view_row(ended ? final_obs : current_obs_, input, e));
@@ -250,7 +224,7 @@ IterationStats DrqAlgorithm::iterate(const trainer::StopCheck& stop) {
     if (!stopped && stop) stopped = stop(env_steps_);
   }
   ++iterations_;
-  stats.extra = {
+  stats.metrics = {
       {"critic_loss", mean_or_none(critic_loss, updates)},
       {"actor_loss", mean_or_none(actor_loss, actor_updates)},
       {"q_mean", mean_or_none(q_mean, updates)},
@@ -274,52 +248,38 @@ void DrqAlgorithm::set_progress(std::int64_t env_steps, std::int64_t updates) {
   iterations_ = updates;
 }
 
-std::vector<std::string> DrqAlgorithm::progress_columns() const {
-  return {"critic_loss",   "actor_loss",
-          "q_mean",        "target_mean",
-          "alpha",         "policy_entropy",        "gradient_updates",
-          "updates_per_s", "replay_transitions",
-          "replay_mb",     "env_s",
-          "act_s",         "sample_s",
-          "update_s"};
+std::vector<std::string> DrqAlgorithm::metric_names() const {
+  return {"critic_loss",      "actor_loss",    "q_mean",
+          "target_mean",      "alpha",         "policy_entropy",
+          "gradient_updates", "updates_per_s", "replay_transitions",
+          "replay_mb",        "env_s",         "act_s",
+          "sample_s",         "update_s"};
 }
 
 void DrqAlgorithm::save(CheckpointBlobs& blobs, json& meta) {
-  blobs["agent"] = to_bytes([&](std::ostream& out) { torch::save(learner_.agent_ptr(), out); });
-  blobs["actor_optimizer"] =
-      to_bytes([&](std::ostream& out) { torch::save(learner_.actor_optimizer(), out); });
-  blobs["critic_optimizer"] =
-      to_bytes([&](std::ostream& out) { torch::save(learner_.critic_optimizer(), out); });
-  const auto generator = [&](at::Generator& g) {
-    const torch::Tensor state = g.get_state();
-    return to_bytes([&](std::ostream& out) { torch::save(state, out); });
-  };
-  blobs["rng_augmentation"] = generator(augmentation_);
-  blobs["rng_exploration"] = generator(exploration_);
-  blobs["rng_sampling"] = generator(sampling_);
-  blobs["alpha_optimizer"] =
-      to_bytes([&](std::ostream& out) { torch::save(learner_.alpha_optimizer(), out); });
+  blobs["agent"] = trainer::save_blob(learner_.agent_ptr());
+  blobs["actor_optimizer"] = trainer::save_blob(learner_.actor_optimizer());
+  blobs["critic_optimizer"] = trainer::save_blob(learner_.critic_optimizer());
+  blobs["rng_augmentation"] = trainer::generator_blob(augmentation_);
+  blobs["rng_exploration"] = trainer::generator_blob(exploration_);
+  blobs["rng_sampling"] = trainer::generator_blob(sampling_);
+  blobs["alpha_optimizer"] = trainer::save_blob(learner_.alpha_optimizer());
   std::ostringstream replay_rng;
   replay_rng << replay_rng_;
   meta["drq"] = {{"replay_rng", replay_rng.str()},
-                   {"update_credit", update_credit_},
-                   {"gradient_updates", gradient_updates_}};
+                 {"update_credit", update_credit_},
+                 {"gradient_updates", gradient_updates_}};
 }
 
 void DrqAlgorithm::restore(const LoadedCheckpoint& checkpoint, const json& meta) {
   std::shared_ptr<Agent> agent = learner_.agent_ptr();
-  load_blob(checkpoint, "agent", agent);
-  load_blob(checkpoint, "actor_optimizer", learner_.actor_optimizer());
-  load_blob(checkpoint, "critic_optimizer", learner_.critic_optimizer());
-  const auto generator = [&](const char* name, at::Generator& g) {
-    torch::Tensor state;
-    load_blob(checkpoint, name, state);
-    g.set_state(state);
-  };
-  generator("rng_augmentation", augmentation_);
-  generator("rng_exploration", exploration_);
-  generator("rng_sampling", sampling_);
-  load_blob(checkpoint, "alpha_optimizer", learner_.alpha_optimizer());
+  trainer::load_blob(checkpoint, "agent", agent);
+  trainer::load_blob(checkpoint, "actor_optimizer", learner_.actor_optimizer());
+  trainer::load_blob(checkpoint, "critic_optimizer", learner_.critic_optimizer());
+  trainer::load_generator(checkpoint, "rng_augmentation", augmentation_);
+  trainer::load_generator(checkpoint, "rng_exploration", exploration_);
+  trainer::load_generator(checkpoint, "rng_sampling", sampling_);
+  trainer::load_blob(checkpoint, "alpha_optimizer", learner_.alpha_optimizer());
   if (!meta.contains("drq")) {
     throw std::runtime_error(checkpoint.path.string() +
                              ": the checkpoint's meta has no \"drq\" member");
@@ -402,15 +362,15 @@ json DrqAlgorithmFactory::parse_config(const std::string& text) const {
 }
 
 int DrqAlgorithmFactory::set_threads(int requested) const {
-  return ppo::set_torch_threads(requested);
+  return trainer::set_torch_threads(requested);
 }
 
 std::unique_ptr<trainer::Algorithm> DrqAlgorithmFactory::make(
-    vector::VectorEnv& env, const json& config, trainer::Communicator* communicator) const {
-  if (communicator != nullptr && communicator->world_size() > 1) {
+    vector::VectorEnv& env, const json& config, trainer::Communicator& communicator) const {
+  if (communicator.world_size() > 1) {
     throw std::invalid_argument(
         "train --algo drq runs in one process; it was started as " +
-        std::to_string(communicator->world_size()) +
+        std::to_string(communicator.world_size()) +
         " ranks (--nproc or WORLD_SIZE). Data-parallel training is PPO's (--algo ppo)");
   }
   DrqConfig parsed;
@@ -423,9 +383,11 @@ std::unique_ptr<trainer::Actor> DrqAlgorithmFactory::load_actor(
     const LoadedCheckpoint& checkpoint) const {
   DrqConfig parsed;
   from_json(config, parsed);
-  auto agent = std::make_shared<Agent>(
-      drqv2::input_layout(observation_space, action_space, parsed.frame_stack, "the run's env"), parsed);
-  load_blob(checkpoint, "agent", agent);
+  auto agent =
+      std::make_shared<Agent>(trainer::input_layout(observation_space, action_space,
+                                                    parsed.frame_stack, "drq", "the run's env"),
+                              parsed);
+  trainer::load_blob(checkpoint, "agent", agent);
   agent->eval();
   return std::make_unique<DrqActor>(std::move(agent), parsed.seed + 4);
 }

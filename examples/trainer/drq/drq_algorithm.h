@@ -15,19 +15,14 @@
 #include <vector>
 
 #include "examples/trainer/drq/drq.h"
-#include "examples/trainer/drqv2/replay_buffer.h"
-
-namespace pixelgym::drq {
-using drqv2::ObservationView;
-using drqv2::ReplayBuffer;
-}  // namespace pixelgym::drq
-#include "examples/trainer/run/algorithm.h"
+#include "examples/trainer/torch_common/replay_buffer.h"
+#include "pixelgym/trainer/algorithm.h"
 #include "pixelgym/wrappers/vector/record_episode_statistics.h"
 
 namespace pixelgym::drq {
 
-/// An Agent acting for evaluation: its mean action (deterministic), or with noise of std
-/// `stochastic_std` (seeded generator of its own).
+/// An Agent acting for evaluation: the tanh of its Gaussian's mean (deterministic), or a sample
+/// of the squashed Gaussian (a seeded generator of its own).
 class DrqActor final : public trainer::Actor {
  public:
   /// Throws std::invalid_argument for a null agent.
@@ -39,33 +34,36 @@ class DrqActor final : public trainer::Actor {
   at::Generator sampling_;
 };
 
-/// DrQ-v2 on a vector env (SameStep autoreset, num_envs as config.num_envs) as an Algorithm.
+/// DrQ on a vector env (SameStep autoreset, num_envs as config.num_envs) as an Algorithm.
 ///
 /// iterate() takes config.iteration_env_steps env steps. Each step acts (uniform random actions
-/// for the first seed_env_steps, then the policy's with the scheduled noise), adds the
-/// transitions to the replay buffer (a step that ends an episode adds the episode's final
-/// observation, then the next episode's first), and then makes updates_per_env_step updates
-/// per env step (the fraction carried over), each from a batch sampled from the buffer. `stop`
-/// is asked after each env step and each update: once it answers true the iteration ends there,
-/// the updates it did not make left as credit for the next env steps.
+/// for the first seed_env_steps, then samples of the policy), adds the transitions to the replay
+/// buffer (a step that ends an episode adds the episode's final observation, then the next
+/// episode's first), and then makes updates_per_env_step updates per env step (the fraction
+/// carried over), each from a batch sampled from the buffer. `stop` is asked after each env step
+/// and each update: once it answers true the iteration ends there, the updates it did not make
+/// left as credit for the next env steps. (This env loop is DrQ-v2's, copied: it moves into the
+/// run, for both, when the run owns the env loop.)
 ///
 /// Determinism: torch::manual_seed(seed) before the weights; the replay sampling draws from a
 /// std::mt19937_64 seeded with seed, the augmentation from a torch generator seeded seed + 1,
-/// the exploration (random and noisy actions) from seed + 2 and the update's noise from
-/// seed + 3; the envs reset with seed.
+/// the exploration (random actions and the policy's samples while training) from seed + 2 and
+/// the update's samples from seed + 3; the envs reset with seed.
 ///
-/// Checkpoint: blobs "agent" (torch::save of the Agent: encoder, actor, critic, target
-/// critic), "encoder_optimizer" (when there is an image), "actor_optimizer",
-/// "critic_optimizer", "rng_augmentation", "rng_exploration", "rng_noise"; meta "drq":
+/// Checkpoint: blobs "agent" (torch::save of the Agent: encoder, heads, actor, critics, target
+/// critics, log_alpha), "actor_optimizer", "critic_optimizer" (with the encoder),
+/// "alpha_optimizer", "rng_augmentation", "rng_exploration", "rng_sampling"; meta "drq":
 /// {"replay_rng" (the sampling generator's state as text), "update_credit",
-/// "gradient_updates"}. The replay buffer is not saved: it holds what the env steps put into it,
-/// and replay_env, which replays the checkpoint's env actions, puts the same transitions back
-/// in the same order, so a resumed run is the run that did not stop.
+/// "gradient_updates" (which also restores the learner's count, that spaces the actor's and the
+/// target's updates)}. The replay buffer is not saved: replay_env, which replays the
+/// checkpoint's env actions, puts the same transitions back in the same order, so a resumed run
+/// is the run that did not stop.
 ///
-/// progress.csv's extra columns: critic_loss, actor_loss, q_mean, target_mean (means over the
-/// iteration's updates), noise_std, gradient_updates (all so far), updates_per_s (this
-/// iteration's updates over the seconds spent in them), replay_transitions, replay_mb (the
-/// buffer's allocation), and where the iteration's time went: env_s, act_s, sample_s, update_s.
+/// Its metrics (progress.csv's columns after the run's): critic_loss, actor_loss, q_mean,
+/// target_mean (means over the iteration's updates; actor_loss over its actor updates), alpha
+/// (the temperature after the last update), policy_entropy (minus the mean log-probability of
+/// the actor updates' samples), gradient_updates (all so far), updates_per_s, replay_transitions,
+/// replay_mb, and where the iteration's time went: env_s, act_s, sample_s, update_s.
 class DrqAlgorithm final : public trainer::Algorithm {
  public:
   /// Throws std::invalid_argument for a config that fails validate(), an env that does not
@@ -76,7 +74,7 @@ class DrqAlgorithm final : public trainer::Algorithm {
   std::int64_t env_steps() const override { return env_steps_; }
   std::int64_t updates() const override { return iterations_; }
   void set_progress(std::int64_t env_steps, std::int64_t updates) override;
-  std::vector<std::string> progress_columns() const override;
+  std::vector<std::string> metric_names() const override;
   void save(trainer::CheckpointBlobs& blobs, nlohmann::json& meta) override;
   void restore(const trainer::LoadedCheckpoint& checkpoint, const nlohmann::json& meta) override;
   const std::string& env_action_log() const override { return env_action_log_; }
@@ -121,18 +119,17 @@ class DrqAlgorithm final : public trainer::Algorithm {
   DrqActor actor_;
 };
 
-/// DrQ-v2's AlgorithmFactory: name "drq", the config a DrqConfig (to_json / from_json).
+/// DrQ's AlgorithmFactory: name "drq", the config a DrqConfig (to_json / from_json).
 class DrqAlgorithmFactory final : public trainer::AlgorithmFactory {
  public:
   std::string name() const override { return "drq"; }
   nlohmann::json parse_config(const std::string& text) const override;
-  /// As ppo::set_torch_threads.
+  /// trainer::set_torch_threads.
   int set_threads(int requested) const override;
-  /// Throws std::invalid_argument for a communicator of several ranks: DrQ-v2 trains in one
+  /// Throws std::invalid_argument for a communicator of several ranks: DrQ trains in one
   /// process (its replay buffer and updates are not shared across ranks).
-  std::unique_ptr<trainer::Algorithm> make(
-      vector::VectorEnv& env, const nlohmann::json& config,
-      trainer::Communicator* communicator = nullptr) const override;
+  std::unique_ptr<trainer::Algorithm> make(vector::VectorEnv& env, const nlohmann::json& config,
+                                           trainer::Communicator& communicator) const override;
   /// An Agent of the config for these spaces with the checkpoint's "agent".
   std::unique_ptr<trainer::Actor> load_actor(
       const Space& observation_space, const Space& action_space, const nlohmann::json& config,

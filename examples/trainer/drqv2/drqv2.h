@@ -14,6 +14,7 @@
 
 #include "examples/trainer/torch_common/conv_encoder.h"
 #include "examples/trainer/torch_common/input_layout.h"
+#include "examples/trainer/torch_common/off_policy_networks.h"
 #include "examples/trainer/torch_common/random_shift.h"
 #include "examples/trainer/torch_common/replay_buffer.h"
 #include "pixelgym/envs/space.h"
@@ -107,8 +108,8 @@ struct DrqV2Config {
 void to_json(nlohmann::json& json, const DrqV2Config& config);
 void from_json(const nlohmann::json& json, DrqV2Config& config);
 
-/// Whether this CPU computes bfloat16 natively (AVX512-BF16 or AMX-BF16).
-bool cpu_has_bfloat16();
+/// Whether this CPU computes bfloat16 natively (torch_common/off_policy_networks.h).
+using trainer::cpu_has_bfloat16;
 
 /// The memory a run of `config` on inputs `input` needs, by the member that sets each part
 /// (replay_capacity: the replay buffer; batch_size: the sampled batches, their copies and the

@@ -93,8 +93,9 @@ struct Fixture {
 
   explicit Fixture(bool pixels = true) {
     const spaces::Box action(-1.0, 1.0, Shape{1});
-    input = pixels ? drqv2::input_layout(pixel_space({3, 32, 32}), action, 3, "T-v0")
-                   : drqv2::input_layout(spaces::Box(-1.0, 1.0, Shape{2}), action, 1, "T-v0");
+    input = pixels
+                ? trainer::input_layout(pixel_space({3, 32, 32}), action, 3, "drq", "T-v0")
+                : trainer::input_layout(spaces::Box(-1.0, 1.0, Shape{2}), action, 1, "drq", "T-v0");
     config.batch_size = 16;
     config.hidden_dim = 32;
     config.feature_dim = 16;
