@@ -2,7 +2,6 @@
 
 #include <ATen/CPUGeneratorImpl.h>
 
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <functional>
@@ -10,9 +9,9 @@
 #include <stdexcept>
 #include <utility>
 
+#include "examples/trainer/torch_common/input_layout.h"
 #include "examples/trainer/torch_common/observation_tensors.h"
 #include "examples/trainer/torch_common/torch_state.h"
-#include "pixelgym/envs/vector/vector_wrapper.h"
 
 namespace pixelgym::drqv2 {
 
@@ -24,12 +23,6 @@ using trainer::LoadedCheckpoint;
 namespace {
 
 using nlohmann::json;
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
 // The stats key of the learner's own RecordEpisodeStatistics (the env may record "episode").
 const char* const kEpisodeKey = "drqv2_episode";
 
@@ -51,21 +44,6 @@ const DrqV2Config& checked(const DrqV2Config& config, const vector::VectorEnv& e
                                    config.frame_stack, "drqv2", env.name()),
                       config));
   return config;
-}
-
-// Row `row` of the batched observation `obs` as the buffer reads it.
-ObservationView view_row(const std::map<std::string, torch::Tensor>& obs, const InputLayout& input,
-                         std::int64_t row) {
-  ObservationView view;
-  if (input.has_image) {
-    const torch::Tensor& images = obs.at(input.image_key);
-    view.images.push_back(images.data_ptr<std::uint8_t>() + row * images.stride(0));
-  }
-  for (const std::string& key : input.vector_keys) {
-    const torch::Tensor& values = obs.at(key);
-    view.vectors.push_back(values.data_ptr<float>() + row * values.stride(0));
-  }
-  return view;
 }
 
 double mean_or_none(double sum, std::int64_t count) {
@@ -94,11 +72,10 @@ ActCounts DrqV2Actor::act(const Value& observations, bool deterministic, Value& 
   return {0, unit.numel()};
 }
 
-// ---- DrqV2Algorithm --------------------------------------------------------------------------
+// ---- DrqV2StepLearner ----------------------------------------------------------------------
 
-DrqV2Algorithm::DrqV2Algorithm(vector::VectorEnv& env, DrqV2Config config)
+DrqV2StepLearner::DrqV2StepLearner(const vector::VectorEnv& env, DrqV2Config config)
     : config_(checked(config, env)),
-      episodes_(std::make_unique<vector::VectorWrapper>(env), 1, kEpisodeKey),
       learner_(input_layout(env.single_observation_space(), env.single_action_space(),
                             config_.frame_stack, "drqv2", env.name()),
                config_),
@@ -108,150 +85,72 @@ DrqV2Algorithm::DrqV2Algorithm(vector::VectorEnv& env, DrqV2Config config)
       augmentation_(at::detail::createCPUGenerator(config_.seed + 1)),
       exploration_(at::detail::createCPUGenerator(config_.seed + 2)),
       noise_(at::detail::createCPUGenerator(config_.seed + 3)),
-      actions_(env.action_space().zeros()),
+      updates_(config_.num_envs, config_.updates_per_env_step, config_.seed_env_steps),
       actor_(learner_.agent_ptr(), config_.noise_end, config_.seed + 4) {}
 
-void DrqV2Algorithm::start() {
-  current_obs_ = trainer::observation_tensors(episodes_.reset(config_.seed).obs);
-  for (std::int64_t e = 0; e < config_.num_envs; ++e) {
-    buffer_.add_first(e, view_row(current_obs_, learner_.agent().input(), e));
-  }
-  started_ = true;
+void DrqV2StepLearner::begin(const Value& observations) {
+  trainer::add_first_observations(buffer_, learner_.agent().input(), observations);
 }
 
-void DrqV2Algorithm::choose_actions(StepTimes& times) {
-  const auto start = Clock::now();
+void DrqV2StepLearner::act(const Value& observations, std::int64_t env_steps, Value& actions) {
   Agent& agent = learner_.agent();
   torch::Tensor unit;
-  if (env_steps_ < config_.seed_env_steps) {
+  if (env_steps < config_.seed_env_steps) {
     unit = torch::rand({config_.num_envs, agent.input().action_size}, exploration_) * 2.0 - 1.0;
   } else {
-    unit = agent.act(current_obs_, false, config_.noise_std(env_steps_), &exploration_);
+    unit = agent.act(trainer::observation_tensors(observations), false,
+                     config_.noise_std(env_steps), &exploration_);
   }
-  Array& action = actions_.array();
+  Array& action = actions.array();
   const torch::Tensor chosen =
       agent.env_action(unit).to(trainer::torch_dtype(action.dtype())).contiguous();
   std::memcpy(action.raw_data(), chosen.data_ptr(), action.nbytes());
-  env_action_log_.append(static_cast<const char*>(action.raw_data()), action.nbytes());
-  times.act += seconds_since(start);
 }
 
-void DrqV2Algorithm::step_env(std::vector<double>* ended_returns, StepTimes& times) {
-  auto start = Clock::now();
-  const vector::VectorStepResult& step = episodes_.step(actions_);
-  times.env += seconds_since(start);
-  const InputLayout& input = learner_.agent().input();
+void DrqV2StepLearner::observe(const Value& actions, const vector::VectorStepResult& step) {
+  torch::NoGradGuard no_grad;
   // The buffer keeps actions in [-1, 1], as the actor gives them, from what the env was sent
   // (so that a replayed log fills the buffer with the same bytes).
-  Array& action = actions_.array();
   const torch::Tensor unit =
       learner_.agent()
-          .unit_action(trainer::array_tensor(action).reshape({config_.num_envs, -1}))
+          .unit_action(trainer::array_tensor(actions.array()).reshape({config_.num_envs, -1}))
           .contiguous();
-  const double* rewards = step.rewards.data<double>();
-  const bool* terminated = step.terminated.data<bool>();
-  const bool* truncated = step.truncated.data<bool>();
-  current_obs_ = trainer::observation_tensors(step.obs);
-  std::map<std::string, torch::Tensor> final_obs;
-  const bool* ended_mask = nullptr;
-  if (step.infos.contains("_" + std::string(kEpisodeKey))) {
-    ended_mask = step.infos.at("_" + std::string(kEpisodeKey)).array().data<bool>();
-  }
-  for (std::int64_t e = 0; e < config_.num_envs; ++e) {
-    const bool ended = terminated[e] || truncated[e];
-    if (ended && final_obs.empty()) {
-      if (!step.infos.contains("final_obs")) {
-        throw std::logic_error("drqv2: an episode ended without infos[\"final_obs\"]");
-      }
-      final_obs = trainer::observation_tensors(step.infos.at("final_obs"));
-    }
-    buffer_.add_step(e, unit[e].data_ptr<float>(), rewards[e], terminated[e], truncated[e],
-                     view_row(ended ? final_obs : current_obs_, input, e));
-    if (ended) buffer_.add_first(e, view_row(current_obs_, input, e));
-  }
-  if (ended_returns != nullptr && ended_mask != nullptr) {
-    const double* returns = step.infos.at(kEpisodeKey).dict().at("r").array().data<double>();
-    for (std::int64_t e = 0; e < config_.num_envs; ++e) {
-      if (ended_mask[e]) ended_returns->push_back(returns[e]);
-    }
-  }
-  env_steps_ += config_.num_envs;
+  trainer::add_env_step(buffer_, learner_.agent().input(), unit.data_ptr<float>(), step, "drqv2");
 }
 
-IterationStats DrqV2Algorithm::iterate(const trainer::StopCheck& stop) {
-  if (!started_) start();
-  IterationStats stats;
-  StepTimes times;
-  double sample_s = 0.0;
-  double update_s = 0.0;
-  double critic_loss = 0.0, actor_loss = 0.0, q_mean = 0.0, target_mean = 0.0;
-  std::int64_t updates = 0;
-  const std::int64_t steps = config_.iteration_env_steps / config_.num_envs;
-  bool stopped = false;
-  for (std::int64_t s = 0; s < steps && !stopped; ++s) {
-    choose_actions(times);
-    step_env(&stats.episode_returns, times);
-    if (env_steps_ < config_.seed_env_steps || !buffer_.can_sample()) {
-      stopped = stop && stop(env_steps_);
-      continue;
-    }
-    update_credit_ += static_cast<double>(config_.num_envs) * config_.updates_per_env_step;
-    while (update_credit_ >= 1.0) {
-      update_credit_ -= 1.0;
-      auto start = Clock::now();
-      buffer_.sample(config_.batch_size, replay_rng_, batch_);
-      sample_s += seconds_since(start);
-      start = Clock::now();
-      const UpdateStats update = learner_.update(batch_, env_steps_, augmentation_, noise_);
-      update_s += seconds_since(start);
-      critic_loss += update.critic_loss;
-      actor_loss += update.actor_loss;
-      q_mean += update.q_mean;
-      target_mean += update.target_mean;
-      ++updates;
-      ++gradient_updates_;
-      if (stop && stop(env_steps_)) {
-        stopped = true;
-        break;
-      }
-    }
-    if (!stopped && stop) stopped = stop(env_steps_);
-  }
-  ++iterations_;
-  stats.metrics = {
-      {"critic_loss", mean_or_none(critic_loss, updates)},
-      {"actor_loss", mean_or_none(actor_loss, updates)},
-      {"q_mean", mean_or_none(q_mean, updates)},
-      {"target_mean", mean_or_none(target_mean, updates)},
-      {"noise_std", config_.noise_std(env_steps_)},
-      {"gradient_updates", static_cast<double>(gradient_updates_)},
-      {"updates_per_s", updates > 0 ? static_cast<double>(updates) / (sample_s + update_s)
-                                    : trainer::ProgressRow::kNone},
-      {"replay_transitions", static_cast<double>(buffer_.steps_added())},
-      {"replay_mb", static_cast<double>(buffer_.bytes()) / 1e6},
-      {"env_s", times.env},
-      {"act_s", times.act},
-      {"sample_s", sample_s},
-      {"update_s", update_s}};
-  return stats;
-}
-
-void DrqV2Algorithm::set_progress(std::int64_t env_steps, std::int64_t updates) {
+bool DrqV2StepLearner::learn(std::int64_t env_steps, const trainer::StopCheck& stop) {
   env_steps_ = env_steps;
-  iterations_ = updates;
+  return updates_.run(env_steps, buffer_, config_.batch_size, replay_rng_, batch_, stop,
+                      [this, env_steps](const ReplayBatch& batch) {
+                        const UpdateStats update =
+                            learner_.update(batch, env_steps, augmentation_, noise_);
+                        sums_.critic_loss += update.critic_loss;
+                        sums_.actor_loss += update.actor_loss;
+                        sums_.q_mean += update.q_mean;
+                        sums_.target_mean += update.target_mean;
+                      });
 }
 
-std::vector<std::string> DrqV2Algorithm::metric_names() const {
-  return {"critic_loss",   "actor_loss",
-          "q_mean",        "target_mean",
-          "noise_std",     "gradient_updates",
-          "updates_per_s", "replay_transitions",
-          "replay_mb",     "env_s",
-          "act_s",         "sample_s",
-          "update_s"};
+std::map<std::string, double> DrqV2StepLearner::end_iteration(const trainer::LoopTimes& times) {
+  const IterationSums sums = std::exchange(sums_, IterationSums{});
+  const std::int64_t updates = updates_.iteration_updates();
+  std::map<std::string, double> metrics = {{"critic_loss", mean_or_none(sums.critic_loss, updates)},
+                                           {"actor_loss", mean_or_none(sums.actor_loss, updates)},
+                                           {"q_mean", mean_or_none(sums.q_mean, updates)},
+                                           {"target_mean", mean_or_none(sums.target_mean, updates)},
+                                           {"noise_std", config_.noise_std(env_steps_)}};
+  updates_.end_iteration(buffer_, times, metrics);
+  return metrics;
 }
 
-void DrqV2Algorithm::save(CheckpointBlobs& blobs, json& meta) {
+std::vector<std::string> DrqV2StepLearner::metric_names() const {
+  std::vector<std::string> names = {"critic_loss", "actor_loss", "q_mean", "target_mean",
+                                    "noise_std"};
+  for (const std::string& name : trainer::ReplayUpdates::metric_names()) names.push_back(name);
+  return names;
+}
+
+void DrqV2StepLearner::save(CheckpointBlobs& blobs, json& meta) {
   blobs["agent"] = trainer::save_blob(learner_.agent_ptr());
   if (torch::optim::Adam* encoder = learner_.encoder_optimizer()) {
     blobs["encoder_optimizer"] = trainer::save_blob(*encoder);
@@ -264,11 +163,11 @@ void DrqV2Algorithm::save(CheckpointBlobs& blobs, json& meta) {
   std::ostringstream replay_rng;
   replay_rng << replay_rng_;
   meta["drqv2"] = {{"replay_rng", replay_rng.str()},
-                   {"update_credit", update_credit_},
-                   {"gradient_updates", gradient_updates_}};
+                   {"update_credit", updates_.credit()},
+                   {"gradient_updates", updates_.total()}};
 }
 
-void DrqV2Algorithm::restore(const LoadedCheckpoint& checkpoint, const json& meta) {
+void DrqV2StepLearner::restore(const LoadedCheckpoint& checkpoint, const json& meta) {
   std::shared_ptr<Agent> agent = learner_.agent_ptr();
   trainer::load_blob(checkpoint, "agent", agent);
   if (torch::optim::Adam* encoder = learner_.encoder_optimizer()) {
@@ -290,57 +189,8 @@ void DrqV2Algorithm::restore(const LoadedCheckpoint& checkpoint, const json& met
     throw std::runtime_error(checkpoint.path.string() +
                              ": the checkpoint's replay_rng is not a generator state");
   }
-  update_credit_ = own.at("update_credit").get<double>();
-  gradient_updates_ = own.at("gradient_updates").get<std::int64_t>();
-}
-
-bool DrqV2Algorithm::env_action_log_complete() const {
-  const auto batches = static_cast<std::size_t>(env_steps_ / config_.num_envs);
-  return env_action_log_.size() == batches * actions_.array().nbytes();
-}
-
-void DrqV2Algorithm::replay_env(const std::string& env_action_log) {
-  if (started_) {
-    throw std::logic_error("DrqV2Algorithm::replay_env: the envs were already reset or stepped");
-  }
-  Array& action = actions_.array();
-  const std::size_t batch_bytes = action.nbytes();
-  const std::int64_t steps_done = env_steps_;
-  const auto batches = static_cast<std::size_t>(steps_done / config_.num_envs);
-  if (env_action_log.size() != batches * batch_bytes) {
-    throw std::invalid_argument(
-        "DrqV2Algorithm::replay_env: an action log of " + std::to_string(batches) + " batches of " +
-        std::to_string(batch_bytes) + " bytes (for " + std::to_string(steps_done) +
-        " env steps) expected, got " + std::to_string(env_action_log.size()) + " bytes");
-  }
-  torch::NoGradGuard no_grad;
-  env_steps_ = 0;
-  start();
-  StepTimes times;
-  for (std::size_t b = 0; b < batches; ++b) {
-    std::memcpy(action.raw_data(), env_action_log.data() + b * batch_bytes, batch_bytes);
-    step_env(nullptr, times);
-  }
-  env_action_log_ = env_action_log;
-}
-
-std::uint64_t DrqV2Algorithm::env_digest() const {
-  if (!started_) return 0;
-  std::uint64_t digest = 14695981039346656037ULL;  // FNV-1a, 64-bit
-  const auto add = [&digest](const void* data, std::size_t size) {
-    const auto* bytes = static_cast<const unsigned char*>(data);
-    for (std::size_t k = 0; k < size; ++k) digest = (digest ^ bytes[k]) * 1099511628211ULL;
-  };
-  for (const auto& [key, tensor] : current_obs_) {
-    add(key.data(), key.size());
-    const torch::Tensor contiguous = tensor.contiguous();
-    add(contiguous.data_ptr(), contiguous.nbytes());
-  }
-  const std::vector<double>& returns = episodes_.episode_returns();
-  const std::vector<std::int64_t>& lengths = episodes_.episode_lengths();
-  add(returns.data(), returns.size() * sizeof(double));
-  add(lengths.data(), lengths.size() * sizeof(std::int64_t));
-  return digest;
+  updates_.restore(own.at("update_credit").get<double>(),
+                   own.at("gradient_updates").get<std::int64_t>());
 }
 
 // ---- DrqV2AlgorithmFactory -------------------------------------------------------------------
@@ -373,7 +223,9 @@ std::unique_ptr<trainer::Algorithm> DrqV2AlgorithmFactory::make(
   }
   DrqV2Config parsed;
   from_json(config, parsed);
-  return std::make_unique<DrqV2Algorithm>(env, parsed);
+  return std::make_unique<trainer::SteppedAlgorithm>(
+      env, trainer::SteppedSettings{parsed.seed, parsed.iteration_env_steps, kEpisodeKey},
+      std::make_unique<DrqV2StepLearner>(env, parsed));
 }
 
 std::unique_ptr<trainer::Actor> DrqV2AlgorithmFactory::load_actor(

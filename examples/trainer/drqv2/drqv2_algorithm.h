@@ -1,6 +1,6 @@
-// DrQ-v2 behind the run's Algorithm interface (examples/trainer/run/algorithm.h): it steps a
-// vector env, fills a replay buffer and updates a Learner; and the factory that builds it from
-// config.json's "drqv2".
+// DrQ-v2 as the run's learner (pixelgym/trainer/stepped_algorithm.h): it acts, fills a replay
+// buffer from the env steps the run takes and updates a Learner; and the factory that builds it
+// from config.json's "drqv2".
 #pragma once
 
 #include <ATen/core/Generator.h>
@@ -16,8 +16,10 @@
 
 #include "examples/trainer/drqv2/drqv2.h"
 #include "examples/trainer/torch_common/replay_buffer.h"
+#include "examples/trainer/torch_common/replay_updates.h"
 #include "pixelgym/trainer/algorithm.h"
-#include "pixelgym/wrappers/vector/record_episode_statistics.h"
+#include "pixelgym/trainer/progress_csv.h"
+#include "pixelgym/trainer/stepped_algorithm.h"
 
 namespace pixelgym::drqv2 {
 
@@ -35,15 +37,14 @@ class DrqV2Actor final : public trainer::Actor {
   at::Generator noise_;
 };
 
-/// DrQ-v2 on a vector env (SameStep autoreset, num_envs as config.num_envs) as an Algorithm.
-///
-/// iterate() takes config.iteration_env_steps env steps. Each step acts (uniform random actions
-/// for the first seed_env_steps, then the policy's with the scheduled noise), adds the
-/// transitions to the replay buffer (a step that ends an episode adds the episode's final
-/// observation, then the next episode's first), and then makes updates_per_env_step updates
-/// per env step (the fraction carried over), each from a batch sampled from the buffer. `stop`
-/// is asked after each env step and each update: once it answers true the iteration ends there,
-/// the updates it did not make left as credit for the next env steps.
+/// DrQ-v2's side of the run's env loop (trainer::SteppedAlgorithm steps the vector env, SameStep
+/// autoreset, num_envs as config.num_envs, config.iteration_env_steps env steps an iteration).
+/// Each env step: act (uniform random actions for the first seed_env_steps, then the policy's
+/// with the scheduled noise), add the transitions to the replay buffer (a step that ends an
+/// episode adds the episode's final observation, then the next episode's first), then make
+/// updates_per_env_step updates per env step (the fraction carried over), each from a batch
+/// sampled from the buffer, asking `stop` after each (the updates not made are left as credit
+/// for the next env steps).
 ///
 /// Determinism: torch::manual_seed(seed) before the weights; the replay sampling draws from a
 /// std::mt19937_64 seeded with seed, the augmentation from a torch generator seeded seed + 1,
@@ -55,8 +56,8 @@ class DrqV2Actor final : public trainer::Actor {
 /// "critic_optimizer", "rng_augmentation", "rng_exploration", "rng_noise"; meta "drqv2":
 /// {"replay_rng" (the sampling generator's state as text), "update_credit",
 /// "gradient_updates"}. The replay buffer is not saved: it holds what the env steps put into it,
-/// and replay_env, which replays the checkpoint's env actions, puts the same transitions back
-/// in the same order, so a resumed run is the run that did not stop.
+/// and the run's replay of the checkpoint's env actions puts the same transitions back in the
+/// same order (observe), so a resumed run is the run that did not stop.
 ///
 /// Its metrics (progress.csv's columns after the run's; runs before metrics were named by their
 /// algorithm also have PPO's five loss columns, left empty): critic_loss, actor_loss, q_mean,
@@ -64,43 +65,33 @@ class DrqV2Actor final : public trainer::Actor {
 /// updates_per_s (this iteration's updates over the seconds spent in them), replay_transitions,
 /// replay_mb (the buffer's allocation), and where the iteration's time went: env_s, act_s,
 /// sample_s, update_s.
-class DrqV2Algorithm final : public trainer::Algorithm {
+class DrqV2StepLearner final : public trainer::StepLearner {
  public:
   /// Throws std::invalid_argument for a config that fails validate(), an env that does not
   /// autoreset in SameStep mode or has another num_envs, and as input_layout for the spaces.
-  DrqV2Algorithm(vector::VectorEnv& env, DrqV2Config config);
+  DrqV2StepLearner(const vector::VectorEnv& env, DrqV2Config config);
 
-  trainer::IterationStats iterate(const trainer::StopCheck& stop) override;
-  std::int64_t env_steps() const override { return env_steps_; }
-  std::int64_t updates() const override { return iterations_; }
-  void set_progress(std::int64_t env_steps, std::int64_t updates) override;
+  void begin(const Value& observations) override;
+  void act(const Value& observations, std::int64_t env_steps, Value& actions) override;
+  void observe(const Value& actions, const vector::VectorStepResult& step) override;
+  bool learn(std::int64_t env_steps, const trainer::StopCheck& stop) override;
+  std::map<std::string, double> end_iteration(const trainer::LoopTimes& times) override;
   std::vector<std::string> metric_names() const override;
   void save(trainer::CheckpointBlobs& blobs, nlohmann::json& meta) override;
   void restore(const trainer::LoadedCheckpoint& checkpoint, const nlohmann::json& meta) override;
-  const std::string& env_action_log() const override { return env_action_log_; }
-  bool env_action_log_complete() const override;
-  void replay_env(const std::string& env_action_log) override;
-  std::uint64_t env_digest() const override;
   trainer::Actor& actor() override { return actor_; }
 
   Learner& learner() { return learner_; }
   const ReplayBuffer& buffer() const { return buffer_; }
-  std::int64_t gradient_updates() const { return gradient_updates_; }
+  std::int64_t gradient_updates() const { return updates_.total(); }
 
  private:
-  struct StepTimes {
-    double env = 0.0, act = 0.0;
+  // Sums over the iteration's updates, for its metrics.
+  struct IterationSums {
+    double critic_loss = 0.0, actor_loss = 0.0, q_mean = 0.0, target_mean = 0.0;
   };
-  // Resets the envs with the seed and adds their first observations.
-  void start();
-  // Steps the envs with actions_ (already in the log) and adds the transitions; returns the
-  // step's ended episodes' returns.
-  void step_env(std::vector<double>* ended_returns, StepTimes& times);
-  // Chooses the next actions into actions_ and appends them to the log.
-  void choose_actions(StepTimes& times);
 
   DrqV2Config config_;
-  vector::RecordEpisodeStatistics episodes_;
   Learner learner_;
   ReplayBuffer buffer_;
   ReplayBatch batch_;
@@ -108,14 +99,9 @@ class DrqV2Algorithm final : public trainer::Algorithm {
   at::Generator augmentation_;
   at::Generator exploration_;
   at::Generator noise_;
-  Value actions_;                                     // laid out as the env's action_space()
-  std::map<std::string, torch::Tensor> current_obs_;  // views of the env's observation batch
-  std::string env_action_log_;
-  bool started_ = false;
-  std::int64_t env_steps_ = 0;
-  std::int64_t iterations_ = 0;
-  std::int64_t gradient_updates_ = 0;
-  double update_credit_ = 0.0;
+  trainer::ReplayUpdates updates_;
+  std::int64_t env_steps_ = 0;  // as the last learn() was given them, for noise_std
+  IterationSums sums_;
   DrqV2Actor actor_;
 };
 

@@ -56,9 +56,12 @@ struct IterationStats {
 using StopCheck = std::function<bool(std::int64_t env_steps)>;
 
 /// A learning algorithm on a vector env, driven by a TrainingRun: the run calls iterate() until
-/// its budget is spent, and checkpoints, resumes and evaluates through the calls below. The
-/// algorithm keeps a reference to the env it was built on (AlgorithmFactory::make) and is the
-/// only one to step it.
+/// its budget is spent, and checkpoints, resumes and evaluates through the calls below. An
+/// algorithm that learns env step by env step need not step the env itself: SteppedAlgorithm
+/// (stepped_algorithm.h) is this interface over a StepLearner's act / observe / learn, with the
+/// env loop, action log, replay and digest written once (DrQ and DrQ-v2 are made so; PPO still
+/// steps its env in its rollouts). The algorithm keeps a reference to the env it was built on
+/// (AlgorithmFactory::make) and is the only one to step it.
 class Algorithm {
  public:
   virtual ~Algorithm() = default;

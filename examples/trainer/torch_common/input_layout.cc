@@ -108,3 +108,58 @@ InputLayout input_layout(const Space& observation_space, const Space& action_spa
 }
 
 }  // namespace pixelgym::trainer
+
+namespace pixelgym::trainer {
+namespace {
+
+// The array of `key` in a batched observation (the bare Array for key "").
+const Array& observation_array(const Value& observations, const std::string& key) {
+  return observations.is_array() && key.empty() ? observations.array()
+                                                : observations.dict().at(key).array();
+}
+
+// Row `row` of the batched `observations` as the buffer reads it.
+ObservationView view_row(const Value& observations, const InputLayout& input, std::int64_t row) {
+  ObservationView view;
+  if (input.has_image) {
+    const Array& images = observation_array(observations, input.image_key);
+    const std::size_t row_bytes = images.nbytes() / static_cast<std::size_t>(images.shape()[0]);
+    view.images.push_back(static_cast<const std::uint8_t*>(images.raw_data()) +
+                          static_cast<std::size_t>(row) * row_bytes);
+  }
+  for (std::size_t k = 0; k < input.vector_keys.size(); ++k) {
+    const Array& values = observation_array(observations, input.vector_keys[k]);
+    view.vectors.push_back(values.data<float>() + row * input.vector_sizes[k]);
+  }
+  return view;
+}
+
+}  // namespace
+
+void add_first_observations(ReplayBuffer& buffer, const InputLayout& input,
+                            const Value& observations) {
+  const auto envs = observations.is_array()
+                        ? observations.array().shape()[0]
+                        : observations.dict().values().front().array().shape()[0];
+  for (std::int64_t e = 0; e < envs; ++e) buffer.add_first(e, view_row(observations, input, e));
+}
+
+void add_env_step(ReplayBuffer& buffer, const InputLayout& input, const float* unit_actions,
+                  const vector::VectorStepResult& step, const std::string& learner) {
+  const double* rewards = step.rewards.data<double>();
+  const bool* terminated = step.terminated.data<bool>();
+  const bool* truncated = step.truncated.data<bool>();
+  const auto envs = step.rewards.shape()[0];
+  for (std::int64_t e = 0; e < envs; ++e) {
+    const bool ended = terminated[e] || truncated[e];
+    if (ended && !step.infos.contains("final_obs")) {
+      throw std::logic_error(learner + ": an episode ended without infos[\"final_obs\"]");
+    }
+    buffer.add_step(e, unit_actions + e * input.action_size, rewards[e], terminated[e],
+                    truncated[e],
+                    view_row(ended ? step.infos.at("final_obs") : step.obs, input, e));
+    if (ended) buffer.add_first(e, view_row(step.obs, input, e));
+  }
+}
+
+}  // namespace pixelgym::trainer

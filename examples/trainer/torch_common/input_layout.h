@@ -8,6 +8,8 @@
 
 #include "examples/trainer/torch_common/replay_buffer.h"
 #include "pixelgym/envs/space.h"
+#include "pixelgym/envs/value.h"
+#include "pixelgym/envs/vector/vector_env.h"
 
 namespace pixelgym::trainer {
 
@@ -42,5 +44,18 @@ struct InputLayout {
 InputLayout input_layout(const Space& observation_space, const Space& action_space,
                          std::int64_t frame_stack, const std::string& learner,
                          const std::string& env_name);
+
+/// Adds the envs' first observations (rows of a vector env's `observations` batch, laid out as
+/// `input`) to `buffer`: at the start, or where a replay starts.
+void add_first_observations(ReplayBuffer& buffer, const InputLayout& input,
+                            const Value& observations);
+
+/// Adds a vector env's `step` (SameStep autoreset) to `buffer`: for each env its transition
+/// (the action `unit_actions` row, float32 (num_envs, action_size) in [-1, 1]; the reward; the
+/// flags; the next observation, an ended episode's from infos["final_obs"]), then for an ended
+/// episode the next episode's first observation. Throws std::logic_error naming `learner` when
+/// an episode ended without infos["final_obs"].
+void add_env_step(ReplayBuffer& buffer, const InputLayout& input, const float* unit_actions,
+                  const vector::VectorStepResult& step, const std::string& learner);
 
 }  // namespace pixelgym::trainer
