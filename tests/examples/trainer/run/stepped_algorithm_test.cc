@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <numeric>
@@ -36,7 +37,7 @@ class CountingLearner final : public StepLearner {
  public:
   void begin(const Value& first) override {
     ++begins;
-    observed = observed * 31 + first.array().data<std::int64_t>()[0];
+    observed = observed * 31 + static_cast<std::uint64_t>(first.array().data<std::int64_t>()[0]);
   }
   void act(const Value&, std::int64_t env_steps, Value& actions) override {
     Array& batch = actions.array();
@@ -48,9 +49,11 @@ class CountingLearner final : public StepLearner {
   void observe(const Value& actions, const vector::VectorStepResult& step) override {
     ++observations;
     for (std::int64_t i = 0; i < step.rewards.shape()[0]; ++i) {
-      observed = observed * 31 + step.obs.array().data<std::int64_t>()[i] +
-                 actions.array().data<std::int64_t>()[i] +
-                 static_cast<std::int64_t>(step.rewards.data<double>()[i] * 100);
+      // Unsigned: the sum wraps around (defined) instead of overflowing.
+      observed = observed * 31 +
+                 static_cast<std::uint64_t>(step.obs.array().data<std::int64_t>()[i]) +
+                 static_cast<std::uint64_t>(actions.array().data<std::int64_t>()[i]) +
+                 static_cast<std::uint64_t>(std::llround(step.rewards.data<double>()[i] * 100));
     }
   }
   bool learn(std::int64_t env_steps, const StopCheck& stop) override {
@@ -71,7 +74,7 @@ class CountingLearner final : public StepLearner {
 
   int begins = 0;
   std::int64_t observations = 0;
-  std::int64_t observed = 0;
+  std::uint64_t observed = 0;
   std::int64_t updates = 0;
 
  private:
