@@ -46,6 +46,7 @@ std::uint64_t env_digest(const Value& observations, const std::vector<double>& e
 EnvLoop::EnvLoop(vector::VectorEnv& env, std::uint64_t seed, const std::string& episode_key)
     : env_(&env),
       episodes_(std::make_unique<vector::VectorWrapper>(env), 1, episode_key),
+      batch_bytes_(env.action_space().zeros().array().nbytes()),
       episode_key_(episode_key),
       seed_(seed) {}
 
@@ -78,9 +79,8 @@ std::vector<double> EnvLoop::ended_returns(const vector::VectorStepResult& step)
 }
 
 bool EnvLoop::action_log_covers(std::int64_t env_steps) const {
-  const auto batch_bytes = static_cast<std::int64_t>(env_->action_space().zeros().array().nbytes());
-  return static_cast<std::int64_t>(action_log_.size()) ==
-         env_steps / env_->num_envs() * batch_bytes;
+  return action_log_.size() ==
+         static_cast<std::size_t>(env_steps / env_->num_envs()) * batch_bytes_;
 }
 
 void EnvLoop::replay(const std::string& log, std::int64_t env_steps,
@@ -90,7 +90,7 @@ void EnvLoop::replay(const std::string& log, std::int64_t env_steps,
   if (started_) throw std::logic_error("EnvLoop::replay: the envs were already reset or stepped");
   Value actions = zero_actions();
   Array& batch = actions.array();
-  const std::size_t batch_bytes = batch.nbytes();
+  const std::size_t batch_bytes = batch_bytes_;
   const auto batches = static_cast<std::size_t>(env_steps / env_->num_envs());
   if (log.size() != batches * batch_bytes) {
     throw std::invalid_argument(

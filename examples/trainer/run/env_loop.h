@@ -71,6 +71,7 @@ class EnvLoop {
  private:
   vector::VectorEnv* env_;
   vector::RecordEpisodeStatistics episodes_;
+  std::size_t batch_bytes_;  // of one action batch
   std::string episode_key_;
   std::uint64_t seed_;
   Value observations_;

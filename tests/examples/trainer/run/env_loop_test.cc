@@ -12,17 +12,13 @@
 #include <vector>
 
 #include "pixelgym/envs/tasks/grid_world.h"
-#include "pixelgym/envs/vector/make_vec.h"
 #include "pixelgym/trainer/communicator.h"
+#include "tests/examples/trainer/run/grid_envs.h"
 
 namespace pixelgym::trainer {
 namespace {
 
-std::unique_ptr<vector::VectorEnv> grid_envs(int num_envs) {
-  vector::VectorOptions options;
-  options.autoreset = vector::AutoresetMode::kSameStep;
-  return vector::make_vec("GridWorld-v0", num_envs, {}, nullptr, options);
-}
+using test_envs::grid_envs;
 
 // Env i's action at batch t: down or right, in a pattern that differs between envs.
 void fill_actions(Value& actions, std::int64_t t) {

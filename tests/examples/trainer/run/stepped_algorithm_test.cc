@@ -14,16 +14,12 @@
 #include <vector>
 
 #include "pixelgym/envs/tasks/grid_world.h"
-#include "pixelgym/envs/vector/make_vec.h"
+#include "tests/examples/trainer/run/grid_envs.h"
 
 namespace pixelgym::trainer {
 namespace {
 
-std::unique_ptr<vector::VectorEnv> grid_envs(int num_envs) {
-  vector::VectorOptions options;
-  options.autoreset = vector::AutoresetMode::kSameStep;
-  return vector::make_vec("GridWorld-v0", num_envs, {}, nullptr, options);
-}
+using test_envs::grid_envs;
 
 class NoActor final : public Actor {
  public:
