@@ -5,9 +5,11 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pixelgym/envs/vector/vector_wrapper.h"
+#include "pixelgym/wrappers/return_scaling.h"
 #include "pixelgym/wrappers/running_statistics.h"
 
 namespace pixelgym::vector {
@@ -27,7 +29,8 @@ namespace pixelgym::vector {
 /// (Gymnasium releases up to 1.3.0 merge every row; its development version skips these rows
 /// too). So a batch of one env gives exactly the per-env wrapper's rewards and statistics.
 ///
-/// `set_update_statistics(false)` freezes the variance (for evaluation); `statistics()` /
+/// The arithmetic is wrappers::ReturnScaling's (which PPO's trainer also uses, without the
+/// wrapper). `set_update_statistics(false)` freezes the variance (for evaluation); `statistics()` /
 /// `set_statistics()` read and write it (RunningStatistics::to_value / from_value for
 /// checkpoints). Allocates nothing per step beyond copying non-empty infos (VectorWrapper).
 class NormalizeReward final : public VectorWrapper {
@@ -37,25 +40,29 @@ class NormalizeReward final : public VectorWrapper {
                            double epsilon = 1e-8);
 
   /// The discount of the returns R_i.
-  double gamma() const { return gamma_; }
+  double gamma() const { return scaling_.gamma(); }
   /// The constant added to the variance before its square root.
-  double epsilon() const { return epsilon_; }
+  double epsilon() const { return scaling_.epsilon(); }
   /// Each env's discounted return R_i of its current episode so far (num_envs entries).
-  const std::vector<double>& discounted_returns() const { return returns_; }
+  const std::vector<double>& discounted_returns() const { return scaling_.discounted_returns(); }
   /// Replaces them (restoring a checkpoint). Throws std::invalid_argument naming the wrapper
   /// unless `returns` has num_envs entries, all finite; nothing changes then.
-  void set_discounted_returns(std::vector<double> returns);
+  void set_discounted_returns(std::vector<double> returns) {
+    scaling_.set_discounted_returns(std::move(returns));
+  }
 
   /// Whether steps update the statistics (true at construction).
-  bool update_statistics() const { return update_statistics_; }
+  bool update_statistics() const { return scaling_.update_statistics(); }
   /// false freezes the variance (rewards are still scaled by it); true resumes.
-  void set_update_statistics(bool update) { update_statistics_ = update; }
+  void set_update_statistics(bool update) { scaling_.set_update_statistics(update); }
 
   /// The running statistics of the returns (one element).
-  const wrappers::RunningStatistics& statistics() const { return statistics_; }
+  const wrappers::RunningStatistics& statistics() const { return scaling_.statistics(); }
   /// Replaces them (restoring a checkpoint). Throws std::invalid_argument naming the wrapper when
   /// they are not valid statistics of one element; nothing changes then.
-  void set_statistics(wrappers::RunningStatistics statistics);
+  void set_statistics(wrappers::RunningStatistics statistics) {
+    scaling_.set_statistics(std::move(statistics));
+  }
 
  protected:
   std::string type_name() const override { return "NormalizeReward"; }
@@ -64,14 +71,10 @@ class NormalizeReward final : public VectorWrapper {
   const VectorStepResult& do_step(const Value& actions) override;
 
  private:
-  double gamma_;
-  double epsilon_;
-  bool update_statistics_ = true;
-  wrappers::RunningStatistics statistics_ = wrappers::RunningStatistics::initial(1);
-  std::vector<double> returns_;
-  std::vector<std::uint8_t> ended_;  // NextStep: env i's episode ended at the last step
-  std::vector<double> merged_;       // the returns one step merges (capacity num_envs)
-  Array rewards_;                    // float64 (num_envs,): the results' rewards
+  wrappers::ReturnScaling scaling_;
+  std::vector<std::uint8_t> ended_;      // env i's episode ended at the last step
+  std::vector<std::uint8_t> was_ended_;  // NextStep: ended_ of the step before (skipped rows)
+  Array rewards_;                        // float64 (num_envs,): the results' rewards
   VectorStepResult result_;
 };
 

@@ -24,8 +24,6 @@ using trainer::LoadedCheckpoint;
 namespace {
 
 using nlohmann::json;
-// The stats key of the learner's own RecordEpisodeStatistics (the env may record "episode").
-const char* const kEpisodeKey = "drq_episode";
 
 const DrqConfig& checked(const DrqConfig& config, const vector::VectorEnv& env) {
   config.validate();
@@ -215,7 +213,7 @@ int DrqAlgorithmFactory::set_threads(int requested) const {
 }
 
 std::unique_ptr<trainer::Algorithm> DrqAlgorithmFactory::make(
-    vector::VectorEnv& env, const json& config, trainer::Communicator& communicator) const {
+    trainer::EnvLoop& loop, const json& config, trainer::Communicator& communicator) const {
   if (communicator.world_size() > 1) {
     throw std::invalid_argument(
         "train --algo drq runs in one process; it was started as " +
@@ -225,8 +223,8 @@ std::unique_ptr<trainer::Algorithm> DrqAlgorithmFactory::make(
   DrqConfig parsed;
   from_json(config, parsed);
   return std::make_unique<trainer::SteppedAlgorithm>(
-      env, trainer::SteppedSettings{parsed.seed, parsed.iteration_env_steps, kEpisodeKey},
-      std::make_unique<DrqStepLearner>(env, parsed));
+      loop, trainer::SteppedSettings{parsed.iteration_env_steps},
+      std::make_unique<DrqStepLearner>(loop.env(), parsed));
 }
 
 std::unique_ptr<trainer::Actor> DrqAlgorithmFactory::load_actor(

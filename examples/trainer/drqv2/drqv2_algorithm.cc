@@ -23,8 +23,6 @@ using trainer::LoadedCheckpoint;
 namespace {
 
 using nlohmann::json;
-// The stats key of the learner's own RecordEpisodeStatistics (the env may record "episode").
-const char* const kEpisodeKey = "drqv2_episode";
 
 const DrqV2Config& checked(const DrqV2Config& config, const vector::VectorEnv& env) {
   config.validate();
@@ -214,7 +212,7 @@ int DrqV2AlgorithmFactory::set_threads(int requested) const {
 }
 
 std::unique_ptr<trainer::Algorithm> DrqV2AlgorithmFactory::make(
-    vector::VectorEnv& env, const json& config, trainer::Communicator& communicator) const {
+    trainer::EnvLoop& loop, const json& config, trainer::Communicator& communicator) const {
   if (communicator.world_size() > 1) {
     throw std::invalid_argument(
         "train --algo drqv2 runs in one process; it was started as " +
@@ -224,8 +222,8 @@ std::unique_ptr<trainer::Algorithm> DrqV2AlgorithmFactory::make(
   DrqV2Config parsed;
   from_json(config, parsed);
   return std::make_unique<trainer::SteppedAlgorithm>(
-      env, trainer::SteppedSettings{parsed.seed, parsed.iteration_env_steps, kEpisodeKey},
-      std::make_unique<DrqV2StepLearner>(env, parsed));
+      loop, trainer::SteppedSettings{parsed.iteration_env_steps},
+      std::make_unique<DrqV2StepLearner>(loop.env(), parsed));
 }
 
 std::unique_ptr<trainer::Actor> DrqV2AlgorithmFactory::load_actor(

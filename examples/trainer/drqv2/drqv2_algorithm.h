@@ -114,7 +114,7 @@ class DrqV2AlgorithmFactory final : public trainer::AlgorithmFactory {
   int set_threads(int requested) const override;
   /// Throws std::invalid_argument for a communicator of several ranks: DrQ-v2 trains in one
   /// process (its replay buffer and updates are not shared across ranks).
-  std::unique_ptr<trainer::Algorithm> make(vector::VectorEnv& env, const nlohmann::json& config,
+  std::unique_ptr<trainer::Algorithm> make(trainer::EnvLoop& loop, const nlohmann::json& config,
                                            trainer::Communicator& communicator) const override;
   /// An Agent of the config for these spaces with the checkpoint's "agent".
   std::unique_ptr<trainer::Actor> load_actor(

@@ -386,11 +386,22 @@ std::vector<trainer::MemoryUse> memory_estimate(const Space& observation_space,
 }
 
 Trainer::Trainer(vector::VectorEnv& env, PpoConfig config)
-    : Trainer(env, std::move(config), single_process_) {}
+    : Trainer(env, nullptr, std::move(config), single_process_) {}
 
 Trainer::Trainer(vector::VectorEnv& env, PpoConfig config, trainer::Communicator& communicator)
+    : Trainer(env, nullptr, std::move(config), communicator) {}
+
+Trainer::Trainer(trainer::EnvLoop& loop, PpoConfig config, trainer::Communicator& communicator)
+    : Trainer(loop.env(), &loop, std::move(config), communicator) {}
+
+Trainer::Trainer(vector::VectorEnv& env, trainer::EnvLoop* loop, PpoConfig config,
+                 trainer::Communicator& communicator)
     : config_(std::move(config)),
       policy_(make_policy(env, config_)),
+      reward_scaling_(static_cast<std::size_t>(config_.num_envs), config_.gamma, kRewardEpsilon,
+                      "Trainer"),
+      scaled_rewards_(static_cast<std::size_t>(config_.num_envs)),
+      ended_(static_cast<std::size_t>(config_.num_envs)),
       optimizer_(std::make_unique<torch::optim::Adam>(
           policy_->parameters(),
           torch::optim::AdamOptions(config_.learning_rate).eps(config_.adam_epsilon))),
@@ -402,13 +413,18 @@ Trainer::Trainer(vector::VectorEnv& env, PpoConfig config, trainer::Communicator
     throw std::invalid_argument("Trainer: the batched action space must be an array space, got " +
                                 env.action_space().to_string());
   }
-  auto episodes = std::make_unique<vector::RecordEpisodeStatistics>(
-      std::make_unique<vector::VectorWrapper>(env), 1, kEpisodeKey);
-  episodes_ = episodes.get();
-  normalizer_ =
-      std::make_unique<vector::NormalizeReward>(std::move(episodes), config_.gamma, kRewardEpsilon);
-  reward_statistics_before_ = normalizer_->statistics();
   communicator_ = &communicator;
+  if (loop == nullptr) {
+    own_loop_ = std::make_unique<trainer::EnvLoop>(env, env_seed(), kEpisodeKey);
+    loop = own_loop_.get();
+  } else if (loop->seed() != env_seed()) {
+    throw std::invalid_argument("Trainer: the env loop resets its envs with seed " +
+                                std::to_string(loop->seed()) + ", but rank " +
+                                std::to_string(communicator_->rank()) + "'s env seed is " +
+                                std::to_string(env_seed()) + " (config.seed + rank num_envs)");
+  }
+  loop_ = loop;
+  reward_statistics_before_ = reward_scaling_.statistics();
   if (alone()) return;
   const auto rank = static_cast<std::uint64_t>(communicator_->rank());
   sampling_ = at::detail::createCPUGenerator(config_.seed + rank * kRankSeedStride);
@@ -476,10 +492,10 @@ void Trainer::merge_statistics(
     policy_->set_observation_statistics(key, merged);
   }
   if (!config_.normalize_rewards) return;
-  wrappers::RunningStatistics merged = normalizer_->statistics();
+  wrappers::RunningStatistics merged = reward_scaling_.statistics();
   trainer::merge_statistics_across_ranks(*communicator_, rewards, merged,
                                          "the reward scaling's statistics");
-  normalizer_->set_statistics(merged);
+  reward_scaling_.set_statistics(merged);
   reward_statistics_before_ = std::move(merged);
 }
 
@@ -493,89 +509,43 @@ bool Trainer::preempted(std::int64_t steps_done) {
   return communicator_->rollouts_done(updates_) >= std::max(needed, 1);
 }
 
-vector::VectorEnv& Trainer::stepped() {
-  if (config_.normalize_rewards) return *normalizer_;
-  return *episodes_;
-}
-
-void Trainer::add_ended_episodes(const vector::VectorStepResult& step,
-                                 std::vector<Episode>& ended) const {
-  const std::string mask_key = std::string("_") + kEpisodeKey;
-  if (!step.infos.contains(mask_key)) return;
-  const bool* mask = step.infos.at(mask_key).array().data<bool>();
-  const ValueDict& stats = step.infos.at(kEpisodeKey).dict();
-  const double* returns = stats.at("r").array().data<double>();
-  const std::int64_t* lengths = stats.at("l").array().data<std::int64_t>();
-  for (std::int64_t i = 0; i < config_.num_envs; ++i) {
-    if (mask[i]) ended.push_back({returns[i], lengths[i]});
-  }
-}
-
 void Trainer::replay_env(const std::string& env_action_log) {
-  if (started_) {
+  if (loop_->started()) {
     throw std::logic_error("Trainer::replay_env: the envs were already reset or stepped");
   }
-  Array& env_actions = actions_.array();
-  const std::size_t batch_bytes = env_actions.nbytes();
   // Distributed, a rank's own steps are not env_steps_ (every rank's), nor its share when
   // stragglers were preempted: its log holds whole batches.
-  const bool distributed = !alone();
-  const auto batches = distributed ? env_action_log.size() / batch_bytes
-                                   : static_cast<std::size_t>(env_steps_ / config_.num_envs);
-  if (env_action_log.size() != batches * batch_bytes) {
-    throw std::invalid_argument("Trainer::replay_env: an action log of " + std::to_string(batches) +
-                                " batches of " + std::to_string(batch_bytes) + " bytes (" +
-                                std::to_string(batches * batch_bytes) + " bytes, for " +
-                                std::to_string(env_steps_) + " env steps) expected, got " +
-                                std::to_string(env_action_log.size()) + " bytes");
-  }
-  torch::NoGradGuard no_grad;
-  // Below the reward normalization, whose state comes from the checkpoint.
-  current_obs_ = observation_tensors(episodes_->reset(env_seed()).obs);
-  started_ = true;
-  for (std::size_t b = 0; b < batches; ++b) {
-    std::memcpy(env_actions.raw_data(), env_action_log.data() + b * batch_bytes, batch_bytes);
-    current_obs_ = observation_tensors(episodes_->step(actions_).obs);
-  }
-  env_action_log_ = env_action_log;
+  const std::int64_t steps =
+      alone() ? env_steps_
+              : static_cast<std::int64_t>(env_action_log.size() / loop_->batch_bytes()) *
+                    config_.num_envs;
+  // No policy and no reward statistics: those come from the checkpoint.
+  loop_->replay(
+      env_action_log, steps, [](const Value& /*first*/) {},
+      [](const Value& /*actions*/, const vector::VectorStepResult& /*step*/) {});
   log_from_start_ = true;
 }
 
 bool Trainer::env_action_log_complete() const {
   if (!alone()) return log_from_start_;
-  const auto batches = static_cast<std::size_t>(env_steps_ / config_.num_envs);
-  return env_action_log_.size() == batches * actions_.array().nbytes();
+  return loop_->action_log_covers(env_steps_);
 }
 
-std::uint64_t Trainer::env_digest() const {
-  if (!started_) return 0;
-  std::uint64_t digest = trainer::fnv1a(nullptr, 0);
-  const auto add = [&digest](const void* data, std::size_t size) {
-    digest = trainer::fnv1a(data, size, digest);
-  };
-  for (const auto& [key, tensor] : current_obs_) {  // std::map: in key order
-    add(key.data(), key.size());
-    const torch::Tensor contiguous = tensor.contiguous();
-    add(contiguous.data_ptr(), contiguous.nbytes());
-  }
-  const std::vector<double>& returns = episodes_->episode_returns();
-  const std::vector<std::int64_t>& lengths = episodes_->episode_lengths();
-  add(returns.data(), returns.size() * sizeof(double));
-  add(lengths.data(), lengths.size() * sizeof(std::int64_t));
-  return digest;
-}
+std::uint64_t Trainer::env_digest() const { return loop_->digest(); }
 
 bool Trainer::alone() const { return communicator_->world_size() == 1; }
 
 RolloutStats Trainer::collect(const trainer::StopCheck& stop) {
   torch::NoGradGuard no_grad;
   RolloutStats stats;
-  if (!started_) {
+  if (!loop_->started()) {
     const auto start = Clock::now();
-    current_obs_ = observation_tensors(stepped().reset(env_seed()).obs);
+    loop_->reset();
+    if (config_.normalize_rewards) reward_scaling_.reset();
     stats.env_seconds += seconds_since(start);
-    started_ = true;
   }
+  // Views of the loop's observation batch (also after a replay of the loop's actions).
+  current_obs_ = observation_tensors(loop_->observations());
   Array& env_actions = actions_.array();
   const std::int64_t envs = config_.num_envs;
   std::int64_t steps = 0;
@@ -595,15 +565,23 @@ RolloutStats Trainer::collect(const trainer::StopCheck& stop) {
                              env_actions.to_string());
     }
     std::memcpy(env_actions.raw_data(), env_action.data_ptr(), env_actions.nbytes());
-    env_action_log_.append(static_cast<const char*>(env_actions.raw_data()), env_actions.nbytes());
 
     start = Clock::now();
-    const vector::VectorStepResult& step = stepped().step(actions_);
+    const vector::VectorStepResult& step = loop_->step(actions_);
     stats.env_seconds += seconds_since(start);
     const double* rewards = step.rewards.data<double>();
     const bool* terminated = step.terminated.data<bool>();
     const bool* truncated = step.truncated.data<bool>();
-    add_ended_episodes(step, stats.episodes);
+    if (config_.normalize_rewards) {
+      for (std::int64_t n = 0; n < envs; ++n) {
+        ended_[static_cast<std::size_t>(n)] = terminated[n] || truncated[n] ? 1 : 0;
+      }
+      reward_scaling_.scale(rewards, ended_.data(), nullptr, scaled_rewards_.data());
+      rewards = scaled_rewards_.data();
+    }
+    for (const trainer::EndedEpisode& episode : loop_->ended_episodes(step)) {
+      stats.episodes.push_back({episode.episode_return, episode.length});
+    }
     // The storage tensors are contiguous (T, N): row t starts at t * N.
     float* stored_rewards = storage_.rewards.data_ptr<float>() + t * envs;
     std::uint8_t* stored_terminated = storage_.terminated.data_ptr<std::uint8_t>() + t * envs;
@@ -915,7 +893,7 @@ void Trainer::set_progress(std::int64_t env_steps, std::int64_t updates) {
   }
   env_steps_ = env_steps;
   updates_ = updates;
-  log_from_start_ = env_steps == 0 && env_action_log_.empty();
+  log_from_start_ = env_steps == 0 && loop_->action_log().empty();
 }
 
 void Trainer::load_rollout(const RolloutStorage& rollout) {
@@ -944,7 +922,7 @@ void Trainer::load_rollout(const RolloutStorage& rollout) {
 }
 
 RewardScaling Trainer::reward_scaling() const {
-  return {normalizer_->statistics(), normalizer_->discounted_returns()};
+  return {reward_scaling_.statistics(), reward_scaling_.discounted_returns()};
 }
 
 void Trainer::set_reward_scaling(RewardScaling scaling) {
@@ -964,8 +942,8 @@ void Trainer::set_reward_scaling(RewardScaling scaling) {
     }
   }
   reward_statistics_before_ = scaling.statistics;
-  normalizer_->set_statistics(std::move(scaling.statistics));
-  normalizer_->set_discounted_returns(std::move(scaling.returns));
+  reward_scaling_.set_statistics(std::move(scaling.statistics));
+  reward_scaling_.set_discounted_returns(std::move(scaling.returns));
 }
 
 TrainerRngState Trainer::rng_state() const {

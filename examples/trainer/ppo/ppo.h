@@ -16,10 +16,10 @@
 #include "pixelgym/envs/vector/vector_env.h"
 #include "pixelgym/trainer/algorithm.h"
 #include "pixelgym/trainer/communicator.h"
+#include "pixelgym/trainer/env_loop.h"
 #include "pixelgym/trainer/memory_budget.h"
+#include "pixelgym/wrappers/return_scaling.h"
 #include "pixelgym/wrappers/running_statistics.h"
-#include "pixelgym/wrappers/vector/normalize_reward.h"
-#include "pixelgym/wrappers/vector/record_episode_statistics.h"
 
 namespace pixelgym::ppo {
 
@@ -55,10 +55,10 @@ struct PpoConfig {
   /// Standardize advantages within each minibatch.
   bool normalize_advantages = true;
   /// Learn from rewards divided by the running standard deviation of the discounted returns
-  /// (vector::NormalizeReward's rule, kept inside the trainer so that Episode returns stay the
-  /// env's own; see Trainer). Without it the value targets are on the env's scale (hundreds on
-  /// the 1000-step control tasks), and clip_value_loss lets the value move only clip_range per
-  /// update towards them.
+  /// (vector::NormalizeReward's rule, wrappers::ReturnScaling, applied inside the trainer so that
+  /// Episode returns stay the env's own; see Trainer). Without it the value targets are on the
+  /// env's scale (hundreds on the 1000-step control tasks), and clip_value_loss lets the value move
+  /// only clip_range per update towards them.
   bool normalize_rewards = true;
   /// The surrogate's clip range epsilon: the ratio is clipped to [1 - eps, 1 + eps].
   double clip_range = 0.2;
@@ -216,9 +216,10 @@ struct RewardScaling {
 /// from another seeded with config.seed + 1; the envs reset with config.seed on the first
 /// collect(). Same seed, same env, same torch thread count: same parameters.
 ///
-/// The trainer steps the env through vector wrappers of its own: a vector::RecordEpisodeStatistics
-/// (its Episode records and env_digest's episodes in progress), and, with config.normalize_rewards,
-/// a vector::NormalizeReward (gamma config.gamma, epsilon 1e-8) over that: the rollout stores
+/// The trainer steps the env through a trainer::EnvLoop (the run's, or one of its own), which
+/// keeps the action log, the env digest and the Episode records (its RecordEpisodeStatistics sees
+/// the env's rewards). With config.normalize_rewards the trainer scales the rewards it stores as
+/// vector::NormalizeReward would (wrappers::ReturnScaling, gamma config.gamma, epsilon 1e-8):
 /// r_i / sqrt(var + 1e-8) of the discounted returns R_i = gamma R_i + r_i, R_i restarting after a
 /// step that ends env i's episode. Values, advantages and returns are on that scale;
 /// RolloutStats's Episode returns are the env's.
@@ -244,11 +245,16 @@ class Trainer {
  public:
   /// Throws std::invalid_argument when config.validate() fails, when the env's autoreset mode
   /// is not SameStep or its num_envs differs from config.num_envs, and as Policy's constructor.
-  /// This constructor trains in one process (a trainer::SingleProcessCommunicator of its own).
+  /// This constructor trains in one process (a trainer::SingleProcessCommunicator of its own),
+  /// stepping `env` through an EnvLoop of its own.
   Trainer(vector::VectorEnv& env, PpoConfig config);
   /// As one rank of `communicator`'s run, which must outlive the trainer; every rank must
   /// construct its trainer with the same config.
   Trainer(vector::VectorEnv& env, PpoConfig config, trainer::Communicator& communicator);
+  /// Steps the envs of `loop` (a training run's; it must outlive the trainer). Throws
+  /// std::invalid_argument, as the others, and when the loop's seed is not this rank's env seed
+  /// (config.seed + rank num_envs).
+  Trainer(trainer::EnvLoop& loop, PpoConfig config, trainer::Communicator& communicator);
   /// Not copied or moved: it points at its own communicator when it trains alone.
   Trainer(const Trainer&) = delete;
   Trainer& operator=(const Trainer&) = delete;
@@ -317,7 +323,7 @@ class Trainer {
   /// seed and their actions), which is how a checkpoint carries the envs: see replay_env. Its
   /// size is env_steps() x the bytes of one env's action (4 MB per million env steps of a
   /// one-dimensional float32 action).
-  const std::string& env_action_log() const { return env_action_log_; }
+  const std::string& env_action_log() const { return loop_->action_log(); }
   /// Whether env_action_log covers every env step done (false after set_progress without
   /// replay_env: a resume from a checkpoint that kept no actions).
   bool env_action_log_complete() const;
@@ -327,7 +333,7 @@ class Trainer {
   /// so that the next collect() continues the episodes in progress and the run goes on exactly
   /// as if it had not stopped. Call it after set_progress, before collect(). Throws
   /// std::invalid_argument, naming both sizes, when the log is not env_steps() / num_envs
-  /// batches, and std::logic_error after a collect().
+  /// batches (EnvLoop::replay), and std::logic_error after a collect().
   void replay_env(const std::string& env_action_log);
   /// A 64-bit digest (FNV-1a) of where the envs are: the bytes of the current observation
   /// batch and the returns and lengths of the episodes in progress; 0 before the envs are reset.
@@ -364,8 +370,9 @@ class Trainer {
                         const MinibatchPosition& at, UpdateStats& stats);
   // Averages the sums over the minibatches; the explained variance of the rollout.
   void finish_update_stats(UpdateStats& stats);
-  // The env the trainer steps: normalizer_ when it normalizes rewards, else episodes_.
-  vector::VectorEnv& stepped();
+  // The constructors' work: steps `loop`, or an EnvLoop of its own over `env` when null.
+  Trainer(vector::VectorEnv& env, trainer::EnvLoop* loop, PpoConfig config,
+          trainer::Communicator& communicator);
   // This rank's env seed (config seed + rank num_envs).
   std::uint64_t env_seed() const;
   // Distributed: sums `value` over the ranks (one all-reduce); alone: `value`.
@@ -379,31 +386,30 @@ class Trainer {
   bool preempted(std::int64_t steps_done);
   // Whether the trainer runs alone (no communicator of several ranks).
   bool alone() const;
-  // Appends the episodes that `step` ended (episodes_'s infos) to `ended`.
-  void add_ended_episodes(const vector::VectorStepResult& step, std::vector<Episode>& ended) const;
 
-  // The trainer's wrappers over the given env: normalizer_ owns episodes_, which borrows the env.
-  std::unique_ptr<vector::NormalizeReward> normalizer_;
-  vector::RecordEpisodeStatistics* episodes_;
+  // The loop the trainer steps: own_loop_ when it was given none.
+  std::unique_ptr<trainer::EnvLoop> own_loop_;
+  trainer::EnvLoop* loop_ = nullptr;
   PpoConfig config_;
   std::shared_ptr<Policy> policy_;
+  wrappers::ReturnScaling reward_scaling_;  // config.normalize_rewards
+  std::vector<double> scaled_rewards_;      // one step's, scaled (num_envs)
+  std::vector<std::uint8_t> ended_;         // one step's terminated or truncated (num_envs)
   std::unique_ptr<torch::optim::Adam> optimizer_;
   RolloutStorage storage_;
   at::Generator sampling_;
   at::Generator augmentation_;
   Value actions_;                   // laid out as env_.action_space()
   ObservationTensors current_obs_;  // views of the env's observation batch
-  std::string env_action_log_;
   // The one-process communicator, when the trainer was not given one.
   trainer::SingleProcessCommunicator single_process_;
   trainer::Communicator* communicator_;  // never null: &single_process_ or the one given
   MinibatchOrder minibatch_order_;
   std::int64_t collected_steps_ = 0;     // steps per env of the last rollout (<= num_steps)
   std::int64_t last_rollout_steps_ = 0;  // env steps of every rank in the last rollout
-  bool log_from_start_ = true;           // env_action_log_ goes back to the first reset
+  bool log_from_start_ = true;           // the loop's action log goes back to the first reset
   double collective_seconds_ = 0.0;      // in collectives during the current update
   wrappers::RunningStatistics reward_statistics_before_;  // as of the last update (distributed)
-  bool started_ = false;
   bool collected_ = false;
   std::int64_t env_steps_ = 0;
   std::int64_t updates_ = 0;

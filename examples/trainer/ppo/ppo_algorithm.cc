@@ -44,9 +44,9 @@ ActCounts PpoActor::act(const Value& observations, bool deterministic, Value& ac
   return counts;
 }
 
-PpoAlgorithm::PpoAlgorithm(vector::VectorEnv& env, PpoConfig config,
+PpoAlgorithm::PpoAlgorithm(trainer::EnvLoop& loop, PpoConfig config,
                            trainer::Communicator& communicator)
-    : trainer_(env, std::move(config), communicator), actor_(trainer_.policy_ptr()) {}
+    : trainer_(loop, std::move(config), communicator), actor_(trainer_.policy_ptr()) {}
 
 std::vector<std::string> PpoAlgorithm::rank_blobs() const {
   return {"rng_sampling", "rng_augmentation"};
@@ -116,10 +116,6 @@ void PpoAlgorithm::restore(const LoadedCheckpoint& checkpoint, const json& meta)
   trainer_.set_reward_scaling(std::move(scaling));
 }
 
-void PpoAlgorithm::replay_env(const std::string& env_action_log) {
-  trainer_.replay_env(env_action_log);
-}
-
 json PpoAlgorithmFactory::parse_config(const std::string& text) const {
   return json::parse(config_to_json(config_from_json(text)));
 }
@@ -128,9 +124,9 @@ int PpoAlgorithmFactory::set_threads(int requested) const {
   return trainer::set_torch_threads(requested);
 }
 
-std::unique_ptr<Algorithm> PpoAlgorithmFactory::make(vector::VectorEnv& env, const json& config,
+std::unique_ptr<Algorithm> PpoAlgorithmFactory::make(trainer::EnvLoop& loop, const json& config,
                                                      trainer::Communicator& communicator) const {
-  return std::make_unique<PpoAlgorithm>(env, config_from_json(config.dump()), communicator);
+  return std::make_unique<PpoAlgorithm>(loop, config_from_json(config.dump()), communicator);
 }
 
 std::unique_ptr<Actor> PpoAlgorithmFactory::load_actor(const Space& observation_space,

@@ -39,8 +39,8 @@ class PpoActor final : public trainer::Actor {
 /// in one process).
 class PpoAlgorithm final : public trainer::Algorithm {
  public:
-  /// Throws as Trainer's constructor.
-  PpoAlgorithm(vector::VectorEnv& env, PpoConfig config, trainer::Communicator& communicator);
+  /// Steps the run's `loop`. Throws as Trainer's constructor.
+  PpoAlgorithm(trainer::EnvLoop& loop, PpoConfig config, trainer::Communicator& communicator);
 
   trainer::IterationStats iterate(const trainer::StopCheck& stop) override;
   std::int64_t env_steps() const override { return trainer_.env_steps(); }
@@ -49,10 +49,6 @@ class PpoAlgorithm final : public trainer::Algorithm {
   std::vector<std::string> metric_names() const override;
   void save(trainer::CheckpointBlobs& blobs, nlohmann::json& meta) override;
   void restore(const trainer::LoadedCheckpoint& checkpoint, const nlohmann::json& meta) override;
-  const std::string& env_action_log() const override { return trainer_.env_action_log(); }
-  bool env_action_log_complete() const override { return trainer_.env_action_log_complete(); }
-  void replay_env(const std::string& env_action_log) override;
-  std::uint64_t env_digest() const override { return trainer_.env_digest(); }
   trainer::Actor& actor() override { return actor_; }
   std::uint64_t parameter_digest() const override { return trainer_.parameter_digest(); }
   /// The generators' states: "rng_sampling", "rng_augmentation" (the reward scaling's
@@ -74,7 +70,7 @@ class PpoAlgorithmFactory final : public trainer::AlgorithmFactory {
   /// trainer::set_torch_threads.
   int set_threads(int requested) const override;
   /// Trains distributed (see Trainer) with a communicator of several ranks.
-  std::unique_ptr<trainer::Algorithm> make(vector::VectorEnv& env, const nlohmann::json& config,
+  std::unique_ptr<trainer::Algorithm> make(trainer::EnvLoop& loop, const nlohmann::json& config,
                                            trainer::Communicator& communicator) const override;
   /// A Policy of config["policy"] with the checkpoint's "model", in eval mode.
   std::unique_ptr<trainer::Actor> load_actor(

@@ -1,6 +1,7 @@
 // The learning algorithm as a training run sees it (TrainingRun): what every algorithm offers the
-// run — iterate, its state for checkpoints, its config and the metrics it reports by name, and an
-// Actor for evaluation — without torch, so that the run stays algorithm- and torch-free.
+// run — iterate over the run's env loop, its state for checkpoints, its config and the metrics it
+// reports by name, and an Actor for evaluation — without torch, so that the run stays algorithm-
+// and torch-free.
 #pragma once
 
 #include <cstdint>
@@ -16,6 +17,7 @@
 #include "pixelgym/envs/vector/vector_env.h"
 #include "pixelgym/trainer/checkpoint_file.h"
 #include "pixelgym/trainer/communicator.h"
+#include "pixelgym/trainer/env_loop.h"
 #include "pixelgym/trainer/progress_csv.h"
 
 namespace pixelgym::trainer {
@@ -56,12 +58,13 @@ struct IterationStats {
 using StopCheck = std::function<bool(std::int64_t env_steps)>;
 
 /// A learning algorithm on a vector env, driven by a TrainingRun: the run calls iterate() until
-/// its budget is spent, and checkpoints, resumes and evaluates through the calls below. An
-/// algorithm that learns env step by env step need not step the env itself: SteppedAlgorithm
-/// (stepped_algorithm.h) is this interface over a StepLearner's act / observe / learn, with the
-/// env loop, action log, replay and digest written once (DrQ and DrQ-v2 are made so; PPO still
-/// steps its env in its rollouts). The algorithm keeps a reference to the env it was built on
-/// (AlgorithmFactory::make) and is the only one to step it.
+/// its budget is spent, and checkpoints, resumes and evaluates through the calls below. The env
+/// loop is the run's: it owns an EnvLoop (env_loop.h: the seeded reset, the action log, its
+/// replay on resume, the env digest and the episode statistics) and lends it to the algorithm
+/// (AlgorithmFactory::make), which steps the envs only through it. An algorithm that learns env
+/// step by env step need not step it at all: SteppedAlgorithm (stepped_algorithm.h) is this
+/// interface over a StepLearner's act / observe / learn (DrQ and DrQ-v2 are made so); PPO steps
+/// the loop in its rollouts.
 class Algorithm {
  public:
   virtual ~Algorithm() = default;
@@ -74,7 +77,7 @@ class Algorithm {
   /// checkpoints by them, and records them as "updates").
   virtual std::int64_t env_steps() const = 0;
   virtual std::int64_t updates() const = 0;
-  /// Sets both on resume, before restore() and replay_env().
+  /// Sets both on resume, before restore() and the replay of the env actions.
   virtual void set_progress(std::int64_t env_steps, std::int64_t updates) = 0;
 
   /// The names of the metrics it reports (IterationStats::metrics), in order: progress.csv's
@@ -90,19 +93,12 @@ class Algorithm {
   /// needs that is not there.
   virtual void restore(const LoadedCheckpoint& checkpoint, const nlohmann::json& meta) = 0;
 
-  /// Every action batch sent to the env since its first reset, as bytes: with the config's seed
-  /// it determines where the envs are (see ppo::Trainer::env_action_log).
-  virtual const std::string& env_action_log() const = 0;
-  /// Whether env_action_log covers every env step done (false after set_progress without
-  /// replay_env).
-  virtual bool env_action_log_complete() const = 0;
-  /// Brings the envs to where they were when `env_action_log` was taken (reset with the config's
-  /// seed, then the logged batches). Call it after set_progress, before iterate(). Throws
-  /// std::invalid_argument when the log does not match env_steps().
-  virtual void replay_env(const std::string& env_action_log) = 0;
-  /// A digest of where the envs are (observations and episodes in progress); 0 before the first
-  /// reset. Equal digests after a replay: the envs are where the checkpoint's were.
-  virtual std::uint64_t env_digest() const = 0;
+  /// A resume replays the checkpoint's env actions through the run's EnvLoop (so that the envs
+  /// continue their episodes): the envs' first observations, then each replayed step with the
+  /// actions it took. An algorithm that keeps what it sees (a replay buffer) takes them in here;
+  /// by default it keeps nothing. Called after set_progress and restore, before iterate().
+  virtual void replayed_reset(const Value& /*observations*/) {}
+  virtual void replayed_step(const Value& /*actions*/, const vector::VectorStepResult& /*step*/) {}
 
   /// The policy as trained so far, for evaluation.
   virtual Actor& actor() = 0;
@@ -134,12 +130,13 @@ class AlgorithmFactory {
   /// Sets the threads the algorithm computes with in this process, `requested` or, when 0, its
   /// default; returns the count in use.
   virtual int set_threads(int requested) const = 0;
-  /// The algorithm, to train on `env` (SameStep autoreset, config["num_envs"] envs) with
+  /// The algorithm, to train on the envs of `loop` (SameStep autoreset, config["num_envs"] envs,
+  /// reset with config["seed"] + rank num_envs; the loop must outlive the algorithm) with
   /// `config` (as parse_config gives it), as one rank of `communicator`'s run (a
   /// SingleProcessCommunicator for one process; it must outlive the algorithm). Throws
   /// std::invalid_argument for an env it cannot train on, or a communicator of several ranks
   /// when it does not train distributed.
-  virtual std::unique_ptr<Algorithm> make(vector::VectorEnv& env, const nlohmann::json& config,
+  virtual std::unique_ptr<Algorithm> make(EnvLoop& loop, const nlohmann::json& config,
                                           Communicator& communicator) const = 0;
   /// The policy saved in `checkpoint`, for an env of these spaces, to act only. Throws
   /// std::runtime_error naming checkpoint.path when a blob it needs is not there.

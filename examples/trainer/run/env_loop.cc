@@ -66,16 +66,25 @@ const vector::VectorStepResult& EnvLoop::step(const Value& actions) {
   return result;
 }
 
-std::vector<double> EnvLoop::ended_returns(const vector::VectorStepResult& step) const {
-  std::vector<double> ended;
+std::vector<EndedEpisode> EnvLoop::ended_episodes(const vector::VectorStepResult& step) const {
+  std::vector<EndedEpisode> ended;
   const std::string mask_key = "_" + episode_key_;
   if (!step.infos.contains(mask_key)) return ended;
   const bool* mask = step.infos.at(mask_key).array().data<bool>();
-  const double* returns = step.infos.at(episode_key_).dict().at("r").array().data<double>();
+  const ValueDict& stats = step.infos.at(episode_key_).dict();
+  const double* returns = stats.at("r").array().data<double>();
+  const std::int64_t* lengths = stats.at("l").array().data<std::int64_t>();
   for (std::int64_t e = 0; e < env_->num_envs(); ++e) {
-    if (mask[e]) ended.push_back(returns[e]);
+    if (mask[e]) ended.push_back({returns[e], lengths[e]});
   }
   return ended;
+}
+
+std::vector<double> EnvLoop::ended_returns(const vector::VectorStepResult& step) const {
+  std::vector<double> returns;
+  for (const EndedEpisode& episode : ended_episodes(step))
+    returns.push_back(episode.episode_return);
+  return returns;
 }
 
 bool EnvLoop::action_log_covers(std::int64_t env_steps) const {

@@ -25,10 +25,16 @@ namespace pixelgym::trainer {
 std::uint64_t env_digest(const Value& observations, const std::vector<double>& episode_returns,
                          const std::vector<std::int64_t>& episode_lengths);
 
-/// Steps a vector env for a training run: resets it with `seed` (env i with seed + i), steps it
-/// with the action batches it is given, keeps each batch in its action log and records the
-/// episodes (a RecordEpisodeStatistics of its own over the env, so that the env may record its
-/// own). The env must outlive it.
+/// An episode that ended: its return (the sum of the env's rewards) and its length in steps.
+struct EndedEpisode {
+  double episode_return = 0.0;
+  std::int64_t length = 0;
+};
+
+/// Steps a vector env for a training run (TrainingRun owns one and lends it to the algorithm):
+/// resets it with `seed` (env i with seed + i), steps it with the action batches it is given, keeps
+/// each batch in its action log and records the episodes (a RecordEpisodeStatistics of its own over
+/// the env, so that the env may record its own). The env must outlive it.
 class EnvLoop {
  public:
   /// Observes `env` (not owned). `episode_key` is the infos key of its episode statistics.
@@ -41,7 +47,9 @@ class EnvLoop {
   /// Steps the envs with `actions` (laid out as the env's action_space()) and appends them to
   /// the log. Throws std::logic_error before reset().
   const vector::VectorStepResult& step(const Value& actions);
-  /// The returns of the episodes that `step` (this loop's last step) ended, in env order.
+  /// The episodes that `step` (this loop's last step) ended, in env order.
+  std::vector<EndedEpisode> ended_episodes(const vector::VectorStepResult& step) const;
+  /// Their returns alone.
   std::vector<double> ended_returns(const vector::VectorStepResult& step) const;
 
   /// The observations the envs are at (the last reset's or step's); an empty Value before
@@ -52,6 +60,11 @@ class EnvLoop {
   /// The env batches stepped since the first reset (replayed ones included).
   std::int64_t batches() const { return batches_; }
   std::int64_t num_envs() const { return env_->num_envs(); }
+  /// The env it steps, and the seed it resets it with (env i with seed + i).
+  vector::VectorEnv& env() const { return *env_; }
+  std::uint64_t seed() const { return seed_; }
+  /// The bytes of one action batch in the log.
+  std::size_t batch_bytes() const { return batch_bytes_; }
 
   /// Every action batch sent to the envs since their first reset, as bytes.
   const std::string& action_log() const { return action_log_; }

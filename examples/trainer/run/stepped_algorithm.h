@@ -1,6 +1,6 @@
-// An Algorithm whose env loop is the run's: a StepLearner acts, observes each env step and
-// learns when it is due, and SteppedAlgorithm steps the env for it through an EnvLoop (the action
-// log, replay, digest and episode returns written once). DrQ and DrQ-v2 are StepLearners; an
+// An Algorithm that steps the run's env loop for a learner: a StepLearner acts, observes each env
+// step and learns when it is due, and SteppedAlgorithm steps the run's EnvLoop for it (the action
+// log, replay, digest and episode returns are the loop's). DrQ and DrQ-v2 are StepLearners; an
 // algorithm outside the tree can be one too, without torch.
 #pragma once
 
@@ -55,25 +55,20 @@ class StepLearner {
 
 /// What SteppedAlgorithm needs of the run's config.
 struct SteppedSettings {
-  /// Seeds the envs (env i resets with seed + i).
-  std::uint64_t seed = 0;
   /// Env steps (all envs together) of one iteration: a progress.csv row, and the unit of
   /// checkpoint_every. A multiple of the env's num_envs.
   std::int64_t iteration_env_steps = 0;
-  /// The infos key of the loop's episode statistics.
-  std::string episode_key = "run_episode";
 };
 
-/// An Algorithm made of an EnvLoop and a StepLearner. iterate() takes
+/// An Algorithm made of the run's EnvLoop and a StepLearner. iterate() takes
 /// settings.iteration_env_steps env steps; each: act, step the envs, observe, learn. `stop` is
 /// asked after each env step (through learn, after each update): once it answers true the
 /// iteration ends there. Its metrics are the learner's.
 class SteppedAlgorithm final : public Algorithm {
  public:
-  /// Throws std::invalid_argument for a null learner or an iteration that is not a positive
-  /// multiple of the env's num_envs.
-  SteppedAlgorithm(vector::VectorEnv& env, SteppedSettings settings,
-                   std::unique_ptr<StepLearner> learner);
+  /// Steps `loop` (not owned; it must outlive the algorithm). Throws std::invalid_argument for
+  /// a null learner or an iteration that is not a positive multiple of the env's num_envs.
+  SteppedAlgorithm(EnvLoop& loop, SteppedSettings settings, std::unique_ptr<StepLearner> learner);
 
   IterationStats iterate(const StopCheck& stop) override;
   std::int64_t env_steps() const override { return env_steps_; }
@@ -84,10 +79,11 @@ class SteppedAlgorithm final : public Algorithm {
   void restore(const LoadedCheckpoint& checkpoint, const nlohmann::json& meta) override {
     learner_->restore(checkpoint, meta);
   }
-  const std::string& env_action_log() const override { return loop_.action_log(); }
-  bool env_action_log_complete() const override { return loop_.action_log_covers(env_steps_); }
-  void replay_env(const std::string& env_action_log) override;
-  std::uint64_t env_digest() const override { return loop_.digest(); }
+  /// The learner begins and observes the replayed steps (a replay buffer refills).
+  void replayed_reset(const Value& observations) override { learner_->begin(observations); }
+  void replayed_step(const Value& actions, const vector::VectorStepResult& step) override {
+    learner_->observe(actions, step);
+  }
   Actor& actor() override { return learner_->actor(); }
   std::uint64_t parameter_digest() const override { return learner_->parameter_digest(); }
 
@@ -95,7 +91,7 @@ class SteppedAlgorithm final : public Algorithm {
 
  private:
   SteppedSettings settings_;
-  EnvLoop loop_;
+  EnvLoop* loop_;
   std::unique_ptr<StepLearner> learner_;
   Value actions_;
   std::int64_t env_steps_ = 0;

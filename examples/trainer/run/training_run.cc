@@ -467,7 +467,11 @@ std::optional<json> TrainingRun::train() {
       if (checkpoint_ || restart_) throw;
       throw RunRequestError(error.what());
     }
-    algorithm_ = factory_->make(*env_, settings_.algorithm_config, *communicator_);
+    const auto rank = static_cast<std::uint64_t>(communicator_->rank());
+    loop_ = std::make_unique<EnvLoop>(
+        *env_, settings_.seed() + rank * static_cast<std::uint64_t>(settings_.num_envs()),
+        "run_episode");
+    algorithm_ = factory_->make(*loop_, settings_.algorithm_config, *communicator_);
   } catch (...) {
     // Refused before anything was written (an env it cannot train on, settings that do not fit
     // in memory): a new run leaves no folder behind, only the lock it took.
@@ -546,6 +550,7 @@ void TrainingRun::restore_from_checkpoint() {
 void TrainingRun::replay_env_actions() {
   const auto actions = checkpoint_->blobs.find("env_actions");
   if (actions == checkpoint_->blobs.end()) {
+    env_log_complete_ = algorithm_->env_steps() == 0;
     output_.out << "the checkpoint has no env actions (written before they were kept): the envs "
                    "start new episodes\n";
     return;
@@ -553,14 +558,25 @@ void TrainingRun::replay_env_actions() {
   // The envs continue their episodes where the checkpoint left them, so the resumed run is the
   // run that did not stop (same parameters, update for update).
   const auto replay_start = std::chrono::steady_clock::now();
-  algorithm_->replay_env(actions->second);
+  // Distributed, a rank's own steps are not env_steps (every rank's), nor its share when
+  // stragglers were preempted: its log holds whole batches of its own.
+  const std::string& log = actions->second;
+  const std::int64_t steps =
+      distributed()
+          ? static_cast<std::int64_t>(log.size() / loop_->batch_bytes()) * loop_->num_envs()
+          : algorithm_->env_steps();
+  loop_->replay(
+      log, steps, [this](const Value& first) { algorithm_->replayed_reset(first); },
+      [this](const Value& taken, const vector::VectorStepResult& step) {
+        algorithm_->replayed_step(taken, step);
+      });
   output_.out << "replayed the " << algorithm_->env_steps() << " env steps of the checkpoint in "
               << std::fixed << std::setprecision(1) << seconds_since(replay_start)
               << std::defaultfloat << std::setprecision(6)
               << " s: the envs continue their episodes\n";
   // Absent or 0 (a checkpoint taken before the envs were first reset): nothing to compare.
   const std::uint64_t digest = meta_.value("env_digest", std::uint64_t{0});
-  if (digest != 0 && digest != algorithm_->env_digest()) {
+  if (digest != 0 && digest != loop_->digest()) {
     output_.out << "warning: the replayed envs are not where the checkpoint's were (their "
                    "observations or episodes differ): the code or a library changed since "
                    "the run began, or the envs are not deterministic. Training goes on from "
@@ -766,9 +782,9 @@ void TrainingRun::save_checkpoint() {
     // Each rank's own part (generators, env actions, meta with its env digest) goes to rank 0.
     CheckpointBlobs mine;
     for (const std::string& name : algorithm_->rank_blobs()) mine[name] = blobs.at(name);
-    if (algorithm_->env_action_log_complete()) mine["env_actions"] = algorithm_->env_action_log();
+    if (env_log_complete_) mine["env_actions"] = loop_->action_log();
     json rank_meta = meta;
-    rank_meta["env_digest"] = algorithm_->env_digest();
+    rank_meta["env_digest"] = loop_->digest();
     mine["meta"] = rank_meta.dump();
     const std::vector<std::string> parts = communicator_->gather_bytes(
         pack_blobs(mine), "the checkpoint of update " + std::to_string(algorithm_->updates()));
@@ -793,11 +809,11 @@ void TrainingRun::save_checkpoint() {
   meta["recent_returns"] = recent;
   meta["recent_return_steps"] = ended;
   // Where the envs are, for a resume to check its replay of the actions below against.
-  meta["env_digest"] = algorithm_->env_digest();
+  meta["env_digest"] = loop_->digest();
   blobs["meta"] = meta.dump();
   // The envs' state, as the actions that led to it; none when the log does not go back to the
   // first reset.
-  if (algorithm_->env_action_log_complete()) blobs["env_actions"] = algorithm_->env_action_log();
+  if (env_log_complete_) blobs["env_actions"] = loop_->action_log();
   last_checkpoint_ = run_->checkpoint_path(algorithm_->updates());
   write_checkpoint(last_checkpoint_, blobs);
   prune_checkpoints(run_->path(), settings_.keep_checkpoints);

@@ -245,7 +245,13 @@ class TrainingRun {
 
   // While training.
   std::unique_ptr<vector::VectorEnv> env_;
+  // The env loop the algorithm steps (reset with seed + rank num_envs): its action log, replay
+  // and digest go into checkpoints. Destroyed after the algorithm, which points at it.
+  std::unique_ptr<EnvLoop> loop_;
   std::unique_ptr<Algorithm> algorithm_;
+  // Whether the loop's action log goes back to the envs' first reset (not after a resume from a
+  // checkpoint that kept no env actions).
+  bool env_log_complete_ = true;
   std::optional<RunFolder> run_;
   RecentReturns returns_;       // see add_recent_returns
   std::vector<EvalRow> evals_;  // eval.csv's rows

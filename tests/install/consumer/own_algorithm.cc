@@ -12,7 +12,6 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -60,25 +59,28 @@ class LinearActor final : public Actor {
 
 class RandomSearch final : public Algorithm {
  public:
-  RandomSearch(vector::VectorEnv& env, const json& config)
-      : env_(env),
-        seed_(config.at("seed").get<std::uint64_t>()),
+  RandomSearch(EnvLoop& loop, const json& config)
+      : loop_(loop),
         steps_per_iteration_(config.at("steps_per_iteration").get<std::int64_t>()),
-        rng_(seed_),
+        rng_(config.at("seed").get<std::uint64_t>()),
         best_(kWeights, 0.0),
         candidate_(kWeights, 0.0),
-        actions_(env.action_space().zeros()),
-        returns_(static_cast<std::size_t>(env.num_envs()), 0.0),
+        actions_(loop.zero_actions()),
         actor_(best_) {
     propose();
   }
 
   IterationStats iterate(const StopCheck& stop) override {
     IterationStats stats;
-    if (!started_) reset();
+    // The run's env loop resets the envs with the run's seed, logs the actions (a resume
+    // replays them) and records the episodes.
+    if (!loop_.started()) loop_.reset();
     for (std::int64_t k = 0; k < steps_per_iteration_; ++k) {
-      linear_actions(candidate_, *obs_, actions_);
-      step(&stats.episode_returns);
+      linear_actions(candidate_, loop_.observations(), actions_);
+      for (const double r : loop_.ended_returns(loop_.step(actions_))) {
+        stats.episode_returns.push_back(r);
+      }
+      ++batches_;
       if (stop && stop(env_steps())) break;
     }
     double mean = -1e300;
@@ -98,10 +100,10 @@ class RandomSearch final : public Algorithm {
     stats.metrics = {{"best_return", figure(best_return_)}, {"candidate_return", figure(mean)}};
     return stats;
   }
-  std::int64_t env_steps() const override { return batches_ * env_.num_envs(); }
+  std::int64_t env_steps() const override { return batches_ * loop_.num_envs(); }
   std::int64_t updates() const override { return updates_; }
   void set_progress(std::int64_t env_steps, std::int64_t updates) override {
-    batches_ = env_steps / env_.num_envs();
+    batches_ = env_steps / loop_.num_envs();
     updates_ = updates;
   }
   std::vector<std::string> metric_names() const override {
@@ -129,34 +131,6 @@ class RandomSearch final : public Algorithm {
     std::istringstream rng(state.at("rng").get<std::string>());
     rng >> rng_;
   }
-  const std::string& env_action_log() const override { return log_; }
-  bool env_action_log_complete() const override {
-    return log_.size() == static_cast<std::size_t>(batches_) * actions_.array().nbytes();
-  }
-  void replay_env(const std::string& log) override {
-    const std::size_t bytes = actions_.array().nbytes();
-    if (log.size() != static_cast<std::size_t>(batches_) * bytes) {
-      throw std::invalid_argument("random search: an action log of " + std::to_string(batches_) +
-                                  " batches expected");
-    }
-    const std::int64_t batches = batches_;
-    batches_ = 0;
-    reset();
-    for (std::size_t at = 0; at < log.size(); at += bytes) {
-      std::memcpy(actions_.array().raw_data(), log.data() + at, bytes);
-      step(nullptr);
-    }
-    batches_ = batches;
-  }
-  std::uint64_t env_digest() const override {
-    if (!started_) return 0;
-    std::uint64_t digest = fnv1a(nullptr, 0);
-    for (const char* key : {"joint_pos", "joint_vel"}) {
-      const Array& array = obs_->dict().at(key).array();
-      digest = fnv1a(array.raw_data(), array.nbytes(), digest);
-    }
-    return fnv1a(returns_.data(), returns_.size() * sizeof(double), digest);
-  }
   Actor& actor() override { return actor_; }
 
  private:
@@ -164,36 +138,13 @@ class RandomSearch final : public Algorithm {
     std::normal_distribution<double> noise(0.0, 0.5);
     for (int i = 0; i < kWeights; ++i) candidate_[i] = best_[i] + noise(rng_);
   }
-  void reset() {
-    obs_ = &env_.reset(seed_).obs;
-    started_ = true;
-  }
-  void step(std::vector<double>* ended) {
-    log_.append(static_cast<const char*>(actions_.array().raw_data()), actions_.array().nbytes());
-    const vector::VectorStepResult& result = env_.step(actions_);
-    obs_ = &result.obs;
-    for (std::size_t i = 0; i < returns_.size(); ++i) {
-      returns_[i] += result.rewards.data<double>()[i];
-      if (result.terminated.data<bool>()[i] || result.truncated.data<bool>()[i]) {
-        if (ended != nullptr) ended->push_back(returns_[i]);
-        returns_[i] = 0.0;
-      }
-    }
-    ++batches_;
-  }
-
-  vector::VectorEnv& env_;
-  std::uint64_t seed_;
+  EnvLoop& loop_;
   std::int64_t steps_per_iteration_;
   std::mt19937_64 rng_;
   std::vector<double> best_;
   std::vector<double> candidate_;
   double best_return_ = -1e300;
   Value actions_;
-  const Value* obs_ = nullptr;
-  std::vector<double> returns_;
-  std::string log_;
-  bool started_ = false;
   std::int64_t batches_ = 0;
   std::int64_t updates_ = 0;
   LinearActor actor_;
@@ -213,10 +164,10 @@ class RandomSearchFactory final : public AlgorithmFactory {
     return config;
   }
   int set_threads(int requested) const override { return requested == 0 ? 1 : requested; }
-  std::unique_ptr<Algorithm> make(vector::VectorEnv& env, const json& config,
+  std::unique_ptr<Algorithm> make(EnvLoop& loop, const json& config,
                                   Communicator& communicator) const override {
     if (communicator.world_size() != 1) throw std::invalid_argument("random_search: one process");
-    return std::make_unique<RandomSearch>(env, config);
+    return std::make_unique<RandomSearch>(loop, config);
   }
   std::unique_ptr<Actor> load_actor(const Space&, const Space&, const json&,
                                     const LoadedCheckpoint&) const override {

@@ -269,6 +269,24 @@ TEST(Trainer, RequiresSameStepAutoresetAndMatchingNumEnvs) {
   EXPECT_THROW(trainer.update(), std::logic_error);  // nothing collected yet
 }
 
+// Given a training run's env loop, the trainer steps the envs through it (the loop's log and
+// digest are the trainer's), and refuses a loop seeded other than its env seed.
+TEST(Trainer, StepsTheRunsEnvLoopSeededWithItsEnvSeed) {
+  auto envs = bandit_envs(2, false);
+  trainer::SingleProcessCommunicator alone;
+  PpoConfig config = small_config(2, 4);
+  config.seed = 7;
+  trainer::EnvLoop wrong_seed(*envs, 8, "run_episode");
+  EXPECT_THROW(Trainer(wrong_seed, config, alone), std::invalid_argument);
+  trainer::EnvLoop loop(*envs, 7, "run_episode");
+  Trainer trainer(loop, config, alone);
+  trainer.collect();
+  EXPECT_EQ(loop.batches(), 4);
+  EXPECT_EQ(&trainer.env_action_log(), &loop.action_log());
+  EXPECT_EQ(trainer.env_digest(), loop.digest());
+  EXPECT_TRUE(trainer.env_action_log_complete());
+}
+
 // Episodes of 3 steps, rollouts of 5 steps, 2 envs: steps 0-2 are episode 1 (ending at t = 2),
 // steps 3-4 begin episode 2.
 TEST(Trainer, TruncatedStepsBootstrapFromTheFinalObservationsValue) {
@@ -576,8 +594,8 @@ TEST(Trainer, ReplayEnvContinuesTheEpisodesInProgress) {
     ADD_FAILURE() << "a short log was replayed";
   } catch (const std::invalid_argument& error) {
     EXPECT_STREQ(error.what(),
-                 "Trainer::replay_env: an action log of 8 batches of 16 bytes (128 bytes, for 16 "
-                 "env steps) expected, got 120 bytes");
+                 "replay of the env actions: an action log of 8 batches of 16 bytes (for 16 env "
+                 "steps) expected, got 120 bytes");
   }
   EXPECT_EQ(b.env_digest(), 0U);  // not reset yet
   b.replay_env(log);

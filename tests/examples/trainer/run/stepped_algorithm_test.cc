@@ -79,6 +79,7 @@ class CountingLearner final : public StepLearner {
 
 struct Made {
   std::unique_ptr<vector::VectorEnv> envs;
+  std::unique_ptr<EnvLoop> loop;  // the run's
   CountingLearner* learner;
   std::unique_ptr<SteppedAlgorithm> algorithm;
 };
@@ -88,8 +89,9 @@ Made make(std::int64_t iteration_env_steps) {
   made.envs = grid_envs(2);
   auto learner = std::make_unique<CountingLearner>();
   made.learner = learner.get();
+  made.loop = std::make_unique<EnvLoop>(*made.envs, 5, "test_episode");
   made.algorithm = std::make_unique<SteppedAlgorithm>(
-      *made.envs, SteppedSettings{5, iteration_env_steps, "test_episode"}, std::move(learner));
+      *made.loop, SteppedSettings{iteration_env_steps}, std::move(learner));
   return made;
 }
 
@@ -109,7 +111,7 @@ TEST(SteppedAlgorithmTest, AnIterationTakesItsEnvStepsAndReportsTheLearnersMetri
   EXPECT_EQ(made.learner->begins, 1);
   EXPECT_GT(episodes, 0u);  // GridWorld's episodes end within 50 steps
   EXPECT_NE(returns, 0.0);
-  EXPECT_TRUE(made.algorithm->env_action_log_complete());
+  EXPECT_TRUE(made.loop->action_log_covers(made.algorithm->env_steps()));
   EXPECT_EQ(made.algorithm->metric_names(), std::vector<std::string>{"updates"});
 }
 
@@ -138,28 +140,33 @@ TEST(SteppedAlgorithmTest, AResumeReplaysTheEnvsIntoTheLearnerAndGoesOnAsIfItHad
   Made resumed = make(30);
   resumed.algorithm->set_progress(first.algorithm->env_steps(), first.algorithm->updates());
   resumed.algorithm->restore(LoadedCheckpoint{}, meta);
-  resumed.algorithm->replay_env(first.algorithm->env_action_log());
-  EXPECT_EQ(resumed.algorithm->env_digest(), first.algorithm->env_digest());
+  // As TrainingRun replays a checkpoint's actions through its loop.
+  resumed.loop->replay(
+      first.loop->action_log(), resumed.algorithm->env_steps(),
+      [&](const Value& obs) { resumed.algorithm->replayed_reset(obs); },
+      [&](const Value& actions, const vector::VectorStepResult& step) {
+        resumed.algorithm->replayed_step(actions, step);
+      });
+  EXPECT_EQ(resumed.loop->digest(), first.loop->digest());
   EXPECT_EQ(resumed.learner->observed, first.learner->observed);
   EXPECT_EQ(resumed.learner->observations, first.learner->observations);
 
   first.algorithm->iterate(nullptr);
   resumed.algorithm->iterate(nullptr);
-  EXPECT_EQ(resumed.algorithm->env_digest(), first.algorithm->env_digest());
+  EXPECT_EQ(resumed.loop->digest(), first.loop->digest());
   EXPECT_EQ(resumed.learner->observed, first.learner->observed);
   EXPECT_EQ(resumed.learner->updates, first.learner->updates);
-  EXPECT_EQ(resumed.algorithm->env_action_log(), first.algorithm->env_action_log());
+  EXPECT_EQ(resumed.loop->action_log(), first.loop->action_log());
 }
 
 TEST(SteppedAlgorithmTest, RefusesAnIterationThatIsNotAMultipleOfTheEnvs) {
   auto envs = grid_envs(2);
-  EXPECT_THROW(
-      SteppedAlgorithm(*envs, SteppedSettings{0, 3, "e"}, std::make_unique<CountingLearner>()),
-      std::invalid_argument);
-  EXPECT_THROW(
-      SteppedAlgorithm(*envs, SteppedSettings{0, 0, "e"}, std::make_unique<CountingLearner>()),
-      std::invalid_argument);
-  EXPECT_THROW(SteppedAlgorithm(*envs, SteppedSettings{0, 4, "e"}, nullptr), std::invalid_argument);
+  EnvLoop loop(*envs, 0, "e");
+  EXPECT_THROW(SteppedAlgorithm(loop, SteppedSettings{3}, std::make_unique<CountingLearner>()),
+               std::invalid_argument);
+  EXPECT_THROW(SteppedAlgorithm(loop, SteppedSettings{0}, std::make_unique<CountingLearner>()),
+               std::invalid_argument);
+  EXPECT_THROW(SteppedAlgorithm(loop, SteppedSettings{4}, nullptr), std::invalid_argument);
 }
 
 }  // namespace

@@ -52,25 +52,26 @@ std::int64_t walk_action(std::int64_t t, int i) {
   return kMoves[(z ^ (z >> 31)) % 6];
 }
 
-// Steps its env steps_per_iteration times an iteration, env i taking walk_action(t, i) at step
-// t (counted from the first reset); "learns" a counter of its iterations, saved in a blob
+// Steps the run's env loop steps_per_iteration times an iteration, env i taking walk_action(t, i)
+// at step t (counted from the first reset); "learns" a counter of its iterations, saved in a blob
 // "counter". Its metrics: policy_loss = the counter, and "counter" too.
 class CountingAlgorithm final : public Algorithm {
  public:
-  CountingAlgorithm(vector::VectorEnv& env, const json& config)
-      : env_(env),
-        seed_(config.at("seed").get<std::uint64_t>()),
+  CountingAlgorithm(EnvLoop& loop, const json& config)
+      : loop_(loop),
         steps_per_iteration_(config.at("steps_per_iteration").get<std::int64_t>()),
-        actions_(env.action_space().zeros()),
-        episode_returns_(static_cast<std::size_t>(env.num_envs()), 0.0) {}
+        actions_(loop.zero_actions()) {}
 
   IterationStats iterate(const StopCheck& stop) override {
     IterationStats stats;
-    if (!started_) reset();
+    if (!loop_.started()) loop_.reset();
     for (std::int64_t k = 0; k < steps_per_iteration_; ++k) {
       auto* action = actions_.array().data<std::int64_t>();
-      for (int i = 0; i < env_.num_envs(); ++i) action[i] = walk_action(batches_, i);
-      step(&stats.episode_returns);
+      for (int i = 0; i < loop_.num_envs(); ++i) action[i] = walk_action(loop_.batches(), i);
+      for (const double r : loop_.ended_returns(loop_.step(actions_))) {
+        stats.episode_returns.push_back(r);
+      }
+      batches_ += 1;
       if (stop && stop(env_steps())) break;
     }
     counter_ += 1;
@@ -79,12 +80,11 @@ class CountingAlgorithm final : public Algorithm {
                      {"counter", static_cast<double>(counter_)}};
     return stats;
   }
-  std::int64_t env_steps() const override { return batches_ * env_.num_envs(); }
+  std::int64_t env_steps() const override { return batches_ * loop_.num_envs(); }
   std::int64_t updates() const override { return updates_; }
   void set_progress(std::int64_t env_steps, std::int64_t updates) override {
-    batches_ = env_steps / env_.num_envs();
+    batches_ = env_steps / loop_.num_envs();
     updates_ = updates;
-    log_complete_ = false;
   }
   std::vector<std::string> metric_names() const override { return {"policy_loss", "counter"}; }
   void save(CheckpointBlobs& blobs, json& meta) override {
@@ -95,68 +95,25 @@ class CountingAlgorithm final : public Algorithm {
     counter_ = std::stoll(checkpoint.blobs.at("counter"));
     EXPECT_EQ(meta.at("counter"), counter_);
   }
-  const std::string& env_action_log() const override { return log_; }
-  bool env_action_log_complete() const override { return log_complete_; }
-  void replay_env(const std::string& log) override {
-    const std::int64_t batches = batches_;
-    batches_ = 0;
-    reset();
-    const std::size_t bytes = actions_.array().nbytes();
-    for (std::size_t at = 0; at < log.size(); at += bytes) {
-      std::memcpy(actions_.array().raw_data(), log.data() + at, bytes);
-      step(nullptr);
-    }
-    EXPECT_EQ(batches_, batches);
-    log_complete_ = true;
-  }
-  std::uint64_t env_digest() const override {
-    if (!started_) return 0;
-    std::uint64_t hash = 14695981039346656037ULL;
-    const auto mix = [&](const void* data, std::size_t size) {
-      for (std::size_t b = 0; b < size; ++b) {
-        hash = (hash ^ static_cast<const unsigned char*>(data)[b]) * 1099511628211ULL;
-      }
-    };
-    mix(obs_->array().raw_data(), obs_->array().nbytes());
-    mix(episode_returns_.data(), episode_returns_.size() * sizeof(double));
-    return hash;
+  void replayed_reset(const Value& /*observations*/) override { replayed_ = 0; }
+  void replayed_step(const Value& /*actions*/, const vector::VectorStepResult& /*step*/) override {
+    replayed_ += 1;
   }
   Actor& actor() override { return actor_; }
+  const EnvLoop& loop() const { return loop_; }
+  // The steps the run replayed into it on resume.
+  std::int64_t replayed() const { return replayed_; }
 
   DownActor actor_;
 
  private:
-  void reset() {
-    obs_ = &env_.reset(seed_).obs;
-    started_ = true;
-  }
-  // One step of every env with actions_; appends the returns of the episodes that ended.
-  void step(std::vector<double>* ended) {
-    log_.append(static_cast<const char*>(actions_.array().raw_data()), actions_.array().nbytes());
-    const vector::VectorStepResult& result = env_.step(actions_);
-    obs_ = &result.obs;
-    for (std::size_t i = 0; i < episode_returns_.size(); ++i) {
-      episode_returns_[i] += result.rewards.data<double>()[i];
-      if (result.terminated.data<bool>()[i] || result.truncated.data<bool>()[i]) {
-        if (ended != nullptr) ended->push_back(episode_returns_[i]);
-        episode_returns_[i] = 0.0;
-      }
-    }
-    batches_ += 1;
-  }
-
-  vector::VectorEnv& env_;
-  std::uint64_t seed_;
+  EnvLoop& loop_;
   std::int64_t steps_per_iteration_;
   Value actions_;
-  const Value* obs_ = nullptr;
-  std::vector<double> episode_returns_;
-  std::string log_;
-  bool log_complete_ = true;
-  bool started_ = false;
   std::int64_t batches_ = 0;
   std::int64_t updates_ = 0;
   std::int64_t counter_ = 0;
+  std::int64_t replayed_ = -1;
 };
 
 class CountingFactory final : public AlgorithmFactory {
@@ -176,9 +133,9 @@ class CountingFactory final : public AlgorithmFactory {
     return config;
   }
   int set_threads(int requested) const override { return requested == 0 ? 3 : requested; }
-  std::unique_ptr<Algorithm> make(vector::VectorEnv& env, const json& config,
+  std::unique_ptr<Algorithm> make(EnvLoop& loop, const json& config,
                                   Communicator& /*communicator*/) const override {
-    auto algorithm = std::make_unique<CountingAlgorithm>(env, config);
+    auto algorithm = std::make_unique<CountingAlgorithm>(loop, config);
     algorithm->actor_.sleep_ms = actor_sleep_ms;
     last = algorithm.get();
     return algorithm;
@@ -277,7 +234,7 @@ TEST(TrainingRunTest, ANewRunTrainsToItsStepBudgetAndWritesTheRunFolder) {
   EXPECT_EQ(meta.at("env_steps"), 40);
   EXPECT_EQ(meta.at("updates"), 5);
   EXPECT_EQ(meta.at("counter"), 5);
-  EXPECT_EQ(meta.at("env_digest"), factory.last->env_digest());
+  EXPECT_EQ(meta.at("env_digest"), factory.last->loop().digest());
   const json config = json::parse(read_text(folder / "config.json"));
   EXPECT_EQ(config.at("counting").at("seed"), 7);
   EXPECT_EQ(config.at("torch_threads"), 3);  // the count set_threads reported
@@ -360,6 +317,8 @@ TEST(TrainingRunTest, AResumedRunIsTheRunThatDidNotStop) {
       << resumed_out.str();
   EXPECT_EQ(resumed_out.str().find("warning: the replayed envs"), std::string::npos)
       << resumed_out.str();
+  // The run replayed the log through its loop and gave the algorithm each of its 48 batches.
+  EXPECT_EQ(factory.last->replayed(), 48);
 
   const ProgressTable a = read_progress_csv(base / "whole" / "progress.csv");
   const ProgressTable b = read_progress_csv(base / "stopped" / "progress.csv");
