@@ -1,6 +1,7 @@
 #include "pixelgym/envs/registry.h"
 
 #include <algorithm>
+#include <cctype>
 #include <regex>
 #include <stdexcept>
 
@@ -172,6 +173,49 @@ std::vector<std::string> Registry::registered_ids() const {
 
 std::vector<std::string> Registry::closest_ids(const std::string& id, std::size_t count) const {
   return closest_names(id, newest_versions_first(registered_ids()), count);
+}
+
+Params Registry::parse_kwargs(const std::string& id,
+                              const std::vector<std::string>& entries) const {
+  const std::shared_ptr<const EnvSpec> found = spec(id);
+  // One rule for spaces: none around a key or a number or bool (a string keeps them all).
+  const auto spaced = [](const std::string& s) {
+    return !s.empty() && (std::isspace(static_cast<unsigned char>(s.front())) != 0 ||
+                          std::isspace(static_cast<unsigned char>(s.back())) != 0);
+  };
+  const auto trimmed = [](const std::string& s) {
+    const std::size_t first = s.find_first_not_of(" \t\n\r\f\v");
+    if (first == std::string::npos) return std::string();
+    return s.substr(first, s.find_last_not_of(" \t\n\r\f\v") - first + 1);
+  };
+  Params params;
+  for (const std::string& entry : entries) {
+    const std::size_t equals = entry.find('=');
+    if (equals == std::string::npos || equals == 0) {
+      throw std::invalid_argument("--set expects key=value, got \"" + entry + "\"");
+    }
+    const std::string key = entry.substr(0, equals);
+    const std::string text = entry.substr(equals + 1);
+    if (spaced(key)) {
+      throw std::invalid_argument("--set \"" + entry + "\": the key has spaces around it; write " +
+                                  trimmed(key) + "=" + text);
+    }
+    const auto declared = std::find_if(found->params.begin(), found->params.end(),
+                                       [&](const ParamSpec& p) { return p.name == key; });
+    const ParamType type = key == "max_episode_steps"        ? ParamType::kInt
+                           : declared != found->params.end() ? declared->type()
+                                                             : ParamType::kString;
+    if (type != ParamType::kString && spaced(text)) {
+      throw std::invalid_argument(id + ": --set " + key + ": \"" + text +
+                                  "\" has spaces around it; write " + key + "=" + trimmed(text));
+    }
+    try {
+      params.insert_or_assign(key, parse_param(type, text));
+    } catch (const std::invalid_argument& error) {
+      throw std::invalid_argument(id + ": --set " + key + ": " + error.what());
+    }
+  }
+  return params;
 }
 
 }  // namespace pixelgym

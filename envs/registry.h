@@ -82,6 +82,15 @@ class Registry {
   /// The spec registered as `id`; throws like `make` for an unknown id.
   std::shared_ptr<const EnvSpec> spec(const std::string& id) const;
 
+  /// Env `id`'s kwargs from KEY=VALUE text (the command line's `--set`; the "set" of a run
+  /// config written before kwargs were kept typed), each value read as the type `id` declares
+  /// for its key (parse_param; max_episode_steps an int; an undeclared key a string, which make
+  /// then refuses, listing the valid keys). A later entry for a key replaces an earlier one.
+  /// Throws std::invalid_argument for an unknown id (as `make`), an entry that is not
+  /// key=value, spaces around a key or around a value that is not a string, or a value that
+  /// does not read as its type, naming the entry.
+  Params parse_kwargs(const std::string& id, const std::vector<std::string>& entries) const;
+
   /// Every registered id, sorted.
   std::vector<std::string> registered_ids() const;
 
@@ -120,5 +129,7 @@ EnvDescription describe(const std::string& id, const Params& kwargs = {});
 void register_env(EnvSpec spec);
 /// `default_registry().registered_ids()`.
 std::vector<std::string> registered_ids();
+/// `default_registry().parse_kwargs(id, entries)`.
+Params parse_kwargs(const std::string& id, const std::vector<std::string>& entries);
 
 }  // namespace pixelgym

@@ -59,6 +59,10 @@ EnvDescription describe(const std::string& id, const Params& kwargs) {
 
 std::vector<std::string> registered_ids() { return default_registry().registered_ids(); }
 
+Params parse_kwargs(const std::string& id, const std::vector<std::string>& entries) {
+  return default_registry().parse_kwargs(id, entries);
+}
+
 namespace vector {
 
 std::unique_ptr<VectorEnv> make_vec(const std::string& id, int num_envs, const Params& kwargs,

@@ -100,50 +100,11 @@ void add_set_option(CLI::App& command, std::vector<std::string>& sets) {
 }
 
 Params parse_sets(const std::string& id, const std::vector<std::string>& sets) {
-  std::shared_ptr<const EnvSpec> spec;
   try {
-    spec = default_registry().spec(id);
+    return parse_kwargs(id, sets);
   } catch (const std::invalid_argument& error) {
-    throw UsageError(error.what());  // an unknown id, with the registered ids closest to it
+    throw UsageError(error.what());  // an unknown id (with the closest), a bad entry
   }
-  Params params;
-  for (const std::string& entry : sets) {
-    const std::size_t equals = entry.find('=');
-    if (equals == std::string::npos || equals == 0) {
-      throw UsageError("--set expects key=value, got \"" + entry + "\"");
-    }
-    const std::string key = entry.substr(0, equals);
-    const std::string text = entry.substr(equals + 1);
-    // One rule for spaces: none around a key or a number or bool (a string keeps them all).
-    const auto spaced = [](const std::string& s) {
-      return !s.empty() && (std::isspace(static_cast<unsigned char>(s.front())) != 0 ||
-                            std::isspace(static_cast<unsigned char>(s.back())) != 0);
-    };
-    const auto trimmed = [](const std::string& s) {
-      const std::size_t first = s.find_first_not_of(" \t\n\r\f\v");
-      if (first == std::string::npos) return std::string();
-      return s.substr(first, s.find_last_not_of(" \t\n\r\f\v") - first + 1);
-    };
-    if (spaced(key)) {
-      throw UsageError("--set \"" + entry + "\": the key has spaces around it; write " +
-                       trimmed(key) + "=" + text);
-    }
-    const auto declared = std::find_if(spec->params.begin(), spec->params.end(),
-                                       [&](const ParamSpec& p) { return p.name == key; });
-    const ParamType type = key == "max_episode_steps"       ? ParamType::kInt
-                           : declared != spec->params.end() ? declared->type()
-                                                            : ParamType::kString;
-    if (type != ParamType::kString && spaced(text)) {
-      throw UsageError(id + ": --set " + key + ": \"" + text + "\" has spaces around it; write " +
-                       key + "=" + trimmed(text));
-    }
-    try {
-      params.insert_or_assign(key, parse_param(type, text));
-    } catch (const std::invalid_argument& error) {
-      throw UsageError(id + ": --set " + key + ": " + error.what());
-    }
-  }
-  return params;
 }
 
 void add_wrap_option(CLI::App& command, std::vector<std::string>& wraps) {

@@ -226,8 +226,14 @@ struct CompareArguments {
   int height = 500;
 };
 
-// The control steps per env step of a run: its --set action_repeat=K (1 without).
+// The control steps per env step of a run: its env kwarg action_repeat (1 without); a run
+// config written before the kwargs were kept typed has it as "set": ["action_repeat=K"].
 double action_repeat_of(const nlohmann::json& config) {
+  const auto kwargs = config.find("env_kwargs");
+  if (kwargs != config.end() && kwargs->is_object()) {
+    const auto repeat = kwargs->find("action_repeat");
+    return repeat != kwargs->end() && repeat->is_number() ? repeat->get<double>() : 1.0;
+  }
   double repeat = 1.0;
   for (const auto& set : config.value("set", std::vector<std::string>{})) {
     const std::string key = "action_repeat=";

@@ -210,7 +210,7 @@ trainer::RunSettings new_run_settings(const TrainArguments& args,
                                       const trainer::AlgorithmFactory& algorithm) {
   trainer::RunSettings settings;
   settings.env_id = args.id;
-  settings.sets = args.sets;
+  settings.env_kwargs = parse_sets(args.id, args.sets);  // typed here, at the door
   settings.wraps = args.wraps;
   settings.algorithm = algorithm.name();
   settings.algorithm_config = algorithm_config(args, algorithm);
@@ -324,18 +324,18 @@ int run_train(const TrainArguments& args) {
                                   trainer::ProgressLine::mode_for_stdout(args.quiet || joins),
                                   trainer::ProgressLine::stdout_columns()};
   if (joins) {
-    trainer::TrainingRun::join(kAlgorithms, parse_sets, *communicator, output).train();
+    trainer::TrainingRun::join(kAlgorithms, *communicator, output).train();
     return 0;
   }
   try {
     trainer::TrainingRun run =
         args.resume.empty()
             ? trainer::TrainingRun::create(
-                  algorithm, parse_sets, new_run_settings(args, algorithm),
+                  algorithm, new_run_settings(args, algorithm),
                   args.out.empty() ? fs::path("runs") / args.id : fs::path(args.out), budget,
                   output)
-            : trainer::TrainingRun::resume(algorithm, parse_sets, args.resume, budget,
-                                           resume_checks(args), output);
+            : trainer::TrainingRun::resume(algorithm, args.resume, budget, resume_checks(args),
+                                           output);
     if (communicator) run.distribute(*communicator);
     run.stop_when(interrupt_requested);
     ::signal(SIGINT, on_interrupt);
@@ -367,7 +367,7 @@ int run_eval(const EvalArguments& args) {
   request.stochastic = args.stochastic;
   if (!args.video.empty()) request.video = fs::path(args.video);
   const trainer::CheckpointEvaluation result =
-      trainer::evaluate_checkpoint(kAlgorithms, parse_sets, args.run, request, std::cerr);
+      trainer::evaluate_checkpoint(kAlgorithms, args.run, request, std::cerr);
   const trainer::PolicyEvaluation& evaluation = result.evaluation;
   const std::string from =
       args.seed_given && args.episodes > 0 ? "" : " (as " + result.defaults_from + ")";

@@ -67,13 +67,12 @@ std::int64_t time_limit_of(Env& env) {
 // A vector env of one env built as the run's, recorded through `recorder` when `video_folder`
 // is given.
 std::unique_ptr<vector::SyncVectorEnv> evaluation_env(const RunSettings& settings,
-                                                      const EnvKwargsParser& parse_sets,
                                                       const std::optional<fs::path>& video_folder,
                                                       wrappers::RecordVideo*& recorder,
                                                       std::int64_t* time_limit = nullptr) {
   recorder = nullptr;
   const vector::EnvFactory factory = [&](int) {
-    std::unique_ptr<Env> env = make_run_env(settings, parse_sets);
+    std::unique_ptr<Env> env = make_run_env(settings);
     if (time_limit != nullptr) *time_limit = time_limit_of(*env);
     if (!video_folder) return env;
     auto recorded = std::make_unique<wrappers::RecordVideo>(
@@ -140,13 +139,13 @@ std::pair<RunSettings, const AlgorithmFactory*> checkpoint_settings(
 }  // namespace
 
 PolicyEvaluation evaluate(Actor& actor, const RunSettings& settings,
-                          const EnvKwargsParser& parse_sets, const EvaluationRequest& request) {
+                          const EvaluationRequest& request) {
   const std::optional<fs::path>& video = request.video;
   std::optional<fs::path> video_folder;
   if (video) video_folder = video->parent_path().empty() ? fs::path(".") : video->parent_path();
   wrappers::RecordVideo* recorder = nullptr;
   const std::unique_ptr<vector::SyncVectorEnv> made =
-      evaluation_env(settings, parse_sets, video_folder, recorder);
+      evaluation_env(settings, video_folder, recorder);
   vector::SyncVectorEnv& env = *made;
   Value actions = env.action_space().zeros();
   PolicyEvaluation result;
@@ -187,7 +186,6 @@ double EvaluationCost::evaluation_seconds(std::int64_t episodes, bool video) con
 }
 
 EvaluationCost measure_evaluation_cost(Actor& actor, const RunSettings& settings,
-                                       const EnvKwargsParser& parse_sets,
                                        const fs::path& scratch_folder, std::int64_t steps,
                                        const std::function<void()>& on_step) {
   EvaluationCost cost;
@@ -195,7 +193,7 @@ EvaluationCost measure_evaluation_cost(Actor& actor, const RunSettings& settings
   wrappers::RecordVideo* recorder = nullptr;
   std::int64_t time_limit = 0;
   const std::unique_ptr<vector::SyncVectorEnv> made =
-      evaluation_env(settings, parse_sets, scratch_folder, recorder, &time_limit);
+      evaluation_env(settings, scratch_folder, recorder, &time_limit);
   vector::SyncVectorEnv& env = *made;
   Value actions = env.action_space().zeros();
   cost.setup_s = seconds_since(setup_start);
@@ -291,7 +289,6 @@ json evaluation_json(const PolicyEvaluation& evaluation, const EvaluationRequest
 }
 
 CheckpointEvaluation evaluate_checkpoint(const AlgorithmFactories& algorithms,
-                                         const EnvKwargsParser& parse_sets,
                                          const fs::path& run_or_checkpoint,
                                          const CheckpointEvaluationRequest& given,
                                          std::ostream& errors) {
@@ -322,12 +319,12 @@ CheckpointEvaluation evaluate_checkpoint(const AlgorithmFactories& algorithms,
   request.video = given.video;
   algorithm.set_threads(result.settings.torch_threads);
   // The spaces come from one env built as the run's.
-  std::unique_ptr<Env> probe = make_run_env(result.settings, parse_sets);
+  std::unique_ptr<Env> probe = make_run_env(result.settings);
   const std::unique_ptr<Actor> actor =
       algorithm.load_actor(probe->observation_space(), probe->action_space(),
                            result.settings.algorithm_config, checkpoint);
   probe->close();
-  result.evaluation = evaluate(*actor, result.settings, parse_sets, request);
+  result.evaluation = evaluate(*actor, result.settings, request);
   return result;
 }
 

@@ -67,7 +67,6 @@ struct EvaluationCost {
 /// `steps` more recorded to a scratch video in `scratch_folder` (removed after), calling
 /// `on_step` (when set) after each. Throws what the env throws.
 EvaluationCost measure_evaluation_cost(Actor& actor, const RunSettings& settings,
-                                       const EnvKwargsParser& parse_sets,
                                        const std::filesystem::path& scratch_folder,
                                        std::int64_t steps,
                                        const std::function<void()>& on_step = {});
@@ -87,7 +86,7 @@ FinalEvaluationPlan plan_final_evaluation(double seconds, const EvaluationCost& 
 /// Plays request.episodes episodes of `actor` on one env built as the run's (make_run_env, in a
 /// SyncVectorEnv without autoreset), each to its end. Throws what the env throws.
 PolicyEvaluation evaluate(Actor& actor, const RunSettings& settings,
-                          const EnvKwargsParser& parse_sets, const EvaluationRequest& request);
+                          const EvaluationRequest& request);
 
 /// summary.json's "evaluation": {"episodes", "seed", "deterministic", "return_mean",
 /// "return_std", "returns", "clipped_action_fraction"}.
@@ -127,7 +126,6 @@ struct CheckpointEvaluation {
 /// run folder has one of this checkpoint's env steps, else the run's eval_episodes from its seed
 /// + kEvaluationSeedOffset.
 CheckpointEvaluation evaluate_checkpoint(const AlgorithmFactories& algorithms,
-                                         const EnvKwargsParser& parse_sets,
                                          const std::filesystem::path& run_or_checkpoint,
                                          const CheckpointEvaluationRequest& request,
                                          std::ostream& errors);

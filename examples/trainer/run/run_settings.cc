@@ -21,10 +21,55 @@ std::int64_t RunSettings::total_env_steps() const {
   return algorithm_config.at("total_env_steps").get<std::int64_t>();
 }
 
+json kwargs_to_json(const Params& kwargs) {
+  json out = json::object();
+  for (const auto& [key, value] : kwargs) {
+    switch (value.type()) {
+      case ParamType::kBool:
+        out[key] = value.as_bool();
+        break;
+      case ParamType::kInt:
+        out[key] = value.as_int();
+        break;
+      case ParamType::kFloat:
+        out[key] = value.as_float();
+        break;
+      case ParamType::kString:
+        out[key] = value.as_string();
+        break;
+    }
+  }
+  return out;
+}
+
+Params kwargs_from_json(const json& object) {
+  if (!object.is_object()) {
+    throw std::invalid_argument(std::string("env_kwargs: an object expected, got ") +
+                                object.type_name());
+  }
+  Params kwargs;
+  for (const auto& [key, value] : object.items()) {
+    if (value.is_boolean()) {
+      kwargs.emplace(key, value.get<bool>());
+    } else if (value.is_number_integer()) {
+      kwargs.emplace(key, value.get<std::int64_t>());
+    } else if (value.is_number_float()) {
+      kwargs.emplace(key, value.get<double>());
+    } else if (value.is_string()) {
+      kwargs.emplace(key, value.get<std::string>());
+    } else {
+      throw std::invalid_argument("env_kwargs." + key +
+                                  ": a boolean, integer, float or string expected, got " +
+                                  value.dump());
+    }
+  }
+  return kwargs;
+}
+
 json settings_to_json(const RunSettings& settings) {
   json out;
   out["env_id"] = settings.env_id;
-  out["set"] = settings.sets;
+  out["env_kwargs"] = kwargs_to_json(settings.env_kwargs);
   out["wrap"] = settings.wraps;
   out["num_threads"] = settings.num_threads;
   out["torch_threads"] = settings.torch_threads;
@@ -45,7 +90,14 @@ RunSettings settings_from_json(const json& in, const std::filesystem::path& wher
   try {
     RunSettings settings;
     settings.env_id = in.at("env_id").get<std::string>();
-    settings.sets = in.at("set").get<std::vector<std::string>>();
+    try {
+      settings.env_kwargs =
+          in.contains("env_kwargs") || !in.contains("set")
+              ? kwargs_from_json(in.at("env_kwargs"))
+              : parse_kwargs(settings.env_id, in.at("set").get<std::vector<std::string>>());
+    } catch (const std::invalid_argument& error) {
+      throw std::runtime_error(where.string() + ": not a pixelgym train config: " + error.what());
+    }
     settings.wraps = in.at("wrap").get<std::vector<std::string>>();
     settings.num_threads = in.at("num_threads").get<int>();
     if (in.contains("torch_threads")) settings.torch_threads = in.at("torch_threads").get<int>();
@@ -95,7 +147,8 @@ std::string settings_differences(const RunSettings& run, const RunSettings& chec
   }
   std::string differ;
   const auto note = [&](const std::string& name, const json& a, const json& b) {
-    if (a == b) return;
+    // JSON's equality takes 64 and 64.0 as one number; an env kwarg's type is part of it.
+    if (name == "env_kwargs" ? a.dump() == b.dump() : a == b) return;
     differ += (differ.empty() ? "" : "; ") + name + ": config.json has " +
               (a.is_null() ? std::string("none") : a.dump()) + ", the checkpoint " +
               (b.is_null() ? std::string("none") : b.dump());
@@ -137,18 +190,15 @@ const AlgorithmFactory& algorithm_of(const json& in, const std::filesystem::path
                            ")");
 }
 
-std::unique_ptr<vector::VectorEnv> make_training_env(const RunSettings& settings,
-                                                     const EnvKwargsParser& parse_sets) {
+std::unique_ptr<vector::VectorEnv> make_training_env(const RunSettings& settings) {
   const vector::VectorOptions options{vector::VectorMode::kAsync, settings.num_threads,
                                       vector::AutoresetMode::kSameStep, true};
   return vector::make_vec(settings.env_id, static_cast<int>(settings.num_envs()),
-                          parse_sets(settings.env_id, settings.sets),
-                          wrappers::wrapping(settings.wraps), options);
+                          settings.env_kwargs, wrappers::wrapping(settings.wraps), options);
 }
 
-std::unique_ptr<Env> make_run_env(const RunSettings& settings, const EnvKwargsParser& parse_sets) {
-  return wrappers::apply_wrappers(make(settings.env_id, parse_sets(settings.env_id, settings.sets)),
-                                  settings.wraps);
+std::unique_ptr<Env> make_run_env(const RunSettings& settings) {
+  return wrappers::apply_wrappers(make(settings.env_id, settings.env_kwargs), settings.wraps);
 }
 
 }  // namespace pixelgym::trainer

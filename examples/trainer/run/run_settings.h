@@ -4,7 +4,6 @@
 
 #include <cstdint>
 #include <filesystem>
-#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -17,16 +16,13 @@
 
 namespace pixelgym::trainer {
 
-/// Turns a run's `sets` (KEY=VALUE strings, as `--set` takes them) into env `id`'s kwargs.
-/// The command line's parser, so that its errors are the command line's.
-using EnvKwargsParser =
-    std::function<Params(const std::string& id, const std::vector<std::string>& sets)>;
-
-/// The settings of a run, as config.json holds them (with the same names, but `env_id`'s
-/// "env_id", `sets`' "set", `wraps`' "wrap", and the algorithm's config under `algorithm`).
+/// The settings of a run, as config.json holds them (with the same names, but `wraps`' "wrap",
+/// and the algorithm's config under `algorithm`).
 struct RunSettings {
   std::string env_id;
-  std::vector<std::string> sets;       // KEY=VALUE
+  /// The env's kwargs, typed (the command line parses `--set` into them: parse_kwargs); in
+  /// config.json an object of JSON booleans, integers, floats and strings.
+  Params env_kwargs;
   std::vector<std::string> wraps;      // wrapper specs, the first innermost
   int num_threads = 2;                 // the training env's worker threads (AsyncVectorEnv)
   int torch_threads = 0;               // the algorithm's threads (AlgorithmFactory::set_threads)
@@ -58,12 +54,18 @@ struct RunSettings {
 /// config.json's settings object.
 nlohmann::json settings_to_json(const RunSettings& settings);
 
+/// Params as a JSON object (bool, integer, float and string members) and back. kwargs_from_json
+/// throws std::invalid_argument naming the member that is not one of the four.
+nlohmann::json kwargs_to_json(const Params& kwargs);
+Params kwargs_from_json(const nlohmann::json& object);
+
 /// The settings of config.json's object `in` (read from `where`) for `algorithm`: its config
-/// is the member algorithm.name(), read by algorithm.parse_config. Absent "torch_threads": 0;
-/// absent "keep_checkpoints": 0 (keep all); absent "eval_every": 0 (none), "eval_max_share":
-/// 0.1. Throws
-/// std::runtime_error "{where}: not a pixelgym train config: ..." for a missing or ill-typed
-/// member, and what parse_config throws.
+/// is the member algorithm.name(), read by algorithm.parse_config. The env's kwargs are
+/// "env_kwargs"; a config written before they were kept typed has "set" (KEY=VALUE strings)
+/// instead, read as `--set` is (parse_kwargs, with the env's declared types). Absent
+/// "torch_threads": 0; absent "keep_checkpoints": 0 (keep all); absent "eval_every": 0 (none),
+/// "eval_max_share": 0.1. Throws std::runtime_error "{where}: not a pixelgym train config: ..." for
+/// a missing or ill-typed member, and what parse_config throws.
 RunSettings settings_from_json(const nlohmann::json& in, const std::filesystem::path& where,
                                const AlgorithmFactory& algorithm);
 
@@ -90,10 +92,9 @@ const AlgorithmFactory& algorithm_of(const nlohmann::json& in, const std::filesy
 
 /// The training env: num_envs() copies of the run's env in an AsyncVectorEnv on num_threads
 /// threads, SameStep autoreset.
-std::unique_ptr<vector::VectorEnv> make_training_env(const RunSettings& settings,
-                                                     const EnvKwargsParser& parse_sets);
+std::unique_ptr<vector::VectorEnv> make_training_env(const RunSettings& settings);
 
-/// One env built as the run's: make(env_id, parse_sets(env_id, sets)) under `wraps`.
-std::unique_ptr<Env> make_run_env(const RunSettings& settings, const EnvKwargsParser& parse_sets);
+/// One env built as the run's: make(env_id, env_kwargs) under `wraps`.
+std::unique_ptr<Env> make_run_env(const RunSettings& settings);
 
 }  // namespace pixelgym::trainer

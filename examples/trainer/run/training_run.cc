@@ -201,33 +201,30 @@ std::vector<EvalRow> parse_eval_csv(const std::string& text, const std::string& 
   return rows;
 }
 
-TrainingRun::TrainingRun(const AlgorithmFactory& algorithm, EnvKwargsParser parse_sets,
-                         RunSettings settings, fs::path folder, RunOutput output)
+TrainingRun::TrainingRun(const AlgorithmFactory& algorithm, RunSettings settings, fs::path folder,
+                         RunOutput output)
     : factory_(&algorithm),
-      parse_sets_(std::move(parse_sets)),
       settings_(std::move(settings)),
       folder_(std::move(folder)),
       output_(output) {}
 
-TrainingRun TrainingRun::create(const AlgorithmFactory& algorithm, EnvKwargsParser parse_sets,
-                                RunSettings settings, fs::path folder, TrainBudget budget,
-                                RunOutput output) {
+TrainingRun TrainingRun::create(const AlgorithmFactory& algorithm, RunSettings settings,
+                                fs::path folder, TrainBudget budget, RunOutput output) {
   settings.algorithm = algorithm.name();
-  TrainingRun run(algorithm, std::move(parse_sets), std::move(settings), std::move(folder), output);
+  TrainingRun run(algorithm, std::move(settings), std::move(folder), output);
   if (budget.minutes > 0.0) run.settings_.minutes = budget.minutes;  // the run's first budget
   run.apply_budget(budget);
   return run;
 }
 
-TrainingRun TrainingRun::resume(const AlgorithmFactory& algorithm, EnvKwargsParser parse_sets,
-                                fs::path folder, TrainBudget budget, const ResumeChecks& given,
-                                RunOutput output) {
+TrainingRun TrainingRun::resume(const AlgorithmFactory& algorithm, fs::path folder,
+                                TrainBudget budget, const ResumeChecks& given, RunOutput output) {
   const json config = read_run_config(folder / "config.json", "--resume " + folder.string());
   RunSettings settings = settings_from_json(config, folder / "config.json", algorithm);
   check_resume_settings(given, settings, folder);
   // Before the checkpoint is read: a run being trained by another process is left to it.
   RunLock lock = RunLock::acquire(folder, "train --resume");
-  TrainingRun run(algorithm, std::move(parse_sets), std::move(settings), std::move(folder), output);
+  TrainingRun run(algorithm, std::move(settings), std::move(folder), output);
   run.lock_ = std::move(lock);
   run.load_resume_point(config);
   run.apply_budget(budget);
@@ -324,12 +321,12 @@ bool TrainingRun::nothing_to_do() const {
   return true;
 }
 
-TrainingRun TrainingRun::join(const AlgorithmFactories& algorithms, EnvKwargsParser parse_sets,
-                              Communicator& communicator, RunOutput output) {
+TrainingRun TrainingRun::join(const AlgorithmFactories& algorithms, Communicator& communicator,
+                              RunOutput output) {
   if (communicator.rank() == 0 || algorithms.empty()) {
     throw std::invalid_argument("TrainingRun::join: rank 0 creates or resumes the run");
   }
-  TrainingRun run(*algorithms.front(), std::move(parse_sets), RunSettings{}, fs::path(), output);
+  TrainingRun run(*algorithms.front(), RunSettings{}, fs::path(), output);
   run.communicator_ = &communicator;
   run.join_algorithms_ = algorithms;
   return run;
@@ -460,7 +457,7 @@ std::optional<json> TrainingRun::train() {
   if (lead() && !lock_) lock_ = RunLock::acquire(folder_, "train");
   try {
     try {
-      env_ = make_training_env(settings_, parse_sets_);
+      env_ = make_training_env(settings_);
     } catch (const std::invalid_argument& error) {
       // A new run's env config that `make` refuses (msaa more than this OpenGL offers) is the
       // request's fault; a resumed run's was made before.
@@ -605,8 +602,8 @@ void TrainingRun::plan_time_budget() {
   left_at_start_s_ = time_limit_s_ - elapsed_s();
   if (time_limit_s_ <= 0.0 || !lead()) return;
   const auto probe_start = std::chrono::steady_clock::now();
-  cost_ = measure_evaluation_cost(
-      algorithm_->actor(), settings_, parse_sets_, run_->path(), kCostProbeSteps, [&] {
+  cost_ =
+      measure_evaluation_cost(algorithm_->actor(), settings_, run_->path(), kCostProbeSteps, [&] {
         progress_->tick_note("time budget: timing evaluation steps (" +
                              one_decimal(seconds_since(probe_start)) + " s so far)");
       });
@@ -746,8 +743,7 @@ void TrainingRun::evaluate_when_due(std::int64_t steps_before) {
     progress_->tick_note("eval at " + std::to_string(steps) + " env steps: evaluating (" +
                          one_decimal(seconds_since(eval_start)) + " s so far)");
   };
-  const PolicyEvaluation evaluation =
-      evaluate(algorithm_->actor(), settings_, parse_sets_, request);
+  const PolicyEvaluation evaluation = evaluate(algorithm_->actor(), settings_, request);
   EvalRow row;
   row.steps = steps;
   row.wall_time_s = elapsed_s();
@@ -855,8 +851,7 @@ json TrainingRun::evaluate_and_summarize() {
   };
   std::error_code ignored;
   if (!request.video) fs::remove(video, ignored);  // a previous process's, not of this policy
-  const PolicyEvaluation evaluation =
-      evaluate(algorithm_->actor(), settings_, parse_sets_, request);
+  const PolicyEvaluation evaluation = evaluate(algorithm_->actor(), settings_, request);
   const auto played = static_cast<std::int64_t>(evaluation.returns.size());
   if (played < request.episodes) {
     const std::string cut = std::to_string(played) + " of " + std::to_string(request.episodes) +

@@ -127,9 +127,8 @@ class TrainingRun {
   /// `folder`, which must not hold a run. budget.steps replaces total_env_steps; budget.minutes
   /// becomes settings.minutes. Throws std::invalid_argument when the config, so changed, fails
   /// algorithm.parse_config.
-  static TrainingRun create(const AlgorithmFactory& algorithm, EnvKwargsParser parse_sets,
-                            RunSettings settings, std::filesystem::path folder, TrainBudget budget,
-                            RunOutput output);
+  static TrainingRun create(const AlgorithmFactory& algorithm, RunSettings settings,
+                            std::filesystem::path folder, TrainBudget budget, RunOutput output);
 
   /// More of the run in `folder`, from its config.json and its latest valid checkpoint (newer
   /// invalid ones are reported to output.errors as "train: skipping {path}: {reason}"). Without
@@ -137,9 +136,8 @@ class TrainingRun {
   /// RunRequestError for a `given` setting that differs from the run's or budget.steps not
   /// above the steps done; std::runtime_error when there is no config.json or no valid
   /// checkpoint, or config.json is not a run's.
-  static TrainingRun resume(const AlgorithmFactory& algorithm, EnvKwargsParser parse_sets,
-                            std::filesystem::path folder, TrainBudget budget,
-                            const ResumeChecks& given, RunOutput output);
+  static TrainingRun resume(const AlgorithmFactory& algorithm, std::filesystem::path folder,
+                            TrainBudget budget, const ResumeChecks& given, RunOutput output);
 
   /// The run folder is locked (RunLock) from resume() or the start of train() until train()
   /// returns or throws: a second process is refused meanwhile.
@@ -165,8 +163,8 @@ class TrainingRun {
   /// Rank communicator.rank() > 0 of a data-parallel run whose rank 0 runs `distribute`: its
   /// settings, budget and resume point come from rank 0 at train(), which writes no file and
   /// returns nullopt.
-  static TrainingRun join(const AlgorithmFactories& algorithms, EnvKwargsParser parse_sets,
-                          Communicator& communicator, RunOutput output);
+  static TrainingRun join(const AlgorithmFactories& algorithms, Communicator& communicator,
+                          RunOutput output);
 
   /// Makes `flag` (set by a signal handler: Ctrl-C) stop the run: once it is true the iteration
   /// in progress ends as a time budget would end it, the last checkpoint is written, and train()
@@ -189,8 +187,8 @@ class TrainingRun {
   const std::filesystem::path& folder() const { return folder_; }
 
  private:
-  TrainingRun(const AlgorithmFactory& algorithm, EnvKwargsParser parse_sets, RunSettings settings,
-              std::filesystem::path folder, RunOutput output);
+  TrainingRun(const AlgorithmFactory& algorithm, RunSettings settings, std::filesystem::path folder,
+              RunOutput output);
 
   // Resume: the budget from config.json's latest resume, the checkpoint and its meta.
   void load_resume_point(const nlohmann::json& config);
@@ -231,7 +229,6 @@ class TrainingRun {
   std::vector<double> gather_returns(const std::vector<double>& mine);
 
   const AlgorithmFactory* factory_;
-  EnvKwargsParser parse_sets_;
   RunSettings settings_;
   std::filesystem::path folder_;
   RunOutput output_;

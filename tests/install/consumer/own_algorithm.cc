@@ -175,18 +175,6 @@ class RandomSearchFactory final : public AlgorithmFactory {
   }
 };
 
-// The env's kwargs of `sets` (KEY=VALUE): obs_mode a string, the others integers.
-Params parse_sets(const std::string& /*id*/, const std::vector<std::string>& sets) {
-  Params params;
-  for (const std::string& entry : sets) {
-    const std::size_t equals = entry.find('=');
-    const std::string key = entry.substr(0, equals);
-    params.emplace(key, parse_param(key == "obs_mode" ? ParamType::kString : ParamType::kInt,
-                                    entry.substr(equals + 1)));
-  }
-  return params;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -199,22 +187,25 @@ int main(int argc, char** argv) {
   const RandomSearchFactory factory;
   RunSettings settings;
   settings.env_id = "CartPoleBalance-v1";
-  settings.sets = {"obs_mode=state", "max_episode_steps=50", "render_width=32", "render_height=32"};
+  settings.env_kwargs = {{"obs_mode", "state"},
+                         {"max_episode_steps", 50},
+                         {"render_width", 32},
+                         {"render_height", 32}};
   settings.num_threads = 1;
   settings.checkpoint_every = 4;
   settings.keep_checkpoints = 1;
   settings.eval_episodes = 2;
   settings.algorithm_config = factory.parse_config(R"({"seed": 3})");
-  std::optional<json> summary = TrainingRun::create(factory, parse_sets, settings, folder,
-                                                    TrainBudget{}, RunOutput{std::cout, std::cerr})
-                                    .train();
+  std::optional<json> summary =
+      TrainingRun::create(factory, settings, folder, TrainBudget{}, RunOutput{std::cout, std::cerr})
+          .train();
   if (!summary) throw std::runtime_error("the new run returned no summary");
   const ProgressTable progress = read_progress_csv(folder / "progress.csv");
   std::cout << "own algorithm trained: " << progress.rows.size() << " rows, last best_return "
             << progress.column("best_return").back() << ", evaluation return_mean "
             << summary->at("evaluation").at("return_mean").get<double>() << "\n";
 
-  summary = TrainingRun::resume(factory, parse_sets, folder, TrainBudget{600, 0.0}, ResumeChecks{},
+  summary = TrainingRun::resume(factory, folder, TrainBudget{600, 0.0}, ResumeChecks{},
                                 RunOutput{std::cout, std::cerr})
                 .train();
   if (!summary) throw std::runtime_error("the resumed run returned no summary");

@@ -148,20 +148,11 @@ class CountingFactory final : public AlgorithmFactory {
   int actor_sleep_ms = 0;                     // its actor's (DownActor::sleep_ms)
 };
 
-Params integer_kwargs(const std::string&, const std::vector<std::string>& sets) {
-  Params params;
-  for (const std::string& entry : sets) {
-    const std::size_t equals = entry.find('=');
-    params.emplace(entry.substr(0, equals), parse_param(ParamType::kInt, entry.substr(equals + 1)));
-  }
-  return params;
-}
-
 RunSettings grid_settings(std::int64_t checkpoint_every = 2, std::int64_t keep_checkpoints = 2) {
   const CountingFactory factory;
   RunSettings settings;
   settings.env_id = "GridWorld-v0";
-  settings.sets = {"render_width=32", "render_height=32"};
+  settings.env_kwargs = {{"render_width", 32}, {"render_height", 32}};
   settings.num_threads = 1;
   settings.checkpoint_every = checkpoint_every;
   settings.keep_checkpoints = keep_checkpoints;
@@ -213,8 +204,8 @@ TEST(TrainingRunTest, ANewRunTrainsToItsStepBudgetAndWritesTheRunFolder) {
   const CountingFactory factory;
   std::ostringstream out;
   std::ostringstream errors;
-  TrainingRun run = TrainingRun::create(factory, integer_kwargs, grid_settings(), folder,
-                                        TrainBudget{}, RunOutput{out, errors});
+  TrainingRun run =
+      TrainingRun::create(factory, grid_settings(), folder, TrainBudget{}, RunOutput{out, errors});
   const std::optional<json> summary = run.train();
   ASSERT_TRUE(summary.has_value()) << out.str();
 
@@ -268,8 +259,8 @@ TEST(TrainingRunTest, EvaluationsDuringTrainingKeepToTheirShareOfTheTime) {
     settings.eval_max_share = share;
     std::ostringstream out;
     std::ostringstream errors;
-    TrainingRun run = TrainingRun::create(factory, integer_kwargs, settings, folder, TrainBudget{},
-                                          RunOutput{out, errors});
+    TrainingRun run =
+        TrainingRun::create(factory, settings, folder, TrainBudget{}, RunOutput{out, errors});
     EXPECT_TRUE(run.train().has_value()) << out.str();
     *output = out.str();
     std::ifstream csv(folder / "eval.csv");
@@ -297,16 +288,17 @@ TEST(TrainingRunTest, AResumedRunIsTheRunThatDidNotStop) {
   std::ostringstream errors;
   RunSettings settings = grid_settings(3, 0);
   settings.algorithm_config["steps_per_iteration"] = 16;  // 32 env steps an iteration
-  settings.sets.push_back("max_episode_steps=12");        // episodes end, at the goal or truncated
-  TrainingRun whole = TrainingRun::create(factory, integer_kwargs, settings, base / "whole",
-                                          TrainBudget{192, 0.0}, {out, errors});
+  settings.env_kwargs.insert_or_assign("max_episode_steps",
+                                       12);  // episodes end, at the goal or truncated
+  TrainingRun whole =
+      TrainingRun::create(factory, settings, base / "whole", TrainBudget{192, 0.0}, {out, errors});
   ASSERT_TRUE(whole.train().has_value());
-  TrainingRun first = TrainingRun::create(factory, integer_kwargs, settings, base / "stopped",
-                                          TrainBudget{96, 0.0}, {out, errors});
+  TrainingRun first =
+      TrainingRun::create(factory, settings, base / "stopped", TrainBudget{96, 0.0}, {out, errors});
   ASSERT_TRUE(first.train().has_value());
   std::ostringstream resumed_out;
-  TrainingRun resumed = TrainingRun::resume(factory, integer_kwargs, base / "stopped",
-                                            TrainBudget{192, 0.0}, {}, {resumed_out, errors});
+  TrainingRun resumed = TrainingRun::resume(factory, base / "stopped", TrainBudget{192, 0.0}, {},
+                                            {resumed_out, errors});
   ASSERT_TRUE(resumed.train().has_value());
   EXPECT_NE(resumed_out.str().find("resuming " + (base / "stopped").string() +
                                    " from ckpt-000003.pgck (96 env steps, 3 updates)"),
@@ -356,30 +348,28 @@ TEST(TrainingRunTest, AResumeKeepsTheRunsBudgetAndRefusesWhatDoesNotFit) {
   const CountingFactory factory;
   std::ostringstream out;
   std::ostringstream errors;
-  ASSERT_TRUE(TrainingRun::create(factory, integer_kwargs, grid_settings(), folder,
-                                  TrainBudget{16, 0.0}, {out, errors})
-                  .train()
-                  .has_value());
+  ASSERT_TRUE(
+      TrainingRun::create(factory, grid_settings(), folder, TrainBudget{16, 0.0}, {out, errors})
+          .train()
+          .has_value());
   const auto rows = [&] { return read_progress_csv(folder / "progress.csv").rows.size(); };
   ASSERT_EQ(rows(), 2U);
 
   std::ostringstream spent;
-  EXPECT_FALSE(
-      TrainingRun::resume(factory, integer_kwargs, folder, {}, {}, {spent, errors}).train());
+  EXPECT_FALSE(TrainingRun::resume(factory, folder, {}, {}, {spent, errors}).train());
   EXPECT_NE(spent.str().find("nothing to do, the run has spent its env steps (16 of 16): give "
                              "--steps N (more than 16) to train on"),
             std::string::npos)
       << spent.str();
   EXPECT_EQ(rows(), 2U);
 
-  EXPECT_THROW(
-      TrainingRun::resume(factory, integer_kwargs, folder, TrainBudget{16, 0.0}, {}, {out, errors}),
-      RunRequestError);
+  EXPECT_THROW(TrainingRun::resume(factory, folder, TrainBudget{16, 0.0}, {}, {out, errors}),
+               RunRequestError);
   {
     // Another process training in the folder: a resume is refused before it reads anything.
     const RunLock other = RunLock::acquire(folder, "train");
     try {
-      TrainingRun::resume(factory, integer_kwargs, folder, TrainBudget{24, 0.0}, {}, {out, errors});
+      TrainingRun::resume(factory, folder, TrainBudget{24, 0.0}, {}, {out, errors});
       ADD_FAILURE() << "a resume of a folder in use was accepted";
     } catch (const std::runtime_error& error) {
       EXPECT_NE(std::string(error.what()).find("is in use: another process (pid"),
@@ -392,8 +382,7 @@ TEST(TrainingRunTest, AResumeKeepsTheRunsBudgetAndRefusesWhatDoesNotFit) {
   given.num_threads = 1;  // the run's
   given.eval_episodes = 3;
   try {
-    TrainingRun::resume(factory, integer_kwargs, folder, TrainBudget{24, 0.0}, given,
-                        {out, errors});
+    TrainingRun::resume(factory, folder, TrainBudget{24, 0.0}, given, {out, errors});
     ADD_FAILURE() << "a differing --eval-episodes was accepted";
   } catch (const RunRequestError& error) {
     EXPECT_NE(std::string(error.what())
@@ -404,14 +393,12 @@ TEST(TrainingRunTest, AResumeKeepsTheRunsBudgetAndRefusesWhatDoesNotFit) {
   }
 
   // A picosecond more: spent before the first update, which given minutes allow all the same.
-  ASSERT_TRUE(TrainingRun::resume(factory, integer_kwargs, folder, TrainBudget{400, 1e-14}, {},
-                                  {out, errors})
+  ASSERT_TRUE(TrainingRun::resume(factory, folder, TrainBudget{400, 1e-14}, {}, {out, errors})
                   .train()
                   .has_value());
   EXPECT_EQ(rows(), 3U);
   std::ostringstream again;
-  EXPECT_FALSE(
-      TrainingRun::resume(factory, integer_kwargs, folder, {}, {}, {again, errors}).train());
+  EXPECT_FALSE(TrainingRun::resume(factory, folder, {}, {}, {again, errors}).train());
   EXPECT_NE(again.str().find("nothing to do, the run has spent its time"), std::string::npos)
       << again.str();
   EXPECT_EQ(rows(), 3U);
