@@ -75,54 +75,18 @@ torch::Tensor beside(const torch::Tensor& head, const torch::Tensor& vectors) {
 }  // namespace
 
 void DrqConfig::validate() const {
-  const auto fail = [](const std::string& what) {
-    throw std::invalid_argument(std::string(kConfigName) + ": " + what);
-  };
-  constexpr std::int64_t kMost = std::int64_t{1} << 40;
-  const auto at_least = [&](const char* name, std::int64_t value, std::int64_t minimum) {
-    if (value < minimum || value > kMost) {
-      fail(std::string(name) + " must be from " + std::to_string(minimum) + " to " +
-           std::to_string(kMost) + ", got " + std::to_string(value));
-    }
-  };
-  const auto in_range = [&](const char* name, double value, double low, double high) {
-    if (!(value >= low && value <= high)) {
-      std::ostringstream message;
-      message << name << " must be in [" << low << ", " << high << "], got " << value;
-      fail(message.str());
-    }
-  };
-  at_least("num_envs", num_envs, 1);
-  at_least("total_env_steps", total_env_steps, 1);
-  at_least("iteration_env_steps", iteration_env_steps, 1);
-  if (iteration_env_steps % num_envs != 0) {
-    fail("iteration_env_steps must be a multiple of num_envs (" + std::to_string(num_envs) +
-         "), got " + std::to_string(iteration_env_steps));
-  }
-  at_least("frame_stack", frame_stack, 1);
-  at_least("batch_size", batch_size, 1);
-  at_least("n_step", n_step, 1);
-  at_least("replay_capacity", replay_capacity, num_envs * (n_step + frame_stack + 2));
-  in_range("gamma", gamma, 0.0, 1.0);
-  if (!(learning_rate > 0.0 && std::isfinite(learning_rate))) {
-    fail("learning_rate must be positive, got " + std::to_string(learning_rate));
-  }
-  in_range("init_temperature", init_temperature, 1e-8, 1e8);
-  if (!std::isnan(target_entropy)) in_range("target_entropy", target_entropy, -1e6, 1e6);
-  at_least("actor_update_every", actor_update_every, 1);
-  at_least("target_update_every", target_update_every, 1);
-  in_range("critic_tau", critic_tau, 0.0, 1.0);
-  at_least("feature_dim", feature_dim, 1);
-  at_least("hidden_dim", hidden_dim, 1);
-  at_least("hidden_depth", hidden_depth, 1);
-  in_range("log_std_min", log_std_min, -20.0, 5.0);
-  in_range("log_std_max", log_std_max, log_std_min, 5.0);
-  at_least("seed_env_steps", seed_env_steps, 0);
-  in_range("updates_per_env_step", updates_per_env_step, 0.0, 64.0);
-  in_range("shift_pad", static_cast<double>(shift_pad), 0.0, 65536.0);
-  at_least("augmented_copies", augmented_copies, 1);
+  const trainer::ConfigChecks checks(kConfigName);
+  trainer::validate_off_policy_settings(*this, checks);
+  checks.in_range("init_temperature", init_temperature, 1e-8, 1e8);
+  if (!std::isnan(target_entropy)) checks.in_range("target_entropy", target_entropy, -1e6, 1e6);
+  checks.at_least("actor_update_every", actor_update_every, 1);
+  checks.at_least("target_update_every", target_update_every, 1);
+  checks.at_least("hidden_depth", hidden_depth, 1);
+  checks.in_range("log_std_min", log_std_min, -20.0, 5.0);
+  checks.in_range("log_std_max", log_std_max, log_std_min, 5.0);
+  checks.at_least("augmented_copies", augmented_copies, 1);
   if (augmented_copies > 8) {
-    fail("augmented_copies must be from 1 to 8, got " + std::to_string(augmented_copies));
+    checks.fail("augmented_copies must be from 1 to 8, got " + std::to_string(augmented_copies));
   }
 }
 
@@ -131,35 +95,18 @@ double DrqConfig::entropy_target(std::int64_t action_size) const {
 }
 
 void to_json(nlohmann::json& json, const DrqConfig& config) {
-  json = {
-      {"seed", config.seed},
-      {"num_envs", config.num_envs},
-      {"total_env_steps", config.total_env_steps},
-      {"iteration_env_steps", config.iteration_env_steps},
-      {"frame_stack", config.frame_stack},
-      {"replay_capacity", config.replay_capacity},
-      {"batch_size", config.batch_size},
-      {"n_step", config.n_step},
-      {"gamma", config.gamma},
-      {"learning_rate", config.learning_rate},
-      {"init_temperature", config.init_temperature},
-      {"target_entropy", std::isnan(config.target_entropy) ? nlohmann::json(nullptr)
-                                                           : nlohmann::json(config.target_entropy)},
-      {"actor_update_every", config.actor_update_every},
-      {"target_update_every", config.target_update_every},
-      {"critic_tau", config.critic_tau},
-      {"encoder", trainer::to_string(config.encoder)},
-      {"feature_dim", config.feature_dim},
-      {"hidden_dim", config.hidden_dim},
-      {"hidden_depth", config.hidden_depth},
-      {"log_std_min", config.log_std_min},
-      {"log_std_max", config.log_std_max},
-      {"seed_env_steps", config.seed_env_steps},
-      {"updates_per_env_step", config.updates_per_env_step},
-      {"shift_pad", config.shift_pad},
-      {"augmented_copies", config.augmented_copies},
-      {"bfloat16", config.bfloat16},
-      {"channels_last", config.channels_last}};
+  json = nlohmann::json::object();
+  trainer::add_off_policy_settings(json, config);
+  json["init_temperature"] = config.init_temperature;
+  json["target_entropy"] = std::isnan(config.target_entropy)
+                               ? nlohmann::json(nullptr)
+                               : nlohmann::json(config.target_entropy);
+  json["actor_update_every"] = config.actor_update_every;
+  json["target_update_every"] = config.target_update_every;
+  json["hidden_depth"] = config.hidden_depth;
+  json["log_std_min"] = config.log_std_min;
+  json["log_std_max"] = config.log_std_max;
+  json["augmented_copies"] = config.augmented_copies;
 }
 
 void from_json(const nlohmann::json& json, DrqConfig& config) {
@@ -168,16 +115,7 @@ void from_json(const nlohmann::json& json, DrqConfig& config) {
   std::vector<std::string> known;
   for (const auto& item : defaults.items()) known.push_back(item.key());
   trainer::require_known_members(json, known, kConfigName);
-  read_member(json, "seed", config.seed);
-  read_member(json, "num_envs", config.num_envs);
-  read_member(json, "total_env_steps", config.total_env_steps);
-  read_member(json, "iteration_env_steps", config.iteration_env_steps);
-  read_member(json, "frame_stack", config.frame_stack);
-  read_member(json, "replay_capacity", config.replay_capacity);
-  read_member(json, "batch_size", config.batch_size);
-  read_member(json, "n_step", config.n_step);
-  read_member(json, "gamma", config.gamma);
-  read_member(json, "learning_rate", config.learning_rate);
+  trainer::read_off_policy_settings(json, config, kConfigName);
   read_member(json, "init_temperature", config.init_temperature);
   if (json.contains("target_entropy") && json.at("target_entropy").is_null()) {
     config.target_entropy = std::numeric_limits<double>::quiet_NaN();
@@ -186,25 +124,10 @@ void from_json(const nlohmann::json& json, DrqConfig& config) {
   }
   read_member(json, "actor_update_every", config.actor_update_every);
   read_member(json, "target_update_every", config.target_update_every);
-  read_member(json, "critic_tau", config.critic_tau);
-  std::string encoder = trainer::to_string(config.encoder);
-  read_member(json, "encoder", encoder);
-  try {
-    config.encoder = trainer::parse_encoder_architecture(encoder);
-  } catch (const std::invalid_argument& error) {
-    throw std::invalid_argument(std::string(kConfigName) + ": member \"encoder\": " + error.what());
-  }
-  read_member(json, "feature_dim", config.feature_dim);
-  read_member(json, "hidden_dim", config.hidden_dim);
   read_member(json, "hidden_depth", config.hidden_depth);
   read_member(json, "log_std_min", config.log_std_min);
   read_member(json, "log_std_max", config.log_std_max);
-  read_member(json, "seed_env_steps", config.seed_env_steps);
-  read_member(json, "updates_per_env_step", config.updates_per_env_step);
-  read_member(json, "shift_pad", config.shift_pad);
   read_member(json, "augmented_copies", config.augmented_copies);
-  read_member(json, "bfloat16", config.bfloat16);
-  read_member(json, "channels_last", config.channels_last);
   config.validate();
 }
 

@@ -16,6 +16,7 @@
 
 #include "examples/trainer/torch_common/conv_encoder.h"
 #include "examples/trainer/torch_common/input_layout.h"
+#include "examples/trainer/torch_common/off_policy_settings.h"
 #include "examples/trainer/torch_common/replay_buffer.h"
 
 namespace pixelgym::drq {
@@ -26,30 +27,17 @@ using trainer::ObservationView;
 using trainer::ReplayBatch;
 using trainer::ReplayBuffer;
 
-/// Every setting of the learner; validate() checks each. Counts of steps are env steps (all envs
-/// together): with action_repeat K each is K control steps. The defaults are DrQ's published
+/// Every setting of the learner (the shared off-policy ones, torch_common/off_policy_settings.h,
+/// and DrQ's own); validate() checks each. The defaults are DrQ's published
 /// ones (its config.yaml: learning rate 1e-3, batch 128 (512 in the paper), initial
 /// temperature 0.1, target entropy -|A|, actor and target updates every second update, tau 0.01,
 /// features 50, log std in [-10, 2], 1000 seed steps, one update per env step, pad 4, 3 frames)
 /// except where a CPU needs less: hidden 256 (DrQ: 1024), MR.Q's encoder (DrQ: strides
 /// 2, 1, 1, 1) and one shifted copy (DrQ: K = M = 2); docs/experiments/drq.md measures each.
-struct DrqConfig {
-  /// Seeds torch (weights), the replay sampling, the exploration, the augmentation and the envs
-  /// (env i resets with seed + i).
-  std::uint64_t seed = 0;
-  std::int64_t num_envs = 1;
-  std::int64_t total_env_steps = 100'000;
-  /// Env steps per iteration (a progress.csv row). A multiple of num_envs.
-  std::int64_t iteration_env_steps = 500;
-  /// Frames in each observation's stack (--wrap frame_stack=K; 1: single frames).
-  std::int64_t frame_stack = 3;
-  std::int64_t replay_capacity = 100'000;
-  std::int64_t batch_size = 128;
-  /// Steps of the return before bootstrapping (DrQ: 1).
-  std::int64_t n_step = 1;
-  double gamma = 0.99;
-  /// Adam's learning rate of the critic (with the encoder), the actor and the temperature.
-  double learning_rate = 1e-3;
+struct DrqConfig : trainer::OffPolicySettings {
+  /// DrQ's 1-step returns (the shared default is DrQ-v2's 3).
+  DrqConfig() { n_step = 1; }
+
   /// The entropy temperature alpha starts here and is learned towards target_entropy (NaN: -|A|,
   /// SAC's choice).
   double init_temperature = 0.1;
@@ -58,28 +46,14 @@ struct DrqConfig {
   /// critic moves critic_tau towards the critic every target_update_every updates.
   std::int64_t actor_update_every = 2;
   std::int64_t target_update_every = 2;
-  double critic_tau = 0.01;
-  /// The encoder (images only), the width of each network's head (Linear, LayerNorm, tanh over
-  /// the encoder's features) and of the MLPs' hidden_depth hidden layers.
-  EncoderArchitecture encoder = EncoderArchitecture::kMrq;
-  std::int64_t feature_dim = 50;
-  std::int64_t hidden_dim = 256;
+  /// Hidden layers of each MLP (of hidden_dim).
   std::int64_t hidden_depth = 2;
   /// The actor's log standard deviation is squashed into [log_std_min, log_std_max].
   double log_std_min = -10.0;
   double log_std_max = 2.0;
-  /// Env steps of uniformly random actions before the policy acts (and learning starts).
-  std::int64_t seed_env_steps = 1000;
-  /// Updates per env step (all envs together); fractions carry over.
-  double updates_per_env_step = 1.0;
-  /// Random shifts by up to shift_pad pixels (0: none), and how many shifted copies of each
-  /// observation and next observation an update averages its target and loss over (DrQ's K and
-  /// M, equal here).
-  std::int64_t shift_pad = 4;
+  /// How many shifted copies of each observation and next observation an update averages its
+  /// target and loss over (DrQ's K and M, equal here).
   std::int64_t augmented_copies = 1;
-  /// bfloat16 autocast of the encoder where the CPU has it; channels-last images.
-  bool bfloat16 = true;
-  bool channels_last = true;
 
   /// Throws std::invalid_argument naming the first member out of range and its value.
   void validate() const;

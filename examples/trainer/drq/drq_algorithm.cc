@@ -27,27 +27,8 @@ using nlohmann::json;
 
 const DrqConfig& checked(const DrqConfig& config, const vector::VectorEnv& env) {
   config.validate();
-  if (env.autoreset_mode() != vector::AutoresetMode::kSameStep) {
-    throw std::invalid_argument(
-        std::string("drq: the vector env must autoreset in SameStep mode (an episode's last "
-                    "observation comes from infos[\"final_obs\"]), got ") +
-        vector::autoreset_mode_name(env.autoreset_mode()));
-  }
-  if (env.num_envs() != config.num_envs) {
-    throw std::invalid_argument("drq: config num_envs is " + std::to_string(config.num_envs) +
-                                " but the vector env has " + std::to_string(env.num_envs()));
-  }
-  trainer::require_memory(
-      "drq", trainer::off_policy_memory_estimate(
-                 trainer::input_layout(env.single_observation_space(), env.single_action_space(),
-                                       config.frame_stack, "drq", env.name()),
-                 {config.replay_capacity, config.batch_size * config.augmented_copies,
-                  config.hidden_dim, config.feature_dim, config.encoder}));
+  trainer::require_off_policy_env(config, env, "drq", config.batch_size * config.augmented_copies);
   return config;
-}
-
-double mean_or_none(double sum, std::int64_t count) {
-  return count > 0 ? sum / static_cast<double>(count) : trainer::ProgressRow::kNone;
 }
 
 }  // namespace
@@ -135,12 +116,12 @@ std::map<std::string, double> DrqStepLearner::end_iteration(const trainer::LoopT
   const IterationSums sums = std::exchange(sums_, IterationSums{});
   const std::int64_t updates = updates_.iteration_updates();
   std::map<std::string, double> metrics = {
-      {"critic_loss", mean_or_none(sums.critic_loss, updates)},
-      {"actor_loss", mean_or_none(sums.actor_loss, sums.actor_updates)},
-      {"q_mean", mean_or_none(sums.q_mean, updates)},
-      {"target_mean", mean_or_none(sums.target_mean, updates)},
+      {"critic_loss", trainer::mean_or_none(sums.critic_loss, updates)},
+      {"actor_loss", trainer::mean_or_none(sums.actor_loss, sums.actor_updates)},
+      {"q_mean", trainer::mean_or_none(sums.q_mean, updates)},
+      {"target_mean", trainer::mean_or_none(sums.target_mean, updates)},
       {"alpha", sums.alpha},
-      {"policy_entropy", mean_or_none(sums.entropy, sums.actor_updates)}};
+      {"policy_entropy", trainer::mean_or_none(sums.entropy, sums.actor_updates)}};
   updates_.end_iteration(buffer_, times, metrics);
   return metrics;
 }
@@ -195,17 +176,7 @@ void DrqStepLearner::restore(const LoadedCheckpoint& checkpoint, const json& met
 // ---- DrqAlgorithmFactory -------------------------------------------------------------------
 
 json DrqAlgorithmFactory::parse_config(const std::string& text) const {
-  json parsed;
-  try {
-    parsed = json::parse(text);
-  } catch (const json::parse_error& error) {
-    throw std::invalid_argument(std::string("DrqConfig JSON: ") + error.what());
-  }
-  DrqConfig config;
-  from_json(parsed, config);
-  json out;
-  to_json(out, config);
-  return out;
+  return trainer::parse_off_policy_config<DrqConfig>(text, "DrqConfig");
 }
 
 int DrqAlgorithmFactory::set_threads(int requested) const {
@@ -214,12 +185,7 @@ int DrqAlgorithmFactory::set_threads(int requested) const {
 
 std::unique_ptr<trainer::Algorithm> DrqAlgorithmFactory::make(
     trainer::EnvLoop& loop, const json& config, trainer::Communicator& communicator) const {
-  if (communicator.world_size() > 1) {
-    throw std::invalid_argument(
-        "train --algo drq runs in one process; it was started as " +
-        std::to_string(communicator.world_size()) +
-        " ranks (--nproc or WORLD_SIZE). Data-parallel training is PPO's (--algo ppo)");
-  }
+  trainer::require_one_process(communicator, "drq");
   DrqConfig parsed;
   from_json(config, parsed);
   return std::make_unique<trainer::SteppedAlgorithm>(

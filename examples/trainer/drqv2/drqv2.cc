@@ -58,53 +58,13 @@ torch::nn::Sequential make_mlp(std::int64_t in, std::int64_t hidden, std::int64_
 }  // namespace
 
 void DrqV2Config::validate() const {
-  const auto fail = [](const std::string& what) {
-    throw std::invalid_argument(std::string(kConfigName) + ": " + what);
-  };
-  // Counts are at most 2^40 (about 1.1e12): far past any run, and far from overflowing the
-  // products of counts that sizes are made of; the memory they take is checked with the env.
-  constexpr std::int64_t kMost = std::int64_t{1} << 40;
-  const auto at_least = [&](const char* name, std::int64_t value, std::int64_t minimum) {
-    if (value < minimum || value > kMost) {
-      fail(std::string(name) + " must be from " + std::to_string(minimum) + " to " +
-           std::to_string(kMost) + ", got " + std::to_string(value));
-    }
-  };
-  const auto in_range = [&](const char* name, double value, double low, double high) {
-    if (!(value >= low && value <= high)) {
-      std::ostringstream message;
-      message << name << " must be in [" << low << ", " << high << "], got " << value;
-      fail(message.str());
-    }
-  };
-  at_least("num_envs", num_envs, 1);
-  at_least("total_env_steps", total_env_steps, 1);
-  at_least("iteration_env_steps", iteration_env_steps, 1);
-  if (iteration_env_steps % num_envs != 0) {
-    fail("iteration_env_steps must be a multiple of num_envs (" + std::to_string(num_envs) +
-         "), got " + std::to_string(iteration_env_steps));
-  }
-  at_least("frame_stack", frame_stack, 1);
-  at_least("batch_size", batch_size, 1);
-  at_least("n_step", n_step, 1);
-  at_least("replay_capacity", replay_capacity, num_envs * (n_step + frame_stack + 2));
-  in_range("gamma", gamma, 0.0, 1.0);
-  if (!(learning_rate > 0.0 && std::isfinite(learning_rate))) {
-    fail("learning_rate must be positive, got " + std::to_string(learning_rate));
-  }
-  in_range("critic_tau", critic_tau, 0.0, 1.0);
-  at_least("feature_dim", feature_dim, 1);
-  at_least("hidden_dim", hidden_dim, 1);
-  at_least("seed_env_steps", seed_env_steps, 0);
-  in_range("updates_per_env_step", updates_per_env_step, 0.0, 64.0);
-  in_range("noise_start", noise_start, 0.0, 10.0);
-  in_range("noise_end", noise_end, 0.0, 10.0);
-  at_least("noise_schedule_env_steps", noise_schedule_env_steps, 0);
-  in_range("noise_clip", noise_clip, 0.0, 10.0);
-  in_range("actor_preactivation_penalty", actor_preactivation_penalty, 0.0, 1e3);
-  // Any pad is well defined (past the image's size every shifted pixel repeats an edge); the
-  // bound only keeps 2 pad + 1, the count of offsets drawn, far from overflowing.
-  in_range("shift_pad", static_cast<double>(shift_pad), 0.0, 65536.0);
+  const trainer::ConfigChecks checks(kConfigName);
+  trainer::validate_off_policy_settings(*this, checks);
+  checks.in_range("noise_start", noise_start, 0.0, 10.0);
+  checks.in_range("noise_end", noise_end, 0.0, 10.0);
+  checks.at_least("noise_schedule_env_steps", noise_schedule_env_steps, 0);
+  checks.in_range("noise_clip", noise_clip, 0.0, 10.0);
+  checks.in_range("actor_preactivation_penalty", actor_preactivation_penalty, 0.0, 1e3);
 }
 
 double DrqV2Config::noise_std(std::int64_t env_steps) const {
@@ -115,30 +75,13 @@ double DrqV2Config::noise_std(std::int64_t env_steps) const {
 }
 
 void to_json(nlohmann::json& json, const DrqV2Config& config) {
-  json = {{"seed", config.seed},
-          {"num_envs", config.num_envs},
-          {"total_env_steps", config.total_env_steps},
-          {"iteration_env_steps", config.iteration_env_steps},
-          {"frame_stack", config.frame_stack},
-          {"replay_capacity", config.replay_capacity},
-          {"batch_size", config.batch_size},
-          {"n_step", config.n_step},
-          {"gamma", config.gamma},
-          {"learning_rate", config.learning_rate},
-          {"critic_tau", config.critic_tau},
-          {"encoder", to_string(config.encoder)},
-          {"feature_dim", config.feature_dim},
-          {"hidden_dim", config.hidden_dim},
-          {"seed_env_steps", config.seed_env_steps},
-          {"updates_per_env_step", config.updates_per_env_step},
-          {"noise_start", config.noise_start},
-          {"noise_end", config.noise_end},
-          {"noise_schedule_env_steps", config.noise_schedule_env_steps},
-          {"noise_clip", config.noise_clip},
-          {"actor_preactivation_penalty", config.actor_preactivation_penalty},
-          {"shift_pad", config.shift_pad},
-          {"bfloat16", config.bfloat16},
-          {"channels_last", config.channels_last}};
+  json = nlohmann::json::object();
+  trainer::add_off_policy_settings(json, config);
+  json["noise_start"] = config.noise_start;
+  json["noise_end"] = config.noise_end;
+  json["noise_schedule_env_steps"] = config.noise_schedule_env_steps;
+  json["noise_clip"] = config.noise_clip;
+  json["actor_preactivation_penalty"] = config.actor_preactivation_penalty;
 }
 
 void from_json(const nlohmann::json& json, DrqV2Config& config) {
@@ -147,36 +90,12 @@ void from_json(const nlohmann::json& json, DrqV2Config& config) {
   std::vector<std::string> known;
   for (const auto& item : defaults.items()) known.push_back(item.key());
   trainer::require_known_members(json, known, kConfigName);
-  read_member(json, "seed", config.seed);
-  read_member(json, "num_envs", config.num_envs);
-  read_member(json, "total_env_steps", config.total_env_steps);
-  read_member(json, "iteration_env_steps", config.iteration_env_steps);
-  read_member(json, "frame_stack", config.frame_stack);
-  read_member(json, "replay_capacity", config.replay_capacity);
-  read_member(json, "batch_size", config.batch_size);
-  read_member(json, "n_step", config.n_step);
-  read_member(json, "gamma", config.gamma);
-  read_member(json, "learning_rate", config.learning_rate);
-  read_member(json, "critic_tau", config.critic_tau);
-  std::string encoder = to_string(config.encoder);
-  read_member(json, "encoder", encoder);
-  try {
-    config.encoder = parse_encoder_architecture(encoder);
-  } catch (const std::invalid_argument& error) {
-    throw std::invalid_argument(std::string(kConfigName) + ": member \"encoder\": " + error.what());
-  }
-  read_member(json, "feature_dim", config.feature_dim);
-  read_member(json, "hidden_dim", config.hidden_dim);
-  read_member(json, "seed_env_steps", config.seed_env_steps);
-  read_member(json, "updates_per_env_step", config.updates_per_env_step);
+  trainer::read_off_policy_settings(json, config, kConfigName);
   read_member(json, "noise_start", config.noise_start);
   read_member(json, "noise_end", config.noise_end);
   read_member(json, "noise_schedule_env_steps", config.noise_schedule_env_steps);
   read_member(json, "noise_clip", config.noise_clip);
   read_member(json, "actor_preactivation_penalty", config.actor_preactivation_penalty);
-  read_member(json, "shift_pad", config.shift_pad);
-  read_member(json, "bfloat16", config.bfloat16);
-  read_member(json, "channels_last", config.channels_last);
   config.validate();
 }
 

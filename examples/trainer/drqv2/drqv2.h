@@ -15,6 +15,7 @@
 #include "examples/trainer/torch_common/conv_encoder.h"
 #include "examples/trainer/torch_common/input_layout.h"
 #include "examples/trainer/torch_common/off_policy_networks.h"
+#include "examples/trainer/torch_common/off_policy_settings.h"
 #include "examples/trainer/torch_common/random_shift.h"
 #include "examples/trainer/torch_common/replay_buffer.h"
 #include "pixelgym/envs/space.h"
@@ -36,45 +37,14 @@ using trainer::ReplayLayout;
 using trainer::shift_frames;
 using trainer::to_string;
 
-/// Every setting of the learner; validate() checks each. Counts of steps are env steps (all
-/// envs together): with action_repeat K each is K control steps. The defaults follow DrQ-v2
+/// Every setting of the learner (the shared off-policy ones, torch_common/off_policy_settings.h,
+/// and DrQ-v2's own); validate() checks each. The defaults follow DrQ-v2
 /// (3-step returns, tau 0.01, features 50, noise clip 0.3) with DrQ's learning rate 1e-3 and
 /// one update per env step (DrQ's at action repeat 4 to 8), a smaller batch (128, not 256) and
 /// MLPs (256, not 1024) for a CPU, and TD7's penalty on the actor's pre-tanh values: at DrQ-v2's
 /// learning rate 1e-4 a 100k-control-step run makes too few updates, and at 1e-3 without the
 /// penalty the policy saturated from pixels (docs/drqv2.md, Results).
-struct DrqV2Config {
-  /// Seeds torch (weights), the replay sampling, the exploration noise, the augmentation and the
-  /// envs (env i resets with seed + i).
-  std::uint64_t seed = 0;
-  /// Envs stepped together, and the run's length.
-  std::int64_t num_envs = 1;
-  std::int64_t total_env_steps = 100'000;
-  /// Env steps per iteration (a progress.csv row; checkpoints come every checkpoint_every
-  /// iterations). A multiple of num_envs.
-  std::int64_t iteration_env_steps = 500;
-  /// Frames in each observation's stack (the env must give them: --wrap frame_stack=K, the
-  /// new_axis layout; 1: single frames).
-  std::int64_t frame_stack = 3;
-  /// Replay buffer slots (one per env step, plus one per episode for its last observation).
-  std::int64_t replay_capacity = 100'000;
-  std::int64_t batch_size = 128;
-  std::int64_t n_step = 3;
-  double gamma = 0.99;
-  /// Adam's learning rate of the encoder, the actor and the critic.
-  double learning_rate = 1e-3;
-  /// The target critic moves this fraction towards the critic after each update.
-  double critic_tau = 0.01;
-  /// The encoder, and the width of the actor's and the critic's own trunk (Linear, LayerNorm,
-  /// tanh) and of their hidden layers.
-  EncoderArchitecture encoder = EncoderArchitecture::kMrq;
-  std::int64_t feature_dim = 50;
-  std::int64_t hidden_dim = 256;
-  /// Env steps of uniformly random actions before the policy acts (and learning starts).
-  std::int64_t seed_env_steps = 1000;
-  /// Updates per env step (all envs together): 1 updates after every step of one env, 0.5
-  /// after every second.
-  double updates_per_env_step = 1.0;
+struct DrqV2Config : trainer::OffPolicySettings {
   /// The exploration noise's standard deviation: noise_start, linearly to noise_end over
   /// noise_schedule_env_steps env steps, then noise_end. The target policy's and the actor
   /// loss's noise is clipped to +-noise_clip.
@@ -86,14 +56,6 @@ struct DrqV2Config {
   /// TD7 and MR.Q do): a policy pushed into tanh's flat tails, where the critic's gradient
   /// vanishes, is pulled back. 0: none.
   double actor_preactivation_penalty = 1e-3;
-  /// Random shifts of the images during updates, by up to shift_pad pixels (0: none).
-  std::int64_t shift_pad = 4;
-  /// Run the encoder's convolutions under bfloat16 autocast where the CPU has AVX512-BF16 (or
-  /// AMX); elsewhere it stays float32.
-  bool bfloat16 = true;
-  /// Lay the encoder's images out channels-last (oneDNN's preferred layout: its first
-  /// convolution ran 8x faster so on this project's 2-core AVX2 machine).
-  bool channels_last = true;
 
   /// Throws std::invalid_argument naming the first member out of range and its value.
   void validate() const;

@@ -26,26 +26,8 @@ using nlohmann::json;
 
 const DrqV2Config& checked(const DrqV2Config& config, const vector::VectorEnv& env) {
   config.validate();
-  if (env.autoreset_mode() != vector::AutoresetMode::kSameStep) {
-    throw std::invalid_argument(
-        std::string("drqv2: the vector env must autoreset in SameStep mode (an episode's last "
-                    "observation comes from infos[\"final_obs\"]), got ") +
-        vector::autoreset_mode_name(env.autoreset_mode()));
-  }
-  if (env.num_envs() != config.num_envs) {
-    throw std::invalid_argument("drqv2: config num_envs is " + std::to_string(config.num_envs) +
-                                " but the vector env has " + std::to_string(env.num_envs()));
-  }
-  trainer::require_memory(
-      "drqv2",
-      memory_estimate(input_layout(env.single_observation_space(), env.single_action_space(),
-                                   config.frame_stack, "drqv2", env.name()),
-                      config));
+  trainer::require_off_policy_env(config, env, "drqv2", config.batch_size);
   return config;
-}
-
-double mean_or_none(double sum, std::int64_t count) {
-  return count > 0 ? sum / static_cast<double>(count) : trainer::ProgressRow::kNone;
 }
 
 }  // namespace
@@ -132,11 +114,12 @@ bool DrqV2StepLearner::learn(std::int64_t env_steps, const trainer::StopCheck& s
 std::map<std::string, double> DrqV2StepLearner::end_iteration(const trainer::LoopTimes& times) {
   const IterationSums sums = std::exchange(sums_, IterationSums{});
   const std::int64_t updates = updates_.iteration_updates();
-  std::map<std::string, double> metrics = {{"critic_loss", mean_or_none(sums.critic_loss, updates)},
-                                           {"actor_loss", mean_or_none(sums.actor_loss, updates)},
-                                           {"q_mean", mean_or_none(sums.q_mean, updates)},
-                                           {"target_mean", mean_or_none(sums.target_mean, updates)},
-                                           {"noise_std", config_.noise_std(env_steps_)}};
+  std::map<std::string, double> metrics = {
+      {"critic_loss", trainer::mean_or_none(sums.critic_loss, updates)},
+      {"actor_loss", trainer::mean_or_none(sums.actor_loss, updates)},
+      {"q_mean", trainer::mean_or_none(sums.q_mean, updates)},
+      {"target_mean", trainer::mean_or_none(sums.target_mean, updates)},
+      {"noise_std", config_.noise_std(env_steps_)}};
   updates_.end_iteration(buffer_, times, metrics);
   return metrics;
 }
@@ -194,17 +177,7 @@ void DrqV2StepLearner::restore(const LoadedCheckpoint& checkpoint, const json& m
 // ---- DrqV2AlgorithmFactory -------------------------------------------------------------------
 
 json DrqV2AlgorithmFactory::parse_config(const std::string& text) const {
-  json parsed;
-  try {
-    parsed = json::parse(text);
-  } catch (const json::parse_error& error) {
-    throw std::invalid_argument(std::string("DrqV2Config JSON: ") + error.what());
-  }
-  DrqV2Config config;
-  from_json(parsed, config);
-  json out;
-  to_json(out, config);
-  return out;
+  return trainer::parse_off_policy_config<DrqV2Config>(text, "DrqV2Config");
 }
 
 int DrqV2AlgorithmFactory::set_threads(int requested) const {
@@ -213,12 +186,7 @@ int DrqV2AlgorithmFactory::set_threads(int requested) const {
 
 std::unique_ptr<trainer::Algorithm> DrqV2AlgorithmFactory::make(
     trainer::EnvLoop& loop, const json& config, trainer::Communicator& communicator) const {
-  if (communicator.world_size() > 1) {
-    throw std::invalid_argument(
-        "train --algo drqv2 runs in one process; it was started as " +
-        std::to_string(communicator.world_size()) +
-        " ranks (--nproc or WORLD_SIZE). Data-parallel training is PPO's (--algo ppo)");
-  }
+  trainer::require_one_process(communicator, "drqv2");
   DrqV2Config parsed;
   from_json(config, parsed);
   return std::make_unique<trainer::SteppedAlgorithm>(

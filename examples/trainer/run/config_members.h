@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -98,5 +99,39 @@ inline void require_known_members(const nlohmann::json& json, const std::vector<
     }
   }
 }
+
+/// The range checks of a config's validate(), each error "{config_name}: {member} must be ...,
+/// got {value}" (std::invalid_argument).
+class ConfigChecks {
+ public:
+  /// Counts are at most 2^40 (about 1.1e12): far past any run, and far from overflowing the
+  /// products of counts that sizes are made of.
+  static constexpr std::int64_t kMostCount = std::int64_t{1} << 40;
+
+  explicit ConfigChecks(const char* config_name) : config_name_(config_name) {}
+
+  /// Throws "{config_name}: {what}".
+  [[noreturn]] void fail(const std::string& what) const {
+    throw std::invalid_argument(std::string(config_name_) + ": " + what);
+  }
+  /// A count from `minimum` to kMostCount.
+  void at_least(const char* name, std::int64_t value, std::int64_t minimum) const {
+    if (value < minimum || value > kMostCount) {
+      fail(std::string(name) + " must be from " + std::to_string(minimum) + " to " +
+           std::to_string(kMostCount) + ", got " + std::to_string(value));
+    }
+  }
+  /// A number in [low, high] (NaN is not).
+  void in_range(const char* name, double value, double low, double high) const {
+    if (!(value >= low && value <= high)) {
+      std::ostringstream message;
+      message << name << " must be in [" << low << ", " << high << "], got " << value;
+      fail(message.str());
+    }
+  }
+
+ private:
+  const char* config_name_;
+};
 
 }  // namespace pixelgym::trainer

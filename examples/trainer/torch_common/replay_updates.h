@@ -18,6 +18,11 @@
 
 namespace pixelgym::trainer {
 
+/// sum / count, or ProgressRow::kNone (an empty progress.csv field) when count is 0.
+inline double mean_or_none(double sum, std::int64_t count) {
+  return count > 0 ? sum / static_cast<double>(count) : ProgressRow::kNone;
+}
+
 class ReplayUpdates {
  public:
   /// `num_envs` envs stepped together, `per_env_step` updates per env step (> 0), none before
