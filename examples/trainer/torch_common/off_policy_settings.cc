@@ -38,58 +38,51 @@ void validate_off_policy_settings(const OffPolicySettings& settings, const Confi
   checks.in_range("shift_pad", static_cast<double>(settings.shift_pad), 0.0, 65536.0);
 }
 
+namespace {
+
+// Calls visit(name, field) for each member but the encoder (written by its name), in one list
+// for writing and reading.
+template <typename Settings, typename Visit>
+void visit_members(Settings& settings, Visit&& visit) {
+  visit("seed", settings.seed);
+  visit("num_envs", settings.num_envs);
+  visit("total_env_steps", settings.total_env_steps);
+  visit("iteration_env_steps", settings.iteration_env_steps);
+  visit("frame_stack", settings.frame_stack);
+  visit("replay_capacity", settings.replay_capacity);
+  visit("batch_size", settings.batch_size);
+  visit("n_step", settings.n_step);
+  visit("gamma", settings.gamma);
+  visit("learning_rate", settings.learning_rate);
+  visit("critic_tau", settings.critic_tau);
+  visit("feature_dim", settings.feature_dim);
+  visit("hidden_dim", settings.hidden_dim);
+  visit("seed_env_steps", settings.seed_env_steps);
+  visit("updates_per_env_step", settings.updates_per_env_step);
+  visit("shift_pad", settings.shift_pad);
+  visit("bfloat16", settings.bfloat16);
+  visit("channels_last", settings.channels_last);
+}
+
+}  // namespace
+
 void add_off_policy_settings(nlohmann::json& json, const OffPolicySettings& settings) {
-  json["seed"] = settings.seed;
-  json["num_envs"] = settings.num_envs;
-  json["total_env_steps"] = settings.total_env_steps;
-  json["iteration_env_steps"] = settings.iteration_env_steps;
-  json["frame_stack"] = settings.frame_stack;
-  json["replay_capacity"] = settings.replay_capacity;
-  json["batch_size"] = settings.batch_size;
-  json["n_step"] = settings.n_step;
-  json["gamma"] = settings.gamma;
-  json["learning_rate"] = settings.learning_rate;
-  json["critic_tau"] = settings.critic_tau;
+  visit_members(settings, [&json](const char* name, const auto& field) { json[name] = field; });
   json["encoder"] = to_string(settings.encoder);
-  json["feature_dim"] = settings.feature_dim;
-  json["hidden_dim"] = settings.hidden_dim;
-  json["seed_env_steps"] = settings.seed_env_steps;
-  json["updates_per_env_step"] = settings.updates_per_env_step;
-  json["shift_pad"] = settings.shift_pad;
-  json["bfloat16"] = settings.bfloat16;
-  json["channels_last"] = settings.channels_last;
 }
 
 void read_off_policy_settings(const nlohmann::json& json, OffPolicySettings& settings,
                               const char* config_name) {
-  const auto read = [&](const char* name, auto& field) {
+  visit_members(settings, [&](const char* name, auto& field) {
     read_member(json, name, field, config_name);
-  };
-  read("seed", settings.seed);
-  read("num_envs", settings.num_envs);
-  read("total_env_steps", settings.total_env_steps);
-  read("iteration_env_steps", settings.iteration_env_steps);
-  read("frame_stack", settings.frame_stack);
-  read("replay_capacity", settings.replay_capacity);
-  read("batch_size", settings.batch_size);
-  read("n_step", settings.n_step);
-  read("gamma", settings.gamma);
-  read("learning_rate", settings.learning_rate);
-  read("critic_tau", settings.critic_tau);
+  });
   std::string encoder = to_string(settings.encoder);
-  read("encoder", encoder);
+  read_member(json, "encoder", encoder, config_name);
   try {
     settings.encoder = parse_encoder_architecture(encoder);
   } catch (const std::invalid_argument& error) {
     throw std::invalid_argument(std::string(config_name) + ": member \"encoder\": " + error.what());
   }
-  read("feature_dim", settings.feature_dim);
-  read("hidden_dim", settings.hidden_dim);
-  read("seed_env_steps", settings.seed_env_steps);
-  read("updates_per_env_step", settings.updates_per_env_step);
-  read("shift_pad", settings.shift_pad);
-  read("bfloat16", settings.bfloat16);
-  read("channels_last", settings.channels_last);
 }
 
 void require_one_process(const Communicator& communicator, const char* algorithm) {
