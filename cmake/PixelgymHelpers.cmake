@@ -37,6 +37,32 @@ function(pixelgym_add_library name)
   pixelgym_set_warnings(pixelgym_${name})
 endfunction()
 
+# pixelgym_torch_library(NAME SOURCES ... DEPS ...): static library pixelgym_NAME (alias
+# pixelgym::NAME) of the trainer's LibTorch code, linked to LibTorch and DEPS. TorchConfig.cmake
+# gives a plain `torch` target plus TORCH_INCLUDE_DIRS (find_package(Torch) before the call);
+# those include paths are made SYSTEM so that torch's own warnings do not trip -Werror.
+function(pixelgym_torch_library name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  add_library(pixelgym_${name} STATIC ${ARG_SOURCES})
+  add_library(pixelgym::${name} ALIAS pixelgym_${name})
+  target_compile_features(pixelgym_${name} PUBLIC cxx_std_17)
+  target_include_directories(pixelgym_${name} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>)
+  target_include_directories(pixelgym_${name} SYSTEM PUBLIC ${TORCH_INCLUDE_DIRS})
+  target_link_libraries(pixelgym_${name} PUBLIC ${TORCH_LIBRARIES} ${ARG_DEPS})
+  pixelgym_set_warnings(pixelgym_${name})
+endfunction()
+
+# pixelgym_add_bench(NAME SOURCE LIBS ...): the benchmark program NAME, built only with
+# PIXELGYM_BUILD_BENCH (speed is measured in benchmarks, not in tests).
+function(pixelgym_add_bench name source)
+  cmake_parse_arguments(ARG "" "" "LIBS" ${ARGN})
+  if(PIXELGYM_BUILD_BENCH)
+    add_executable(${name} ${source})
+    target_link_libraries(${name} PRIVATE ${ARG_LIBS})
+    pixelgym_set_warnings(${name})
+  endif()
+endfunction()
+
 # pixelgym_add_test(SOURCE LIBS ...): one GoogleTest executable per test file, named after its
 # path under tests/ (tests/envs/array_test.cc -> envs_array_test), its tests registered with
 # ctest by gtest_discover_tests at test time. Tests run in the build tree with

@@ -1,7 +1,5 @@
 #include "examples/trainer/drq/drq.h"
 
-#include <ATen/autocast_mode.h>
-
 #include <cmath>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -10,7 +8,6 @@
 #include <utility>
 
 #include "examples/trainer/torch_common/off_policy_networks.h"
-#include "examples/trainer/torch_common/random_shift.h"
 #include "pixelgym/trainer/config_members.h"
 
 namespace pixelgym::drq {
@@ -24,7 +21,6 @@ void read_member(const nlohmann::json& json, const char* name, T& field) {
 }
 
 using trainer::copy_parameters;
-using trainer::CpuAutocast;
 using trainer::orthogonal_init;
 using trainer::soft_update;
 
@@ -50,21 +46,8 @@ torch::nn::Sequential make_mlp(std::int64_t in, std::int64_t hidden, std::int64_
   return mlp;
 }
 
-template <typename T>
-torch::Tensor view_of(const std::vector<T>& values, std::vector<std::int64_t> shape,
-                      torch::ScalarType type) {
-  return torch::from_blob(const_cast<T*>(values.data()), shape, torch::TensorOptions(type));
-}
-
-torch::Tensor vectors_of(const std::vector<std::vector<float>>& vectors, const InputLayout& input,
-                         std::int64_t batch) {
-  if (vectors.empty()) return {};
-  std::vector<torch::Tensor> parts;
-  for (std::size_t v = 0; v < vectors.size(); ++v) {
-    parts.push_back(view_of(vectors[v], {batch, input.vector_sizes[v]}, torch::kFloat32));
-  }
-  return parts.size() == 1 ? parts[0] : torch::cat(parts, 1);
-}
+using trainer::batch_vectors;
+using trainer::view_of;
 
 torch::Tensor beside(const torch::Tensor& head, const torch::Tensor& vectors) {
   if (!head.defined()) return vectors;
@@ -134,15 +117,14 @@ void from_json(const nlohmann::json& json, DrqConfig& config) {
 // ---- Agent -----------------------------------------------------------------------------------
 
 Agent::Agent(InputLayout input, const DrqConfig& config)
-    : input_(std::move(input)),
+    : OffPolicyAgent(std::move(input), config),
       log_std_min_(config.log_std_min),
-      log_std_max_(config.log_std_max),
-      autocast_(config.bfloat16 && trainer::cpu_has_bfloat16()),
-      channels_last_(config.channels_last) {
+      log_std_max_(config.log_std_max) {
+  const InputLayout& layout = this->input();
   std::int64_t features = 0;
-  if (input_.has_image) {
+  if (layout.has_image) {
     trainer::ConvEncoder conv = trainer::make_conv_encoder(
-        config.encoder, input_.stack * input_.channels, input_.height, input_.width, "drq");
+        config.encoder, layout.stack * layout.channels, layout.height, layout.width, "drq");
     encoder = register_module("encoder", conv.layers);
     const std::int64_t conv_features = conv.features;
     actor_head = register_module("actor_head", make_head(conv_features, config.feature_dim));
@@ -151,9 +133,9 @@ Agent::Agent(InputLayout input, const DrqConfig& config)
     copy_parameters(*critic_head, *target_head);
     features += config.feature_dim;
   }
-  for (const std::int64_t size : input_.vector_sizes) features += size;
+  for (const std::int64_t size : layout.vector_sizes) features += size;
   if (features == 0) throw std::invalid_argument("drq: the observation has no input");
-  const std::int64_t actions = input_.action_size;
+  const std::int64_t actions = layout.action_size;
   const std::int64_t hidden = config.hidden_dim;
   const std::int64_t depth = config.hidden_depth;
   actor = register_module("actor", make_mlp(features, hidden, depth, 2 * actions));
@@ -169,36 +151,6 @@ Agent::Agent(InputLayout input, const DrqConfig& config)
   }
   log_alpha = register_parameter(
       "log_alpha", torch::full({1}, std::log(config.init_temperature), torch::kFloat32));
-  low_ = register_buffer("action_low", torch::tensor(input_.action_low, torch::kFloat32));
-  high_ = register_buffer("action_high", torch::tensor(input_.action_high, torch::kFloat32));
-}
-
-torch::Tensor Agent::image_input(const torch::Tensor& images) const {
-  const std::int64_t batch = images.size(0);
-  const std::int64_t channels = input_.stack * input_.channels;
-  const torch::Tensor frames =
-      images.view({batch, input_.stack, input_.height, input_.width, input_.channels});
-  if (channels_last_) {
-    return frames.permute({0, 2, 3, 1, 4})
-        .reshape({batch, input_.height, input_.width, channels})
-        .to(torch::kFloat32)
-        .permute({0, 3, 1, 2});
-  }
-  return frames.permute({0, 1, 4, 2, 3})
-      .reshape({batch, channels, input_.height, input_.width})
-      .to(torch::kFloat32);
-}
-
-torch::Tensor Agent::convolve(const torch::Tensor& images) {
-  if (!input_.has_image) return {};
-  torch::Tensor x = images / 255.0 - 0.5;
-  if (channels_last_) x = x.contiguous(at::MemoryFormat::ChannelsLast);
-  torch::Tensor h;
-  {
-    const CpuAutocast autocast(autocast_);
-    h = encoder->forward(x);
-  }
-  return h.to(torch::kFloat32);
 }
 
 torch::Tensor Agent::actor_features(const torch::Tensor& conv, const torch::Tensor& vectors) {
@@ -236,62 +188,19 @@ std::pair<torch::Tensor, torch::Tensor> Agent::q_values(const torch::Tensor& fea
           (target ? target_q2 : q2)->forward(input).squeeze(1)};
 }
 
-torch::Tensor Agent::act(const std::map<std::string, torch::Tensor>& obs, bool deterministic,
+torch::Tensor Agent::act(const trainer::ObservationTensors& obs, bool deterministic,
                          at::Generator* generator) {
   torch::NoGradGuard no_grad;
-  torch::Tensor images;
-  std::int64_t batch = 0;
-  if (input_.has_image) {
-    const torch::Tensor& stacked = obs.at(input_.image_key);
-    batch = stacked.size(0);
-    images = image_input(stacked.reshape({batch, -1}).contiguous());
-  }
-  torch::Tensor vectors;
-  if (!input_.vector_keys.empty()) {
-    std::vector<torch::Tensor> parts;
-    for (const std::string& key : input_.vector_keys) {
-      const torch::Tensor& value = obs.at(key);
-      batch = value.size(0);
-      parts.push_back(value.reshape({batch, -1}).to(torch::kFloat32));
-    }
-    vectors = parts.size() == 1 ? parts[0] : torch::cat(parts, 1);
-  }
-  const torch::Tensor features = actor_features(convolve(images), vectors);
+  const trainer::AgentInput in = observation_input(obs);
+  const torch::Tensor features = actor_features(convolve(in.images), in.vectors);
   if (deterministic || generator == nullptr) return mean_action(features);
   return sample(features, *generator).action;
 }
 
-torch::Tensor Agent::env_action(const torch::Tensor& actions) const {
-  return low_ + (actions + 1.0) * 0.5 * (high_ - low_);
-}
-
-torch::Tensor Agent::unit_action(const torch::Tensor& env_actions) const {
-  return ((env_actions.to(torch::kFloat32) - low_) / (high_ - low_) * 2.0 - 1.0).clamp(-1.0, 1.0);
-}
-
 // ---- Learner ---------------------------------------------------------------------------------
 
-namespace {
-
-std::shared_ptr<Agent> make_agent(InputLayout input, const DrqConfig& config) {
-  config.validate();
-  torch::manual_seed(config.seed);
-  return std::make_shared<Agent>(std::move(input), config);
-}
-
-std::vector<torch::Tensor> parameters_of(std::initializer_list<torch::nn::Module*> modules) {
-  std::vector<torch::Tensor> parameters;
-  for (torch::nn::Module* module : modules) {
-    if (module == nullptr) continue;
-    for (auto& parameter : module->parameters()) parameters.push_back(parameter);
-  }
-  return parameters;
-}
-
-}  // namespace
-
 Learner::Learner(InputLayout input, DrqConfig config)
-    : config_(std::move(config)), agent_(make_agent(std::move(input), config_)) {
+    : config_(std::move(config)), agent_(trainer::make_agent<Agent>(std::move(input), config_)) {
   Agent& agent = *agent_;
   target_entropy_ = config_.entropy_target(agent.input().action_size);
   const auto adam = [&](std::vector<torch::Tensor> parameters) {
@@ -299,10 +208,10 @@ Learner::Learner(InputLayout input, DrqConfig config)
                                                 torch::optim::AdamOptions(config_.learning_rate));
   };
   critic_optimizer_ =
-      adam(parameters_of({agent.encoder ? agent.encoder.ptr().get() : nullptr,
-                          agent.critic_head ? agent.critic_head.ptr().get() : nullptr,
-                          agent.q1.ptr().get(), agent.q2.ptr().get()}));
-  actor_optimizer_ = adam(parameters_of(
+      adam(trainer::parameters_of({agent.encoder ? agent.encoder.ptr().get() : nullptr,
+                                   agent.critic_head ? agent.critic_head.ptr().get() : nullptr,
+                                   agent.q1.ptr().get(), agent.q2.ptr().get()}));
+  actor_optimizer_ = adam(trainer::parameters_of(
       {agent.actor_head ? agent.actor_head.ptr().get() : nullptr, agent.actor.ptr().get()}));
   alpha_optimizer_ = adam({agent.log_alpha});
 }
@@ -314,21 +223,10 @@ UpdateStats Learner::update(const ReplayBatch& batch, at::Generator& augmentatio
   const std::int64_t size = batch.size;
   const std::int64_t copies = input.has_image ? config_.augmented_copies : 1;
   const auto shifted = [&](const std::vector<std::uint8_t>& stacks) {
-    const std::int64_t bytes = input.stack * input.height * input.width * input.channels;
-    if (config_.shift_pad == 0) {
-      return agent.image_input(view_of(stacks, {size, bytes}, torch::kUInt8));
-    }
-    const std::int64_t pad = config_.shift_pad;
-    const torch::Tensor shifts =
-        torch::randint(0, 2 * pad + 1, {size, 2}, augmentation, torch::kInt64);
-    shifted_.resize(stacks.size());
-    trainer::shift_frames(stacks.data(), shifted_.data(), size, input.stack, input.height,
-                          input.width, input.channels, pad, shifts.data_ptr<std::int64_t>());
-    // image_input copies (to float), so shifted_ may be reused by the next call.
-    return agent.image_input(view_of(shifted_, {size, bytes}, torch::kUInt8));
+    return agent.shifted_images(stacks, size, config_.shift_pad, augmentation, shifted_);
   };
-  const torch::Tensor vectors = vectors_of(batch.vectors, input, size);
-  const torch::Tensor next_vectors = vectors_of(batch.next_vectors, input, size);
+  const torch::Tensor vectors = batch_vectors(batch.vectors, input, size);
+  const torch::Tensor next_vectors = batch_vectors(batch.next_vectors, input, size);
   const torch::Tensor actions = view_of(batch.actions, {size, input.action_size}, torch::kFloat32);
   const torch::Tensor rewards = view_of(batch.rewards, {size}, torch::kFloat32);
   const torch::Tensor discounts = view_of(batch.discounts, {size}, torch::kFloat32);

@@ -16,6 +16,7 @@
 
 #include "examples/trainer/torch_common/conv_encoder.h"
 #include "examples/trainer/torch_common/input_layout.h"
+#include "examples/trainer/torch_common/off_policy_agent.h"
 #include "examples/trainer/torch_common/off_policy_settings.h"
 #include "examples/trainer/torch_common/replay_buffer.h"
 
@@ -78,17 +79,14 @@ struct PolicySample {
 /// target critic. From images each network reads the encoder's features through a head of its
 /// own (Linear, LayerNorm, tanh to feature_dim), the vector keys beside them; from vectors
 /// alone it reads them directly, as SAC from state does. Built from torch's default generator
-/// (call torch::manual_seed first); orthogonal weights and zero biases.
-class Agent : public torch::nn::Module {
+/// (call torch::manual_seed first); orthogonal weights and zero biases. The input, the encoder's
+/// pass and the action bounds are the shared OffPolicyAgent's.
+class Agent : public trainer::OffPolicyAgent {
  public:
   Agent(InputLayout input, const DrqConfig& config);
 
-  /// Images uint8 (B, stack * H * W * C) to float (B, stack C, H, W).
-  torch::Tensor image_input(const torch::Tensor& images) const;
-  /// The encoder over float images in [0, 255] (undefined when there is no image).
-  torch::Tensor convolve(const torch::Tensor& images);
   /// The actor's, the critic's or the target critic's input: its head over the encoder's output
-  /// beside the vectors (either may be undefined).
+  /// (convolve's) beside the vectors (either may be undefined).
   torch::Tensor actor_features(const torch::Tensor& conv, const torch::Tensor& vectors);
   torch::Tensor critic_features(const torch::Tensor& conv, const torch::Tensor& vectors,
                                 bool target);
@@ -98,29 +96,17 @@ class Agent : public torch::nn::Module {
   /// Q1 and Q2 (B) of the critic or the target critic.
   std::pair<torch::Tensor, torch::Tensor> q_values(const torch::Tensor& features,
                                                    const torch::Tensor& actions, bool target);
-  /// Actions in [-1, 1] for a batch of a vector env's observations: the mean when
-  /// `deterministic` or `generator` is null, else a sample. Computes no gradients.
-  torch::Tensor act(const std::map<std::string, torch::Tensor>& obs, bool deterministic,
-                    at::Generator* generator);
-  /// Actions in [-1, 1] to the env's bounds (float32), and back.
-  torch::Tensor env_action(const torch::Tensor& actions) const;
-  torch::Tensor unit_action(const torch::Tensor& env_actions) const;
+  /// The mean when `deterministic` or `generator` is null, else a sample.
+  torch::Tensor act(const trainer::ObservationTensors& obs, bool deterministic,
+                    at::Generator* generator) override;
 
-  const InputLayout& input() const { return input_; }
-  bool autocast() const { return autocast_; }
-
-  torch::nn::Sequential encoder{nullptr};
   torch::nn::Sequential actor_head{nullptr}, critic_head{nullptr}, target_head{nullptr};
   torch::nn::Sequential actor{nullptr}, q1{nullptr}, q2{nullptr}, target_q1{nullptr},
       target_q2{nullptr};
   torch::Tensor log_alpha;
 
  private:
-  InputLayout input_;
   double log_std_min_, log_std_max_;
-  bool autocast_ = false;
-  bool channels_last_ = false;
-  torch::Tensor low_, high_;
 };
 
 /// What one update did (NaN where a part was not updated).

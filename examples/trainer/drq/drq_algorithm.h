@@ -1,124 +1,64 @@
-// DrQ as the run's learner (pixelgym/trainer/stepped_algorithm.h): it acts, fills a replay buffer
-// from the env steps the run takes and updates a Learner; and the factory that builds it from
-// config.json's "drq".
+// DrQ as the run's learner (pixelgym/trainer/stepped_algorithm.h): the shared off-policy step
+// learner (torch_common/off_policy_step_learner.h) updating a DrQ Learner; and the factory that
+// builds it from config.json's "drq".
 #pragma once
-
-#include <ATen/core/Generator.h>
-#include <torch/torch.h>
 
 #include <cstdint>
 #include <map>
 #include <memory>
-#include <nlohmann/json.hpp>
-#include <random>
 #include <string>
 #include <vector>
 
 #include "examples/trainer/drq/drq.h"
-#include "examples/trainer/torch_common/replay_buffer.h"
-#include "examples/trainer/torch_common/replay_updates.h"
-#include "pixelgym/trainer/algorithm.h"
+#include "examples/trainer/torch_common/off_policy_factory.h"
+#include "examples/trainer/torch_common/off_policy_step_learner.h"
 #include "pixelgym/trainer/progress_csv.h"
-#include "pixelgym/trainer/stepped_algorithm.h"
 
 namespace pixelgym::drq {
 
-/// An Agent acting for evaluation: the tanh of its Gaussian's mean (deterministic), or a sample
-/// of the squashed Gaussian (a seeded generator of its own).
-class DrqActor final : public trainer::Actor {
- public:
-  /// Throws std::invalid_argument for a null agent.
-  DrqActor(std::shared_ptr<Agent> agent, std::uint64_t seed);
-  trainer::ActCounts act(const Value& observations, bool deterministic, Value& actions) override;
-
- private:
-  std::shared_ptr<Agent> agent_;
-  at::Generator sampling_;
-};
-
-/// DrQ's side of the run's env loop (trainer::SteppedAlgorithm steps the vector env, SameStep
-/// autoreset, num_envs as config.num_envs, config.iteration_env_steps env steps an iteration).
-/// Each env step: act (uniform random actions for the first seed_env_steps, then samples of the
-/// policy), add the transitions to the replay buffer (a step that ends an episode adds the
-/// episode's final observation, then the next episode's first), then make updates_per_env_step
-/// updates per env step (the fraction carried over), each from a batch sampled from the buffer,
-/// asking `stop` after each (the updates not made are left as credit for the next env steps).
+/// DrQ's side of the run's env loop: an OffPolicyStepLearner whose exploring actions are samples
+/// of the policy and whose update is Learner::update (the augmentation generator seeded
+/// seed + 1, the policy's samples in the update from seed + 3: blob "rng_sampling"). The
+/// evaluation actor takes the tanh of the Gaussian's mean (deterministic) or a sample.
 ///
-/// Determinism: torch::manual_seed(seed) before the weights; the replay sampling draws from a
-/// std::mt19937_64 seeded with seed, the augmentation from a torch generator seeded seed + 1,
-/// the exploration (random actions and the policy's samples while training) from seed + 2 and
-/// the update's samples from seed + 3; the envs reset with seed.
-///
-/// Checkpoint: blobs "agent" (torch::save of the Agent: encoder, heads, actor, critics, target
-/// critics, log_alpha), "actor_optimizer", "critic_optimizer" (with the encoder),
-/// "alpha_optimizer", "rng_augmentation", "rng_exploration", "rng_sampling"; meta "drq":
-/// {"replay_rng" (the sampling generator's state as text), "update_credit",
-/// "gradient_updates" (which also restores the learner's count, that spaces the actor's and the
-/// target's updates)}. The replay buffer is not saved: the run's replay of the checkpoint's env
-/// actions puts the same transitions back in the same order (observe), so a resumed run is the
-/// run that did not stop.
+/// Checkpoint: the shared learner's, with "agent" (encoder, heads, actor, critics, target
+/// critics, log_alpha) and the optimizers "actor_optimizer", "critic_optimizer" (with the
+/// encoder) and "alpha_optimizer"; meta member "drq" (its gradient_updates also restores the
+/// Learner's count, that spaces the actor's and the target's updates).
 ///
 /// Its metrics (progress.csv's columns after the run's): critic_loss, actor_loss, q_mean,
 /// target_mean (means over the iteration's updates; actor_loss over its actor updates), alpha
 /// (the temperature after the last update), policy_entropy (minus the mean log-probability of
-/// the actor updates' samples), gradient_updates (all so far), updates_per_s, replay_transitions,
-/// replay_mb, and where the iteration's time went: env_s, act_s, sample_s, update_s.
-class DrqStepLearner final : public trainer::StepLearner {
+/// the actor updates' samples), then the shared replay metrics.
+class DrqStepLearner final : public trainer::OffPolicyStepLearner {
  public:
   /// Throws std::invalid_argument for a config that fails validate(), an env that does not
   /// autoreset in SameStep mode or has another num_envs, and as input_layout for the spaces.
-  DrqStepLearner(const vector::VectorEnv& env, DrqConfig config);
-
-  void begin(const Value& observations) override;
-  void act(const Value& observations, std::int64_t env_steps, Value& actions) override;
-  void observe(const Value& actions, const vector::VectorStepResult& step) override;
-  bool learn(std::int64_t env_steps, const trainer::StopCheck& stop) override;
-  std::map<std::string, double> end_iteration(const trainer::LoopTimes& times) override;
-  std::vector<std::string> metric_names() const override;
-  void save(trainer::CheckpointBlobs& blobs, nlohmann::json& meta) override;
-  void restore(const trainer::LoadedCheckpoint& checkpoint, const nlohmann::json& meta) override;
-  trainer::Actor& actor() override { return actor_; }
+  DrqStepLearner(const vector::VectorEnv& env, const DrqConfig& config);
 
   Learner& learner() { return learner_; }
-  const ReplayBuffer& buffer() const { return buffer_; }
-  std::int64_t gradient_updates() const { return updates_.total(); }
 
  private:
-  // Sums over the iteration's updates, for its metrics.
-  struct IterationSums {
-    double critic_loss = 0.0, actor_loss = 0.0, q_mean = 0.0, target_mean = 0.0, entropy = 0.0;
-    double alpha = trainer::ProgressRow::kNone;
-    std::int64_t actor_updates = 0;
-  };
+  std::shared_ptr<trainer::OffPolicyAgent> shared_agent() const override {
+    return learner_.agent_ptr();
+  }
+  trainer::UpdateSummary update(const ReplayBatch& batch, std::int64_t env_steps) override;
+  std::map<std::string, double> update_metrics(std::int64_t updates, std::int64_t actor_updates,
+                                               std::int64_t env_steps) override;
+  std::vector<std::string> update_metric_names() const override;
+  std::vector<trainer::NamedOptimizer> optimizers() override;
+  void restored_updates(std::int64_t updates) override { learner_.set_updates(updates); }
 
-  DrqConfig config_;
   Learner learner_;
-  ReplayBuffer buffer_;
-  ReplayBatch batch_;
-  std::mt19937_64 replay_rng_;
-  at::Generator augmentation_;
-  at::Generator exploration_;
-  at::Generator sampling_;
-  trainer::ReplayUpdates updates_;
-  IterationSums sums_;
-  DrqActor actor_;
+  double alpha_ = trainer::ProgressRow::kNone;  // after the iteration's last update
+  double entropy_sum_ = 0.0;                    // over its actor updates
 };
 
 /// DrQ's AlgorithmFactory: name "drq", the config a DrqConfig (to_json / from_json).
-class DrqAlgorithmFactory final : public trainer::AlgorithmFactory {
+class DrqAlgorithmFactory final
+    : public trainer::OffPolicyAlgorithmFactory<DrqConfig, DrqStepLearner, Agent> {
  public:
-  std::string name() const override { return "drq"; }
-  nlohmann::json parse_config(const std::string& text) const override;
-  /// trainer::set_torch_threads.
-  int set_threads(int requested) const override;
-  /// Throws std::invalid_argument for a communicator of several ranks: DrQ trains in one
-  /// process (its replay buffer and updates are not shared across ranks).
-  std::unique_ptr<trainer::Algorithm> make(trainer::EnvLoop& loop, const nlohmann::json& config,
-                                           trainer::Communicator& communicator) const override;
-  /// An Agent of the config for these spaces with the checkpoint's "agent".
-  std::unique_ptr<trainer::Actor> load_actor(
-      const Space& observation_space, const Space& action_space, const nlohmann::json& config,
-      const trainer::LoadedCheckpoint& checkpoint) const override;
+  DrqAlgorithmFactory() : OffPolicyAlgorithmFactory("drq", "DrqConfig") {}
 };
 
 }  // namespace pixelgym::drq

@@ -1,7 +1,5 @@
 #include "examples/trainer/drqv2/drqv2.h"
 
-#include <ATen/autocast_mode.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -21,7 +19,6 @@ namespace pixelgym::drqv2 {
 namespace {
 
 using trainer::copy_parameters;
-using trainer::CpuAutocast;
 using trainer::soft_update;
 
 using Clock = std::chrono::steady_clock;
@@ -109,22 +106,21 @@ std::vector<trainer::MemoryUse> memory_estimate(const InputLayout& input,
 }
 
 Agent::Agent(InputLayout input, const DrqV2Config& config)
-    : input_(std::move(input)),
-      autocast_(config.bfloat16 && cpu_has_bfloat16()),
-      channels_last_(config.channels_last) {
+    : OffPolicyAgent(std::move(input), config), evaluation_noise_std_(config.noise_end) {
+  const InputLayout& layout = this->input();
   std::int64_t image_features = 0;
-  if (input_.has_image) {
+  if (layout.has_image) {
     trainer::ConvEncoder conv = trainer::make_conv_encoder(
-        config.encoder, input_.stack * input_.channels, input_.height, input_.width, "drqv2");
+        config.encoder, layout.stack * layout.channels, layout.height, layout.width, "drqv2");
     encoder = register_module("encoder", conv.layers);
     image_features = conv.features;
   }
   std::int64_t vector_features = 0;
-  for (const std::int64_t size : input_.vector_sizes) vector_features += size;
+  for (const std::int64_t size : layout.vector_sizes) vector_features += size;
   feature_size_ = image_features + vector_features;
   if (feature_size_ == 0) throw std::invalid_argument("drqv2: the observation has no input");
   const std::int64_t features = config.feature_dim;
-  const std::int64_t actions = input_.action_size;
+  const std::int64_t actions = layout.action_size;
   actor_trunk = register_module("actor_trunk", make_trunk(feature_size_, features));
   actor_head = register_module("actor_head", make_mlp(features, config.hidden_dim, actions));
   critic_trunk = register_module("critic_trunk", make_trunk(feature_size_, features));
@@ -139,39 +135,11 @@ Agent::Agent(InputLayout input, const DrqV2Config& config)
   for (auto* target : {&target_trunk, &target_q1, &target_q2}) {
     for (auto& parameter : (*target)->parameters()) parameter.set_requires_grad(false);
   }
-  low_ = register_buffer("action_low", torch::tensor(input_.action_low, torch::kFloat32));
-  high_ = register_buffer("action_high", torch::tensor(input_.action_high, torch::kFloat32));
-}
-
-torch::Tensor Agent::image_input(const torch::Tensor& images) const {
-  const std::int64_t batch = images.size(0);
-  const std::int64_t channels = input_.stack * input_.channels;
-  const torch::Tensor frames =
-      images.view({batch, input_.stack, input_.height, input_.width, input_.channels});
-  if (channels_last_) {
-    // (B, H, W, stack C) in memory: the channels-last layout of (B, stack C, H, W).
-    return frames.permute({0, 2, 3, 1, 4})
-        .reshape({batch, input_.height, input_.width, channels})
-        .to(torch::kFloat32)
-        .permute({0, 3, 1, 2});
-  }
-  return frames.permute({0, 1, 4, 2, 3})
-      .reshape({batch, channels, input_.height, input_.width})
-      .to(torch::kFloat32);
 }
 
 torch::Tensor Agent::encode(const torch::Tensor& images, const torch::Tensor& vectors) {
   std::vector<torch::Tensor> parts;
-  if (input_.has_image) {
-    torch::Tensor x = images / 255.0 - 0.5;
-    if (channels_last_) x = x.contiguous(at::MemoryFormat::ChannelsLast);
-    torch::Tensor h;
-    {
-      const CpuAutocast autocast(autocast_);
-      h = encoder->forward(x);
-    }
-    parts.push_back(h.to(torch::kFloat32));
-  }
+  if (input().has_image) parts.push_back(convolve(images));
   if (vectors.defined()) parts.push_back(vectors);
   return parts.size() == 1 ? parts[0] : torch::cat(parts, 1);
 }
@@ -192,48 +160,9 @@ std::pair<torch::Tensor, torch::Tensor> Agent::q_values(const torch::Tensor& fea
           (target ? target_q2 : q2)->forward(input).squeeze(1)};
 }
 
-torch::Tensor Agent::env_action(const torch::Tensor& actions) const {
-  return low_ + (actions + 1.0) * 0.5 * (high_ - low_);
-}
-
-torch::Tensor Agent::unit_action(const torch::Tensor& env_actions) const {
-  return ((env_actions.to(torch::kFloat32) - low_) / (high_ - low_) * 2.0 - 1.0).clamp(-1.0, 1.0);
-}
-
 // ---- Learner ---------------------------------------------------------------------------------
 
 namespace {
-
-std::shared_ptr<Agent> make_agent(InputLayout input, const DrqV2Config& config) {
-  config.validate();
-  torch::manual_seed(config.seed);
-  return std::make_shared<Agent>(std::move(input), config);
-}
-
-std::vector<torch::Tensor> parameters_of(std::initializer_list<torch::nn::Module*> modules) {
-  std::vector<torch::Tensor> parameters;
-  for (torch::nn::Module* module : modules) {
-    for (auto& parameter : module->parameters()) parameters.push_back(parameter);
-  }
-  return parameters;
-}
-
-// A Tensor over a vector's memory (no copy): valid while the vector is not resized.
-template <typename T>
-torch::Tensor view_of(const std::vector<T>& values, std::vector<std::int64_t> shape,
-                      torch::ScalarType type) {
-  return torch::from_blob(const_cast<T*>(values.data()), shape, torch::TensorOptions(type));
-}
-
-torch::Tensor vectors_of(const std::vector<std::vector<float>>& vectors, const InputLayout& input,
-                         std::int64_t batch) {
-  if (vectors.empty()) return {};
-  std::vector<torch::Tensor> parts;
-  for (std::size_t v = 0; v < vectors.size(); ++v) {
-    parts.push_back(view_of(vectors[v], {batch, input.vector_sizes[v]}, torch::kFloat32));
-  }
-  return parts.size() == 1 ? parts[0] : torch::cat(parts, 1);
-}
 
 torch::Tensor clipped_noise(const torch::Tensor& like, double std, double clip,
                             at::Generator& generator) {
@@ -243,15 +172,15 @@ torch::Tensor clipped_noise(const torch::Tensor& like, double std, double clip,
 }  // namespace
 
 Learner::Learner(InputLayout input, DrqV2Config config)
-    : config_(std::move(config)), agent_(make_agent(std::move(input), config_)) {
+    : config_(std::move(config)), agent_(trainer::make_agent<Agent>(std::move(input), config_)) {
   const auto adam = [&](std::vector<torch::Tensor> parameters) {
     return std::make_unique<torch::optim::Adam>(std::move(parameters),
                                                 torch::optim::AdamOptions(config_.learning_rate));
   };
   if (agent_->input().has_image) encoder_optimizer_ = adam(agent_->encoder->parameters());
-  actor_optimizer_ =
-      adam(parameters_of({agent_->actor_trunk.ptr().get(), agent_->actor_head.ptr().get()}));
-  critic_optimizer_ = adam(parameters_of(
+  actor_optimizer_ = adam(
+      trainer::parameters_of({agent_->actor_trunk.ptr().get(), agent_->actor_head.ptr().get()}));
+  critic_optimizer_ = adam(trainer::parameters_of(
       {agent_->critic_trunk.ptr().get(), agent_->q1.ptr().get(), agent_->q2.ptr().get()}));
 }
 
@@ -269,27 +198,17 @@ UpdateStats Learner::update(const ReplayBatch& batch, std::int64_t env_steps,
   // Inputs, augmented.
   torch::Tensor images, next_images;
   if (input.has_image) {
-    const std::int64_t bytes = input.stack * input.height * input.width * input.channels;
-    const auto shifted = [&](const std::vector<std::uint8_t>& stacks,
-                             std::vector<std::uint8_t>& into) {
-      if (config_.shift_pad == 0)
-        return agent.image_input(view_of(stacks, {size, bytes}, torch::kUInt8));
-      const std::int64_t pad = config_.shift_pad;
-      const torch::Tensor shifts =
-          torch::randint(0, 2 * pad + 1, {size, 2}, augmentation, torch::kInt64);
-      into.resize(stacks.size());
-      shift_frames(stacks.data(), into.data(), size, input.stack, input.height, input.width,
-                   input.channels, pad, shifts.data_ptr<std::int64_t>());
-      return agent.image_input(view_of(into, {size, bytes}, torch::kUInt8));
-    };
-    images = shifted(batch.images[0], shifted_);
-    next_images = shifted(batch.next_images[0], next_shifted_);
+    const std::int64_t pad = config_.shift_pad;
+    images = agent.shifted_images(batch.images[0], size, pad, augmentation, shifted_);
+    next_images =
+        agent.shifted_images(batch.next_images[0], size, pad, augmentation, next_shifted_);
   }
-  const torch::Tensor vectors = vectors_of(batch.vectors, input, size);
-  const torch::Tensor next_vectors = vectors_of(batch.next_vectors, input, size);
-  const torch::Tensor actions = view_of(batch.actions, {size, input.action_size}, torch::kFloat32);
-  const torch::Tensor rewards = view_of(batch.rewards, {size}, torch::kFloat32);
-  const torch::Tensor discounts = view_of(batch.discounts, {size}, torch::kFloat32);
+  const torch::Tensor vectors = trainer::batch_vectors(batch.vectors, input, size);
+  const torch::Tensor next_vectors = trainer::batch_vectors(batch.next_vectors, input, size);
+  const torch::Tensor actions =
+      trainer::view_of(batch.actions, {size, input.action_size}, torch::kFloat32);
+  const torch::Tensor rewards = trainer::view_of(batch.rewards, {size}, torch::kFloat32);
+  const torch::Tensor discounts = trainer::view_of(batch.discounts, {size}, torch::kFloat32);
   lap(&UpdateTimes::augment);
 
   const torch::Tensor features = agent.encode(images, vectors);
@@ -358,31 +277,18 @@ UpdateStats Learner::update(const ReplayBatch& batch, std::int64_t env_steps,
   return stats;
 }
 
-torch::Tensor Agent::act(const std::map<std::string, torch::Tensor>& obs, bool deterministic,
+torch::Tensor Agent::act(const trainer::ObservationTensors& obs, bool deterministic,
                          double noise_std, at::Generator* noise) {
   torch::NoGradGuard no_grad;
-  Agent& agent = *this;
-  const InputLayout& input = input_;
-  torch::Tensor images;
-  std::int64_t batch = 0;
-  if (input.has_image) {
-    const torch::Tensor& stacked = obs.at(input.image_key);
-    batch = stacked.size(0);
-    images = agent.image_input(stacked.reshape({batch, -1}).contiguous());
-  }
-  torch::Tensor vectors;
-  if (!input.vector_keys.empty()) {
-    std::vector<torch::Tensor> parts;
-    for (const std::string& key : input.vector_keys) {
-      const torch::Tensor& value = obs.at(key);
-      batch = value.size(0);
-      parts.push_back(value.reshape({batch, -1}).to(torch::kFloat32));
-    }
-    vectors = parts.size() == 1 ? parts[0] : torch::cat(parts, 1);
-  }
-  const torch::Tensor mean = agent.actor_mean(agent.encode(images, vectors));
+  const trainer::AgentInput in = observation_input(obs);
+  const torch::Tensor mean = actor_mean(encode(in.images, in.vectors));
   if (deterministic || noise == nullptr) return mean;
   return (mean + torch::randn(mean.sizes(), *noise, mean.options()) * noise_std).clamp(-1.0, 1.0);
+}
+
+torch::Tensor Agent::act(const trainer::ObservationTensors& obs, bool deterministic,
+                         at::Generator* noise) {
+  return act(obs, deterministic, evaluation_noise_std_, noise);
 }
 
 }  // namespace pixelgym::drqv2

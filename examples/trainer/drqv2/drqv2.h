@@ -14,6 +14,7 @@
 
 #include "examples/trainer/torch_common/conv_encoder.h"
 #include "examples/trainer/torch_common/input_layout.h"
+#include "examples/trainer/torch_common/off_policy_agent.h"
 #include "examples/trainer/torch_common/off_policy_networks.h"
 #include "examples/trainer/torch_common/off_policy_settings.h"
 #include "examples/trainer/torch_common/random_shift.h"
@@ -84,12 +85,10 @@ std::vector<trainer::MemoryUse> memory_estimate(const InputLayout& input,
 /// The encoder, actor, critic and target critic. Built from torch's default generator (call
 /// torch::manual_seed first). Orthogonal weights (gain sqrt(2) before ReLU, else 1), zero
 /// biases, as DrQ-v2.
-class Agent : public torch::nn::Module {
+class Agent : public trainer::OffPolicyAgent {
  public:
   Agent(InputLayout input, const DrqV2Config& config);
 
-  /// Images uint8 (B, stack * H * W * C) as the buffer stores them, to float (B, stack C, H, W).
-  torch::Tensor image_input(const torch::Tensor& images) const;
   /// Features of a batch: the encoder over float images (B, stack C, H, W) in [0, 255]
   /// (undefined: no image) beside the vector keys (B, sum of sizes; undefined: none).
   torch::Tensor encode(const torch::Tensor& images, const torch::Tensor& vectors);
@@ -103,27 +102,21 @@ class Agent : public torch::nn::Module {
   /// trainer::observation_tensors gives them): the policy's mean when `deterministic` or `noise` is
   /// null, else the mean plus Gaussian noise of std `noise_std` drawn from `noise`, clamped.
   /// Computes no gradients.
-  torch::Tensor act(const std::map<std::string, torch::Tensor>& obs, bool deterministic,
-                    double noise_std, at::Generator* noise);
-  /// Actions in [-1, 1] to the env's bounds (float32), and back.
-  torch::Tensor env_action(const torch::Tensor& actions) const;
-  torch::Tensor unit_action(const torch::Tensor& env_actions) const;
+  torch::Tensor act(const trainer::ObservationTensors& obs, bool deterministic, double noise_std,
+                    at::Generator* noise);
+  /// The same with noise of std noise_end (the evaluation's stochastic actions).
+  torch::Tensor act(const trainer::ObservationTensors& obs, bool deterministic,
+                    at::Generator* noise) override;
 
-  const InputLayout& input() const { return input_; }
   std::int64_t feature_size() const { return feature_size_; }
-  bool autocast() const { return autocast_; }
 
-  torch::nn::Sequential encoder{nullptr};
   torch::nn::Sequential actor_trunk{nullptr}, actor_head{nullptr};
   torch::nn::Sequential critic_trunk{nullptr}, q1{nullptr}, q2{nullptr};
   torch::nn::Sequential target_trunk{nullptr}, target_q1{nullptr}, target_q2{nullptr};
 
  private:
-  InputLayout input_;
   std::int64_t feature_size_ = 0;
-  bool autocast_ = false;
-  bool channels_last_ = false;
-  torch::Tensor low_, high_;
+  double evaluation_noise_std_ = 0.0;
 };
 
 /// What one update did.

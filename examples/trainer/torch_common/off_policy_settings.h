@@ -69,6 +69,14 @@ void add_off_policy_settings(nlohmann::json& json, const OffPolicySettings& sett
 void read_off_policy_settings(const nlohmann::json& json, OffPolicySettings& settings,
                               const char* config_name);
 
+/// `config` once config.validate() has passed (it throws naming the setting out of range), for a
+/// constructor's initializer list.
+template <typename Config>
+const Config& validated(const Config& config) {
+  config.validate();
+  return config;
+}
+
 /// An AlgorithmFactory::parse_config for a config type of from_json / to_json: the JSON text
 /// read (a parse error as "{config_name} JSON: ..."), completed with the defaults and checked,
 /// and written back with every member.
