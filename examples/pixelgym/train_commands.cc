@@ -48,22 +48,8 @@ void add_run_options(CLI::App& train, TrainArguments& args) {
       "--algo's algorithm, which --list-configs shows), a FILE.json (or any path with a '/'), or "
       "the JSON itself, e.g. "
       "'{\"gamma\": 0.95}'. --print-config shows every field of --algo's algorithm with the "
-      "value a run would use, --list-configs the recipes. drqv2's: seed, num_envs (1), "
-      "total_env_steps (100,000), iteration_env_steps (500, one progress.csv row), "
-      "frame_stack (3), replay_capacity (100,000 steps), batch_size (128), n_step "
-      "(3), gamma (0.99), learning_rate (0.001), critic_tau (0.01), encoder (mrq, "
-      "fine or drqv2), feature_dim (50), hidden_dim (256), seed_env_steps (1000 steps of "
-      "random actions), updates_per_env_step (1), noise_start (1), noise_end (0.1), "
-      "noise_schedule_env_steps (25,000), noise_clip (0.3), "
-      "actor_preactivation_penalty (0.001), shift_pad (4), "
-      "bfloat16 (true: autocast the encoder where the CPU has AVX512-BF16 or AMX), "
-      "channels_last (true). drq's: as drqv2's without the noise and the penalty, with "
-      "n_step (1), hidden_depth (2), init_temperature (0.1), target_entropy (null: -|A|), "
-      "actor_update_every (2), target_update_every (2), log_std_min (-10), log_std_max (2), "
-      "augmented_copies (1: shifted copies averaged, DrQ's K = M). Neither replay buffer is "
-      "in the checkpoints: "
-      "--resume refills it by replaying the run's env actions, which puts the "
-      "same transitions back");
+      "value a run would use, --list-settings every setting of each algorithm (its default, "
+      "its range and what it does), --list-configs the recipes");
   train
       .add_option("--set-algo", args.algo_sets,
                   "One of the algorithm's settings as KEY=VALUE (repeatable), over --config's: "
@@ -74,6 +60,9 @@ void add_run_options(CLI::App& train, TrainArguments& args) {
   train.add_flag("--list-configs", args.list_configs,
                  "Print the recipes that --config NAME takes (of --algo's algorithm when given, "
                  "else of each), each with its settings, and exit");
+  train.add_flag("--list-settings", args.list_settings,
+                 "Print every setting that --config and --set-algo take (of --algo's algorithm "
+                 "when given, else of each): its name, default, range and what it does, and exit");
   train.add_flag("--print-config", args.print_config,
                  "Print the settings the run would write to config.json (--config, --set-algo "
                  "and the flags applied) and exit without training or writing anything");

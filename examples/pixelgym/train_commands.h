@@ -20,6 +20,7 @@ struct TrainArguments : EnvArguments {
   std::string config_file;             // --config: a recipe's name, a file or inline JSON
   std::vector<std::string> algo_sets;  // --set-algo KEY=VALUE, over --config
   bool list_configs = false;           // --list-configs: print the recipes, train nothing
+  bool list_settings = false;          // --list-settings: print the settings, train nothing
   bool print_config = false;           // --print-config: print the settings, train nothing
   std::int64_t steps = 0;              // 0: the config's total_env_steps
   double minutes = 0.0;

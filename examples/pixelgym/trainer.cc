@@ -247,7 +247,26 @@ trainer::ResumeChecks resume_checks(const TrainArguments& args) {
   return checks;
 }
 
+// `train --list-settings`: each setting of `algorithm` with its default, range and help.
+void print_settings(const trainer::AlgorithmFactory& algorithm) {
+  std::cout << algorithm.name() << " (--algo " << algorithm.name()
+            << "): --config JSON members, or --set-algo NAME=VALUE\n";
+  for (const trainer::SettingDescription& setting : algorithm.settings()) {
+    std::cout << "  " << setting.name << " = " << setting.value.dump();
+    if (!setting.range.empty()) std::cout << "  (" << setting.range << ")";
+    std::cout << "\n";
+    if (!setting.help.empty()) std::cout << "      " << setting.help << "\n";
+  }
+  std::cout << "\n";
+}
+
 int run_train(const TrainArguments& args) {
+  if (args.list_settings) {
+    for (const trainer::AlgorithmFactory* algorithm : kAlgorithms) {
+      if (!args.algo_given || algorithm->name() == args.algo) print_settings(*algorithm);
+    }
+    return 0;
+  }
   if (args.list_configs) {
     for (const trainer::AlgorithmFactory* algorithm : kAlgorithms) {
       if (!args.algo_given || algorithm->name() == args.algo) print_recipes(*algorithm);

@@ -652,35 +652,47 @@ TEST(TrainCliTest, DrqV2TrainsWithAShiftPadWiderThanTheImage) {
   fs::remove_all(folder);
 }
 
-// `train --help` names every DrqV2Config member with its default (the JSON --config reads).
-TEST(TrainCliTest, TrainHelpListsEveryDrqV2Setting) {
-  const CliRun help = run_cli("train --help");
-  ASSERT_EQ(help.exit_code, 0) << help.output;
-  // CLI11 wraps long descriptions: compare with the whitespace folded and the thousands'
-  // commas dropped.
-  std::string text;
-  for (const char c : help.output) {
-    if (c == ',') continue;
-    if (c == ' ' || c == '\n') {
-      if (!text.empty() && text.back() != ' ') text += ' ';
-    } else {
-      text += c;
+// `train --list-settings` names every setting that --print-config shows for each algorithm, with
+// the default a run would use, its range and a line of help; with --algo, that algorithm's alone.
+TEST(TrainCliTest, ListSettingsShowsEverySettingOfEachAlgorithmWithItsDefault) {
+  const CliRun listed = run_cli("train --list-settings");
+  ASSERT_EQ(listed.exit_code, 0) << listed.output;
+  for (const std::string algorithm : {"ppo", "drq", "drqv2"}) {
+    const CliRun printed =
+        run_cli("train CartPoleBalance-v1 --algo " + algorithm + " --print-config");
+    ASSERT_EQ(printed.exit_code, 0) << printed.output;
+    const json config = json::parse(printed.output).at(algorithm);
+    const std::size_t section = listed.output.find(algorithm + " (--algo " + algorithm + ")");
+    ASSERT_NE(section, std::string::npos) << listed.output;
+    const std::size_t next = listed.output.find("\n" + std::string(1, '\n'), section);
+    const std::string text = listed.output.substr(section, next - section);
+    // Each setting, members of an object member as "policy.cnn".
+    std::vector<std::pair<std::string, json>> settings;
+    for (const auto& item : config.items()) {
+      if (item.value().is_object()) {
+        for (const auto& inner : item.value().items()) {
+          settings.emplace_back(item.key() + "." + inner.key(), inner.value());
+        }
+      } else {
+        settings.emplace_back(item.key(), item.value());
+      }
+    }
+    ASSERT_GT(settings.size(), 15U) << algorithm;
+    for (const auto& [name, value] : settings) {
+      const std::string line = "\n  " + name + " = " + value.dump() + "  (";
+      const std::size_t at = text.find(line);
+      ASSERT_NE(at, std::string::npos) << algorithm << ": no line " << line << " in\n" << text;
+      // The next line is its help, indented.
+      const std::size_t help = text.find('\n', at + 1);
+      EXPECT_EQ(text.compare(help, 7, "\n      "), 0)
+          << algorithm << ": " << name << " has no help";
+      EXPECT_GT(text.find('\n', help + 1) - help, 20U) << algorithm << ": " << name;
     }
   }
-  nlohmann::json defaults;
-  drqv2::to_json(defaults, drqv2::DrqV2Config{});
-  for (const auto& item : defaults.items()) {
-    if (item.key() == "seed") continue;  // listed bare: --seed sets it
-    std::string shown = item.value().dump();
-    if (item.value().is_number_float()) {
-      std::ostringstream number;
-      number << item.value().get<double>();
-      shown = number.str();
-    }
-    if (item.value().is_string()) shown = item.value().get<std::string>();
-    EXPECT_NE(text.find(item.key() + " (" + shown), std::string::npos)
-        << item.key() << " (" << shown << ") is not in train --help";
-  }
+  const CliRun drq_only = run_cli("train --list-settings --algo drq");
+  ASSERT_EQ(drq_only.exit_code, 0) << drq_only.output;
+  EXPECT_NE(drq_only.output.find("init_temperature = 0.1"), std::string::npos) << drq_only.output;
+  EXPECT_EQ(drq_only.output.find("noise_clip"), std::string::npos) << drq_only.output;
 }
 
 // The off-policy learner through the same run machinery: a run folder with its own columns and

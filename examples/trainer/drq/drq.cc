@@ -15,11 +15,6 @@ namespace {
 
 constexpr const char* kConfigName = "DrqConfig";
 
-template <typename T>
-void read_member(const nlohmann::json& json, const char* name, T& field) {
-  trainer::read_member(json, name, field, kConfigName);
-}
-
 using trainer::copy_parameters;
 using trainer::orthogonal_init;
 using trainer::soft_update;
@@ -58,19 +53,10 @@ torch::Tensor beside(const torch::Tensor& head, const torch::Tensor& vectors) {
 }  // namespace
 
 void DrqConfig::validate() const {
+  trainer::check_settings(*this, kConfigName);
   const trainer::ConfigChecks checks(kConfigName);
   trainer::validate_off_policy_settings(*this, checks);
-  checks.in_range("init_temperature", init_temperature, 1e-8, 1e8);
-  if (!std::isnan(target_entropy)) checks.in_range("target_entropy", target_entropy, -1e6, 1e6);
-  checks.at_least("actor_update_every", actor_update_every, 1);
-  checks.at_least("target_update_every", target_update_every, 1);
-  checks.at_least("hidden_depth", hidden_depth, 1);
-  checks.in_range("log_std_min", log_std_min, -20.0, 5.0);
   checks.in_range("log_std_max", log_std_max, log_std_min, 5.0);
-  checks.at_least("augmented_copies", augmented_copies, 1);
-  if (augmented_copies > 8) {
-    checks.fail("augmented_copies must be from 1 to 8, got " + std::to_string(augmented_copies));
-  }
 }
 
 double DrqConfig::entropy_target(std::int64_t action_size) const {
@@ -78,39 +64,11 @@ double DrqConfig::entropy_target(std::int64_t action_size) const {
 }
 
 void to_json(nlohmann::json& json, const DrqConfig& config) {
-  json = nlohmann::json::object();
-  trainer::add_off_policy_settings(json, config);
-  json["init_temperature"] = config.init_temperature;
-  json["target_entropy"] = std::isnan(config.target_entropy)
-                               ? nlohmann::json(nullptr)
-                               : nlohmann::json(config.target_entropy);
-  json["actor_update_every"] = config.actor_update_every;
-  json["target_update_every"] = config.target_update_every;
-  json["hidden_depth"] = config.hidden_depth;
-  json["log_std_min"] = config.log_std_min;
-  json["log_std_max"] = config.log_std_max;
-  json["augmented_copies"] = config.augmented_copies;
+  trainer::write_settings(json, config);
 }
 
 void from_json(const nlohmann::json& json, DrqConfig& config) {
-  nlohmann::json defaults;
-  to_json(defaults, DrqConfig{});
-  std::vector<std::string> known;
-  for (const auto& item : defaults.items()) known.push_back(item.key());
-  trainer::require_known_members(json, known, kConfigName);
-  trainer::read_off_policy_settings(json, config, kConfigName);
-  read_member(json, "init_temperature", config.init_temperature);
-  if (json.contains("target_entropy") && json.at("target_entropy").is_null()) {
-    config.target_entropy = std::numeric_limits<double>::quiet_NaN();
-  } else {
-    read_member(json, "target_entropy", config.target_entropy);
-  }
-  read_member(json, "actor_update_every", config.actor_update_every);
-  read_member(json, "target_update_every", config.target_update_every);
-  read_member(json, "hidden_depth", config.hidden_depth);
-  read_member(json, "log_std_min", config.log_std_min);
-  read_member(json, "log_std_max", config.log_std_max);
-  read_member(json, "augmented_copies", config.augmented_copies);
+  trainer::read_settings(json, config, kConfigName);
   config.validate();
 }
 

@@ -12,6 +12,7 @@
 #include <memory>
 #include <nlohmann/json_fwd.hpp>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "examples/trainer/torch_common/conv_encoder.h"
@@ -61,6 +62,30 @@ struct DrqConfig : trainer::OffPolicySettings {
   /// target_entropy, or -action_size when it is NaN.
   double entropy_target(std::int64_t action_size) const;
 };
+
+/// DrqConfig's settings, declared once (pixelgym/trainer/settings_declaration.h): the shared
+/// off-policy ones, then DrQ's own. Its JSON form, its ranges and `train --list-settings` come
+/// from here.
+template <typename Config, typename Visit>
+std::enable_if_t<std::is_same_v<std::remove_const_t<Config>, DrqConfig>> declare_settings(
+    Config& c, Visit& visit) {
+  trainer::declare_off_policy_settings(c, visit);
+  visit.number("init_temperature", c.init_temperature, 1e-8, 1e8,
+               "the entropy temperature alpha at the start (it is learned)");
+  visit.optional_number("target_entropy", c.target_entropy, -1e6, 1e6,
+                        "the entropy alpha steers the policy towards (null: -|A|, SAC's)");
+  visit.count("actor_update_every", c.actor_update_every, 1,
+              "the actor and alpha are updated every this many updates");
+  visit.count("target_update_every", c.target_update_every, 1,
+              "the target critic moves critic_tau towards the critic every this many updates");
+  visit.count("hidden_depth", c.hidden_depth, 1, "hidden layers of each MLP");
+  visit.number("log_std_min", c.log_std_min, -20.0, 5.0,
+               "the lower bound of the actor's log standard deviation");
+  visit.number("log_std_max", c.log_std_max, -20.0, 5.0, "its upper bound (at least log_std_min)");
+  visit.integer("augmented_copies", c.augmented_copies, std::int64_t{1}, std::int64_t{8},
+                "shifted copies of each observation and next observation that an update "
+                "averages over (DrQ's K = M)");
+}
 
 /// JSON form: one member per field (target_entropy null for NaN). from_json takes any subset and
 /// throws std::invalid_argument for an unknown member, a wrong type or a config failing

@@ -29,11 +29,6 @@ double seconds_since(Clock::time_point start) {
 
 constexpr const char* kConfigName = "DrqV2Config";
 
-template <typename T>
-void read_member(const nlohmann::json& json, const char* name, T& field) {
-  trainer::read_member(json, name, field, kConfigName);
-}
-
 using trainer::orthogonal_init;
 
 torch::nn::Sequential make_trunk(std::int64_t in, std::int64_t features) {
@@ -55,13 +50,8 @@ torch::nn::Sequential make_mlp(std::int64_t in, std::int64_t hidden, std::int64_
 }  // namespace
 
 void DrqV2Config::validate() const {
-  const trainer::ConfigChecks checks(kConfigName);
-  trainer::validate_off_policy_settings(*this, checks);
-  checks.in_range("noise_start", noise_start, 0.0, 10.0);
-  checks.in_range("noise_end", noise_end, 0.0, 10.0);
-  checks.at_least("noise_schedule_env_steps", noise_schedule_env_steps, 0);
-  checks.in_range("noise_clip", noise_clip, 0.0, 10.0);
-  checks.in_range("actor_preactivation_penalty", actor_preactivation_penalty, 0.0, 1e3);
+  trainer::check_settings(*this, kConfigName);
+  trainer::validate_off_policy_settings(*this, trainer::ConfigChecks(kConfigName));
 }
 
 double DrqV2Config::noise_std(std::int64_t env_steps) const {
@@ -72,27 +62,11 @@ double DrqV2Config::noise_std(std::int64_t env_steps) const {
 }
 
 void to_json(nlohmann::json& json, const DrqV2Config& config) {
-  json = nlohmann::json::object();
-  trainer::add_off_policy_settings(json, config);
-  json["noise_start"] = config.noise_start;
-  json["noise_end"] = config.noise_end;
-  json["noise_schedule_env_steps"] = config.noise_schedule_env_steps;
-  json["noise_clip"] = config.noise_clip;
-  json["actor_preactivation_penalty"] = config.actor_preactivation_penalty;
+  trainer::write_settings(json, config);
 }
 
 void from_json(const nlohmann::json& json, DrqV2Config& config) {
-  nlohmann::json defaults;
-  to_json(defaults, DrqV2Config{});
-  std::vector<std::string> known;
-  for (const auto& item : defaults.items()) known.push_back(item.key());
-  trainer::require_known_members(json, known, kConfigName);
-  trainer::read_off_policy_settings(json, config, kConfigName);
-  read_member(json, "noise_start", config.noise_start);
-  read_member(json, "noise_end", config.noise_end);
-  read_member(json, "noise_schedule_env_steps", config.noise_schedule_env_steps);
-  read_member(json, "noise_clip", config.noise_clip);
-  read_member(json, "actor_preactivation_penalty", config.actor_preactivation_penalty);
+  trainer::read_settings(json, config, kConfigName);
   config.validate();
 }
 

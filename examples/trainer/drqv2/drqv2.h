@@ -10,6 +10,7 @@
 #include <memory>
 #include <nlohmann/json_fwd.hpp>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "examples/trainer/torch_common/conv_encoder.h"
@@ -63,6 +64,27 @@ struct DrqV2Config : trainer::OffPolicySettings {
   /// The noise's standard deviation after `env_steps`.
   double noise_std(std::int64_t env_steps) const;
 };
+
+/// DrqV2Config's settings, declared once (pixelgym/trainer/settings_declaration.h): the shared
+/// off-policy ones, then DrQ-v2's own. Its JSON form, its ranges and `train --list-settings`
+/// come from here.
+template <typename Config, typename Visit>
+std::enable_if_t<std::is_same_v<std::remove_const_t<Config>, DrqV2Config>> declare_settings(
+    Config& c, Visit& visit) {
+  trainer::declare_off_policy_settings(c, visit);
+  visit.number("noise_start", c.noise_start, 0.0, 10.0,
+               "the exploration noise's standard deviation at the start");
+  visit.number("noise_end", c.noise_end, 0.0, 10.0,
+               "its standard deviation once noise_schedule_env_steps have passed (linearly in "
+               "between), and the stochastic evaluation's");
+  visit.count("noise_schedule_env_steps", c.noise_schedule_env_steps, 0,
+              "env steps over which the noise goes from noise_start to noise_end");
+  visit.number("noise_clip", c.noise_clip, 0.0, 10.0,
+               "the target policy's and the actor loss's noise is clipped to +-noise_clip");
+  visit.number("actor_preactivation_penalty", c.actor_preactivation_penalty, 0.0, 1e3,
+               "the actor's loss adds this times the mean square of what its tanh is taken of "
+               "(TD7's and MR.Q's pull away from tanh's flat tails; 0: none)");
+}
 
 /// JSON form: one member per field, named as the fields, the encoder by its name. from_json
 /// takes any subset (the rest keep their defaults) and throws std::invalid_argument for an

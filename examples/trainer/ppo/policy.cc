@@ -165,17 +165,15 @@ CnnArchitecture parse_cnn_architecture(const std::string& name) {
   throw std::invalid_argument("unknown CNN architecture \"" + name + "\"; valid: " + valid);
 }
 
-void PolicyConfig::validate() const {
-  auto fail = [](const std::string& what) { throw std::invalid_argument("PolicyConfig: " + what); };
-  if (cnn_features < 1) fail("cnn_features must be >= 1, got " + std::to_string(cnn_features));
-  for (std::int64_t width : mlp_hidden) {
-    if (width < 1) fail("mlp_hidden widths must be >= 1, got " + std::to_string(width));
-  }
-  if (trunk_hidden < 0) fail("trunk_hidden must be >= 0, got " + std::to_string(trunk_hidden));
-  if (!std::isfinite(initial_log_std)) fail("initial_log_std must be finite");
-  if (!(observation_clip > 0.0)) {
-    fail("observation_clip must be > 0, got " + std::to_string(observation_clip));
-  }
+void PolicyConfig::validate() const { trainer::check_settings(*this, "PolicyConfig"); }
+
+const trainer::ChoiceNames<CnnArchitecture>& cnn_names() {
+  static const trainer::ChoiceNames<CnnArchitecture> names = [] {
+    trainer::ChoiceNames<CnnArchitecture> list;
+    for (const CnnSpec& spec : cnn_specs()) list.emplace_back(spec.name, spec.architecture);
+    return list;
+  }();
+  return names;
 }
 
 Policy::Policy(const Space& observation_space, const Space& action_space, PolicyConfig config)

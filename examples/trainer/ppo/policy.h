@@ -9,6 +9,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -16,6 +17,7 @@
 #include "examples/trainer/torch_common/random_shift.h"
 #include "pixelgym/envs/space.h"
 #include "pixelgym/envs/value.h"
+#include "pixelgym/trainer/settings_declaration.h"
 #include "pixelgym/wrappers/running_statistics.h"
 
 namespace pixelgym::ppo {
@@ -75,6 +77,33 @@ struct PolicyConfig {
   /// Throws std::invalid_argument naming the field and the value when a field is out of range.
   void validate() const;
 };
+
+/// The CNNs' names, for the settings' declarations.
+const trainer::ChoiceNames<CnnArchitecture>& cnn_names();
+
+/// PolicyConfig's settings, declared once (pixelgym/trainer/settings_declaration.h): its JSON
+/// form (config.json's "policy"), its ranges and `train --list-settings` come from here.
+template <typename Config, typename Visit>
+std::enable_if_t<std::is_same_v<std::remove_const_t<Config>, PolicyConfig>> declare_settings(
+    Config& c, Visit& visit) {
+  visit.choice("cnn", c.cnn, cnn_names(),
+               "the CNN over each image key: nature (Mnih et al. 2015), small (NIPS DQN), fine "
+               "(three 3x3/2 convolutions of 32) or finer (the last of stride 1)");
+  visit.count("cnn_features", c.cnn_features, 1, "width of the linear layer closing each CNN");
+  visit.counts("mlp_hidden", c.mlp_hidden, 1,
+               "hidden widths of the MLP over the vector keys ([]: they go to the trunk as they "
+               "are)");
+  visit.count("trunk_hidden", c.trunk_hidden, 0,
+              "width of the trunk layer over the fused features (0: the heads read them)");
+  visit.number("initial_log_std", c.initial_log_std, -20.0, 20.0,
+               "the Gaussian head's log standard deviation at the start (Box actions)");
+  visit.flag("separate_value_network", c.separate_value_network,
+             "give the value head an encoder of its own (doubles the network's cost)");
+  visit.flag("normalize_observations", c.normalize_observations,
+             "normalize the vector keys with running statistics (images are scaled to [0, 1])");
+  visit.positive("observation_clip", c.observation_clip,
+                 "normalized vector inputs are clamped to +-observation_clip");
+}
 
 /// How an image key is laid out; the network sees every layout as (C, H, W) with the frames of
 /// a stack (oldest first) concatenated on the channel axis.

@@ -25,13 +25,6 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// PpoConfig's members and PolicyConfig's (nested in it): errors name PpoConfig.
-template <typename T>
-void read_member(const nlohmann::json& json, const char* name, T& field) {
-  trainer::read_member(json, name, field, "PpoConfig");
-}
-using trainer::require_known_members;
-
 // The steps after which a rollout may be preempted: ceil(fraction * num_steps), at least 1.
 std::int64_t preempt_min_steps(std::int64_t num_steps, double fraction) {
   return std::max<std::int64_t>(
@@ -43,55 +36,12 @@ std::int64_t preempt_min_steps(std::int64_t num_steps, double fraction) {
 // ---- PpoConfig -------------------------------------------------------------------------------
 
 void PpoConfig::validate() const {
+  trainer::check_settings(*this, "PpoConfig");
   auto fail = [](const std::string& what) { throw std::invalid_argument("PpoConfig: " + what); };
-  auto positive = [&](const char* name, double value) {
-    if (!(value > 0.0) || !std::isfinite(value)) {
-      fail(std::string(name) + " must be > 0 and finite, got " + std::to_string(value));
-    }
-  };
-  auto non_negative = [&](const char* name, double value) {
-    if (!(value >= 0.0) || !std::isfinite(value)) {
-      fail(std::string(name) + " must be >= 0 and finite, got " + std::to_string(value));
-    }
-  };
-  auto unit = [&](const char* name, double value) {
-    if (!(value >= 0.0 && value <= 1.0)) {
-      fail(std::string(name) + " must be in [0, 1], got " + std::to_string(value));
-    }
-  };
-  // Counts are at most 2^40 (about 1.1e12): far past any run, and far from overflowing the
-  // products of counts that sizes are made of (num_steps * num_envs); the memory they take is
-  // checked with the env (memory_estimate).
-  constexpr std::int64_t kMost = std::int64_t{1} << 40;
-  auto count = [&](const char* name, std::int64_t value) {
-    if (value < 1 || value > kMost) {
-      fail(std::string(name) + " must be from 1 to " + std::to_string(kMost) + ", got " +
-           std::to_string(value));
-    }
-  };
-  count("num_envs", num_envs);
-  count("num_steps", num_steps);
-  count("total_env_steps", total_env_steps);
-  positive("learning_rate", learning_rate);
-  positive("adam_epsilon", adam_epsilon);
-  unit("gamma", gamma);
-  unit("gae_lambda", gae_lambda);
-  count("update_epochs", update_epochs);
-  count("num_minibatches", num_minibatches);
   if (num_minibatches > 0 && (num_steps * num_envs) % num_minibatches != 0) {
     fail("num_steps * num_envs (" + std::to_string(num_steps * num_envs) +
          ") must be a multiple of num_minibatches (" + std::to_string(num_minibatches) + ")");
   }
-  positive("clip_range", clip_range);
-  non_negative("entropy_coef", entropy_coef);
-  non_negative("value_coef", value_coef);
-  positive("max_grad_norm", max_grad_norm);
-  non_negative("target_kl", target_kl);
-  if (shift_pad < 0 || shift_pad > 65536) {
-    fail("shift_pad must be from 0 to 65536, got " + std::to_string(shift_pad));
-  }
-  unit("preempt_done_fraction", preempt_done_fraction);
-  unit("preempt_min_steps_fraction", preempt_min_steps_fraction);
   if (preempt_stragglers && num_minibatches > 0 &&
       preempt_min_steps(num_steps, preempt_min_steps_fraction) * num_envs < num_minibatches) {
     fail("a rollout preempted after preempt_min_steps_fraction (" +
@@ -99,123 +49,23 @@ void PpoConfig::validate() const {
          std::to_string(preempt_min_steps(num_steps, preempt_min_steps_fraction) * num_envs) +
          " transitions, fewer than num_minibatches (" + std::to_string(num_minibatches) + ")");
   }
-  policy.validate();
 }
 
 void to_json(nlohmann::json& json, const PolicyConfig& config) {
-  json = nlohmann::json{{"cnn", to_string(config.cnn)},
-                        {"cnn_features", config.cnn_features},
-                        {"mlp_hidden", config.mlp_hidden},
-                        {"trunk_hidden", config.trunk_hidden},
-                        {"initial_log_std", config.initial_log_std},
-                        {"separate_value_network", config.separate_value_network},
-                        {"normalize_observations", config.normalize_observations},
-                        {"observation_clip", config.observation_clip}};
+  trainer::write_settings(json, config);
 }
 
 void from_json(const nlohmann::json& json, PolicyConfig& config) {
-  require_known_members(json,
-                        {"cnn", "cnn_features", "mlp_hidden", "trunk_hidden", "initial_log_std",
-                         "separate_value_network", "normalize_observations", "observation_clip"},
-                        "PolicyConfig");
-  std::string cnn = to_string(config.cnn);
-  read_member(json, "cnn", cnn);
-  config.cnn = parse_cnn_architecture(cnn);
-  read_member(json, "cnn_features", config.cnn_features);
-  read_member(json, "mlp_hidden", config.mlp_hidden);
-  read_member(json, "trunk_hidden", config.trunk_hidden);
-  read_member(json, "initial_log_std", config.initial_log_std);
-  read_member(json, "separate_value_network", config.separate_value_network);
-  read_member(json, "normalize_observations", config.normalize_observations);
-  read_member(json, "observation_clip", config.observation_clip);
+  trainer::read_settings(json, config, "PolicyConfig");
   config.validate();
 }
 
 void to_json(nlohmann::json& json, const PpoConfig& config) {
-  json = nlohmann::json{{"seed", config.seed},
-                        {"num_envs", config.num_envs},
-                        {"num_steps", config.num_steps},
-                        {"total_env_steps", config.total_env_steps},
-                        {"learning_rate", config.learning_rate},
-                        {"anneal_learning_rate", config.anneal_learning_rate},
-                        {"adam_epsilon", config.adam_epsilon},
-                        {"gamma", config.gamma},
-                        {"gae_lambda", config.gae_lambda},
-                        {"update_epochs", config.update_epochs},
-                        {"num_minibatches", config.num_minibatches},
-                        {"normalize_advantages", config.normalize_advantages},
-                        {"normalize_rewards", config.normalize_rewards},
-                        {"clip_range", config.clip_range},
-                        {"clip_value_loss", config.clip_value_loss},
-                        {"entropy_coef", config.entropy_coef},
-                        {"value_coef", config.value_coef},
-                        {"max_grad_norm", config.max_grad_norm},
-                        {"target_kl", config.target_kl},
-                        {"augment", config.augment},
-                        {"shift_pad", config.shift_pad},
-                        {"preempt_stragglers", config.preempt_stragglers},
-                        {"preempt_done_fraction", config.preempt_done_fraction},
-                        {"preempt_min_steps_fraction", config.preempt_min_steps_fraction},
-                        {"policy", config.policy}};
+  trainer::write_settings(json, config);
 }
 
 void from_json(const nlohmann::json& json, PpoConfig& config) {
-  require_known_members(json,
-                        {"seed",
-                         "num_envs",
-                         "num_steps",
-                         "total_env_steps",
-                         "learning_rate",
-                         "anneal_learning_rate",
-                         "adam_epsilon",
-                         "gamma",
-                         "gae_lambda",
-                         "update_epochs",
-                         "num_minibatches",
-                         "normalize_advantages",
-                         "normalize_rewards",
-                         "clip_range",
-                         "clip_value_loss",
-                         "entropy_coef",
-                         "value_coef",
-                         "max_grad_norm",
-                         "target_kl",
-                         "augment",
-                         "shift_pad",
-                         "preempt_stragglers",
-                         "preempt_done_fraction",
-                         "preempt_min_steps_fraction",
-                         "policy"},
-                        "PpoConfig");
-  read_member(json, "seed", config.seed);
-  read_member(json, "num_envs", config.num_envs);
-  read_member(json, "num_steps", config.num_steps);
-  read_member(json, "total_env_steps", config.total_env_steps);
-  read_member(json, "learning_rate", config.learning_rate);
-  read_member(json, "anneal_learning_rate", config.anneal_learning_rate);
-  read_member(json, "adam_epsilon", config.adam_epsilon);
-  read_member(json, "gamma", config.gamma);
-  read_member(json, "gae_lambda", config.gae_lambda);
-  read_member(json, "update_epochs", config.update_epochs);
-  read_member(json, "num_minibatches", config.num_minibatches);
-  read_member(json, "normalize_advantages", config.normalize_advantages);
-  read_member(json, "normalize_rewards", config.normalize_rewards);
-  read_member(json, "clip_range", config.clip_range);
-  read_member(json, "clip_value_loss", config.clip_value_loss);
-  read_member(json, "entropy_coef", config.entropy_coef);
-  read_member(json, "value_coef", config.value_coef);
-  read_member(json, "max_grad_norm", config.max_grad_norm);
-  read_member(json, "target_kl", config.target_kl);
-  read_member(json, "augment", config.augment);
-  read_member(json, "shift_pad", config.shift_pad);
-  read_member(json, "preempt_stragglers", config.preempt_stragglers);
-  read_member(json, "preempt_done_fraction", config.preempt_done_fraction);
-  read_member(json, "preempt_min_steps_fraction", config.preempt_min_steps_fraction);
-  if (auto found = json.find("policy"); found != json.end()) {
-    PolicyConfig policy = config.policy;
-    from_json(*found, policy);
-    config.policy = policy;
-  }
+  trainer::read_settings(json, config, "PpoConfig");
   config.validate();
 }
 

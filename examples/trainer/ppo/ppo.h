@@ -6,10 +6,12 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <nlohmann/json_fwd.hpp>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "examples/trainer/ppo/policy.h"
@@ -91,6 +93,61 @@ struct PpoConfig {
   /// Throws std::invalid_argument naming the first field out of range and its value.
   void validate() const;
 };
+
+/// PpoConfig's settings, declared once (pixelgym/trainer/settings_declaration.h): its JSON form
+/// (config.json's "ppo"), its ranges and `train --list-settings` come from here.
+template <typename Config, typename Visit>
+std::enable_if_t<std::is_same_v<std::remove_const_t<Config>, PpoConfig>> declare_settings(
+    Config& c, Visit& visit) {
+  visit.integer("seed", c.seed, std::uint64_t{0}, std::numeric_limits<std::uint64_t>::max(),
+                "seeds the weights, the action sampling, the minibatch order, the augmentation "
+                "and the envs (env i resets with seed + i); --seed sets it");
+  visit.count("num_envs", c.num_envs, 1, "envs stepped together; --num-envs sets it");
+  visit.count("num_steps", c.num_steps, 1,
+              "steps per env per rollout: a rollout is num_steps * num_envs transitions");
+  visit.count("total_env_steps", c.total_env_steps, 1,
+              "the run's length in env steps, all envs together (the learning rate anneals over "
+              "it); --steps sets it");
+  visit.positive("learning_rate", c.learning_rate, "Adam's learning rate at the start");
+  visit.flag("anneal_learning_rate", c.anneal_learning_rate,
+             "anneal the learning rate linearly to 0 over total_env_steps");
+  visit.positive("adam_epsilon", c.adam_epsilon, "Adam's epsilon");
+  visit.number("gamma", c.gamma, 0.0, 1.0, "the discount of future rewards per env step");
+  visit.number("gae_lambda", c.gae_lambda, 0.0, 1.0,
+               "GAE's lambda: between one-step TD (0) and Monte Carlo (1) advantages");
+  visit.count("update_epochs", c.update_epochs, 1, "passes over the rollout per update");
+  visit.count("num_minibatches", c.num_minibatches, 1,
+              "minibatches per pass (num_steps * num_envs must be a multiple of it)");
+  visit.flag("normalize_advantages", c.normalize_advantages,
+             "standardize the advantages within each minibatch");
+  visit.flag("normalize_rewards", c.normalize_rewards,
+             "learn from rewards divided by the running standard deviation of the discounted "
+             "returns (episode returns stay the env's own)");
+  visit.positive("clip_range", c.clip_range,
+                 "the surrogate's clip range: the ratio is clipped to [1 - it, 1 + it]");
+  visit.flag("clip_value_loss", c.clip_value_loss,
+             "clip the value loss around the rollout's values with the same range");
+  visit.non_negative("entropy_coef", c.entropy_coef,
+                     "loss = policy loss - entropy_coef * entropy + value_coef * value loss");
+  visit.non_negative("value_coef", c.value_coef, "the value loss's weight");
+  visit.positive("max_grad_norm", c.max_grad_norm,
+                 "gradients are rescaled to this global L2 norm at most");
+  visit.non_negative("target_kl", c.target_kl,
+                     "stop an update's epochs once a minibatch's approximate KL exceeds it "
+                     "(0: never)");
+  visit.flag("augment", c.augment,
+             "DrQ's random shift of every image key during updates, by up to shift_pad pixels");
+  visit.integer("shift_pad", c.shift_pad, std::int64_t{0}, std::int64_t{65536},
+                "the random shift's reach in pixels");
+  visit.flag("preempt_stragglers", c.preempt_stragglers,
+             "in a distributed run, end a rank's rollout early once preempt_done_fraction of "
+             "the ranks are done (DD-PPO's straggler preemption)");
+  visit.number("preempt_done_fraction", c.preempt_done_fraction, 0.0, 1.0,
+               "the share of ranks done that preempts the others");
+  visit.number("preempt_min_steps_fraction", c.preempt_min_steps_fraction, 0.0, 1.0,
+               "the share of num_steps a rank collects before it may be preempted");
+  visit.object("policy", c.policy, "PolicyConfig", "the network (its own settings)");
+}
 
 /// The memory a run of `config` on envs of these spaces needs, by the member that sets each
 /// part: num_steps (the rollout storage and a minibatch's activations) and the policy's widths

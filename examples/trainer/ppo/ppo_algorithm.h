@@ -76,6 +76,10 @@ class PpoAlgorithmFactory final : public trainer::AlgorithmFactory {
   std::unique_ptr<trainer::Actor> load_actor(
       const Space& observation_space, const Space& action_space, const nlohmann::json& config,
       const trainer::LoadedCheckpoint& checkpoint) const override;
+  /// PpoConfig's declared settings, policy's as "policy.NAME".
+  std::vector<trainer::SettingDescription> settings() const override {
+    return trainer::describe_settings(PpoConfig{});
+  }
 };
 
 }  // namespace pixelgym::ppo

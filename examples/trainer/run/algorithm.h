@@ -19,6 +19,7 @@
 #include "pixelgym/trainer/communicator.h"
 #include "pixelgym/trainer/env_loop.h"
 #include "pixelgym/trainer/progress_csv.h"
+#include "pixelgym/trainer/settings_declaration.h"
 
 namespace pixelgym::trainer {
 
@@ -143,6 +144,18 @@ class AlgorithmFactory {
   virtual std::unique_ptr<Actor> load_actor(const Space& observation_space,
                                             const Space& action_space, const nlohmann::json& config,
                                             const LoadedCheckpoint& checkpoint) const = 0;
+  /// Every setting of the config with its default, its range and what it does (`train
+  /// --list-settings`): describe_settings of a config that declares its settings
+  /// (pixelgym/trainer/settings_declaration.h). By default, the members of parse_config("{}")
+  /// with their defaults alone.
+  virtual std::vector<SettingDescription> settings() const {
+    std::vector<SettingDescription> described;
+    const nlohmann::json defaults = parse_config("{}");  // kept alive while iterated
+    for (const auto& item : defaults.items()) {
+      described.push_back({item.key(), item.value(), "", ""});
+    }
+    return described;
+  }
 };
 
 }  // namespace pixelgym::trainer

@@ -57,6 +57,8 @@ class OffPolicyAlgorithmFactory : public AlgorithmFactory {
     agent->eval();
     return std::make_unique<OffPolicyActor>(std::move(agent), parsed.seed + 4);
   }
+  /// The config's declared settings.
+  std::vector<SettingDescription> settings() const override { return describe_settings(Config{}); }
 
  private:
   std::string algorithm_;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -11,6 +12,7 @@
 #include "pixelgym/envs/vector/vector_env.h"
 #include "pixelgym/trainer/communicator.h"
 #include "pixelgym/trainer/config_members.h"
+#include "pixelgym/trainer/settings_declaration.h"
 
 namespace pixelgym::trainer {
 
@@ -59,15 +61,64 @@ struct OffPolicySettings {
   bool channels_last = true;
 };
 
-/// The shared members' checks (`checks` names the config in its errors).
+/// The encoders' names, for the settings' declarations.
+inline const ChoiceNames<EncoderArchitecture>& encoder_names() {
+  static const ChoiceNames<EncoderArchitecture> names = {{"drqv2", EncoderArchitecture::kDrqV2},
+                                                         {"mrq", EncoderArchitecture::kMrq},
+                                                         {"fine", EncoderArchitecture::kFine}};
+  return names;
+}
+
+/// The shared settings, declared once (pixelgym/trainer/settings_declaration.h): DrQ's and
+/// DrQ-v2's declare_settings begin with this. `Settings` is OffPolicySettings (or a config
+/// derived from it), const or not.
+template <typename Settings, typename Visit>
+void declare_off_policy_settings(Settings& s, Visit& visit) {
+  visit.integer("seed", s.seed, std::uint64_t{0}, std::numeric_limits<std::uint64_t>::max(),
+                "seeds the weights, the replay sampling, the exploration, the augmentation and "
+                "the envs (env i resets with seed + i); --seed sets it");
+  visit.count("num_envs", s.num_envs, 1, "envs stepped together; --num-envs sets it");
+  visit.count("total_env_steps", s.total_env_steps, 1,
+              "the run's length in env steps, all envs together (each is action_repeat control "
+              "steps); --steps sets it");
+  visit.count("iteration_env_steps", s.iteration_env_steps, 1,
+              "env steps per iteration: a progress.csv row, and the unit of --checkpoint-every; "
+              "a multiple of num_envs");
+  visit.count("frame_stack", s.frame_stack, 1,
+              "frames in each observation's stack: the env must give them (--wrap "
+              "frame_stack=K); 1 for single frames");
+  visit.count("replay_capacity", s.replay_capacity, 1,
+              "replay buffer slots: one per env step, plus one per episode for its last "
+              "observation");
+  visit.count("batch_size", s.batch_size, 1, "transitions sampled for each update");
+  visit.count("n_step", s.n_step, 1, "steps of the return before bootstrapping");
+  visit.number("gamma", s.gamma, 0.0, 1.0, "the discount of future rewards per env step");
+  visit.positive("learning_rate", s.learning_rate, "Adam's learning rate, for every network");
+  visit.number("critic_tau", s.critic_tau, 0.0, 1.0,
+               "the target critic moves this fraction towards the critic at each of its updates");
+  visit.choice("encoder", s.encoder, encoder_names(),
+               "the convolutions over images: four 3x3 of 32 channels, strides 2, 2, 2, 1 "
+               "(mrq), 2, 2, 1, 1 (fine) or 2, 1, 1, 1 (drqv2)");
+  visit.count("feature_dim", s.feature_dim, 1,
+              "width of the head over the encoder's output (Linear, LayerNorm, tanh)");
+  visit.count("hidden_dim", s.hidden_dim, 1, "width of the MLPs' hidden layers");
+  visit.count("seed_env_steps", s.seed_env_steps, 0,
+              "env steps of uniformly random actions before the policy acts and learning starts");
+  visit.number("updates_per_env_step", s.updates_per_env_step, 0.0, 64.0,
+               "updates per env step, all envs together (0.5: one every second step; fractions "
+               "carry over)");
+  visit.integer("shift_pad", s.shift_pad, std::int64_t{0}, std::int64_t{65536},
+                "random shifts of the images in updates, by up to this many pixels (0: none)");
+  visit.flag("bfloat16", s.bfloat16,
+             "run the encoder under bfloat16 autocast where the CPU has AVX512-BF16 or AMX "
+             "(elsewhere it stays float32)");
+  visit.flag("channels_last", s.channels_last, "lay the encoder's images out channels-last");
+}
+
+/// The checks between shared members that their declared ranges cannot say (iteration_env_steps
+/// a multiple of num_envs, a replay buffer that holds a stack and an n-step return of every
+/// env); `checks` names the config in its errors.
 void validate_off_policy_settings(const OffPolicySettings& settings, const ConfigChecks& checks);
-/// Sets the shared members of `json` (an object), each named as its field, the encoder by its
-/// name.
-void add_off_policy_settings(nlohmann::json& json, const OffPolicySettings& settings);
-/// Reads the shared members that `json` has (read_member's rules; an unknown encoder name is an
-/// error naming `config_name` and the known names).
-void read_off_policy_settings(const nlohmann::json& json, OffPolicySettings& settings,
-                              const char* config_name);
 
 /// `config` once config.validate() has passed (it throws naming the setting out of range), for a
 /// constructor's initializer list.
