@@ -87,7 +87,9 @@ void add_run_options(CLI::App& train, TrainArguments& args) {
                    "change the budget, and a run setting such as --threads given with it must "
                    "equal the run's). The envs replay the checkpoint's actions and go on "
                    "with their episodes, so with the run's --steps (the learning rate anneals "
-                   "over it) the result is the run that did not stop");
+                   "over it) the result is the run that did not stop. drq's and drqv2's replay "
+                   "buffers are not in the checkpoints: the replayed actions refill them with "
+                   "the same transitions");
   add_checked_option(
       train, "--nproc", args.nproc,
       "Train data-parallel (DD-PPO) with this many local processes (ranks), as torchrun "

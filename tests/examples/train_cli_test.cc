@@ -26,6 +26,7 @@
 #include "examples/trainer/drqv2/drqv2.h"
 #include "pixelgym/trainer/checkpoint_file.h"
 #include "pixelgym/trainer/progress_csv.h"
+#include "pixelgym/trainer/recipes.h"
 #include "pixelgym/trainer/training_run.h"
 #include "tests/examples/cli_run.h"
 
@@ -913,6 +914,34 @@ TEST(TrainCliTest, RecipesByNameInlineJsonAndSetAlgo) {
   const CliRun ppo_only = run_cli("train --list-configs --algo ppo");
   EXPECT_EQ(ppo_only.output.find("drqv2 (--algo drqv2)"), std::string::npos) << ppo_only.output;
   fs::remove_all(folder);
+}
+
+// Every recipe shipped with each algorithm is a valid config of it: --print-config shows the
+// recipe's values in the settings a run would use.
+TEST(TrainCliTest, EveryRecipeIsAValidConfigOfItsAlgorithm) {
+  std::size_t recipes = 0;
+  for (const std::string algorithm : {"ppo", "drq", "drqv2"}) {
+    for (const std::string& name : pixelgym::trainer::recipe_names(algorithm)) {
+      ++recipes;
+      const CliRun printed = run_cli("train CartPoleBalance-v1 --algo " + algorithm + " --config " +
+                                     name + " --print-config");
+      ASSERT_EQ(printed.exit_code, 0) << algorithm << " " << name << ": " << printed.output;
+      std::ifstream file(pixelgym::trainer::recipe_folder(algorithm) / (name + ".json"));
+      const json recipe = json::parse(file);
+      const json config = json::parse(printed.output).at(algorithm);
+      for (const auto& item : recipe.items()) {
+        if (!item.value().is_object()) {
+          EXPECT_EQ(config.at(item.key()), item.value()) << algorithm << " " << name;
+          continue;
+        }
+        for (const auto& inner : item.value().items()) {  // an object member's members
+          EXPECT_EQ(config.at(item.key()).at(inner.key()), inner.value())
+              << algorithm << " " << name << " " << item.key();
+        }
+      }
+    }
+  }
+  EXPECT_GE(recipes, 8U);
 }
 
 // A run's output as a reader of a pipe sees it: each line with the seconds since the start when

@@ -111,57 +111,14 @@ struct Writer {
   }
 };
 
-// Collects the members' names (for the unknown-member check).
-struct Names {
-  std::vector<std::string>& out;
-
-  template <typename... Rest>
-  void count(const char* name, Rest&&...) {
-    out.emplace_back(name);
-  }
-  template <typename... Rest>
-  void integer(const char* name, Rest&&...) {
-    out.emplace_back(name);
-  }
-  template <typename... Rest>
-  void number(const char* name, Rest&&...) {
-    out.emplace_back(name);
-  }
-  template <typename... Rest>
-  void positive(const char* name, Rest&&...) {
-    out.emplace_back(name);
-  }
-  template <typename... Rest>
-  void non_negative(const char* name, Rest&&...) {
-    out.emplace_back(name);
-  }
-  template <typename... Rest>
-  void optional_number(const char* name, Rest&&...) {
-    out.emplace_back(name);
-  }
-  template <typename... Rest>
-  void flag(const char* name, Rest&&...) {
-    out.emplace_back(name);
-  }
-  template <typename... Rest>
-  void choice(const char* name, Rest&&...) {
-    out.emplace_back(name);
-  }
-  template <typename... Rest>
-  void counts(const char* name, Rest&&...) {
-    out.emplace_back(name);
-  }
-  template <typename... Rest>
-  void object(const char* name, Rest&&...) {
-    out.emplace_back(name);
-  }
-};
-
+// The members' names (for the unknown-member check), from the JSON form.
 template <typename Config>
-std::vector<std::string> member_names(Config& config) {
+std::vector<std::string> member_names(const Config& config) {
+  nlohmann::json json = nlohmann::json::object();
+  Writer writer{json};
+  declare_settings(config, writer);
   std::vector<std::string> names;
-  Names visit{names};
-  declare_settings(config, visit);
+  for (const auto& item : json.items()) names.push_back(item.key());
   return names;
 }
 
