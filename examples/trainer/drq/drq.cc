@@ -16,30 +16,7 @@ namespace {
 constexpr const char* kConfigName = "DrqConfig";
 
 using trainer::copy_parameters;
-using trainer::orthogonal_init;
 using trainer::soft_update;
-
-torch::nn::Sequential make_head(std::int64_t in, std::int64_t features) {
-  torch::nn::Sequential head(torch::nn::Linear(in, features),
-                             torch::nn::LayerNorm(torch::nn::LayerNormOptions({features})),
-                             torch::nn::Tanh());
-  orthogonal_init(*head, 1.0);
-  return head;
-}
-
-torch::nn::Sequential make_mlp(std::int64_t in, std::int64_t hidden, std::int64_t depth,
-                               std::int64_t out) {
-  torch::nn::Sequential mlp;
-  std::int64_t width = in;
-  for (std::int64_t layer = 0; layer < depth; ++layer) {
-    mlp->push_back(torch::nn::Linear(width, hidden));
-    mlp->push_back(torch::nn::ReLU());
-    width = hidden;
-  }
-  mlp->push_back(torch::nn::Linear(width, out));
-  orthogonal_init(*mlp, std::sqrt(2.0));
-  return mlp;
-}
 
 using trainer::batch_vectors;
 using trainer::view_of;
@@ -80,14 +57,14 @@ Agent::Agent(InputLayout input, const DrqConfig& config)
       log_std_max_(config.log_std_max) {
   const InputLayout& layout = this->input();
   std::int64_t features = 0;
+  const std::int64_t conv_features = register_encoder(config.encoder, "drq");
   if (layout.has_image) {
-    trainer::ConvEncoder conv = trainer::make_conv_encoder(
-        config.encoder, layout.stack * layout.channels, layout.height, layout.width, "drq");
-    encoder = register_module("encoder", conv.layers);
-    const std::int64_t conv_features = conv.features;
-    actor_head = register_module("actor_head", make_head(conv_features, config.feature_dim));
-    critic_head = register_module("critic_head", make_head(conv_features, config.feature_dim));
-    target_head = register_module("target_head", make_head(conv_features, config.feature_dim));
+    actor_head = register_module("actor_head",
+                                 trainer::make_feature_head(conv_features, config.feature_dim));
+    critic_head = register_module("critic_head",
+                                  trainer::make_feature_head(conv_features, config.feature_dim));
+    target_head = register_module("target_head",
+                                  trainer::make_feature_head(conv_features, config.feature_dim));
     copy_parameters(*critic_head, *target_head);
     features += config.feature_dim;
   }
@@ -96,11 +73,13 @@ Agent::Agent(InputLayout input, const DrqConfig& config)
   const std::int64_t actions = layout.action_size;
   const std::int64_t hidden = config.hidden_dim;
   const std::int64_t depth = config.hidden_depth;
-  actor = register_module("actor", make_mlp(features, hidden, depth, 2 * actions));
-  q1 = register_module("q1", make_mlp(features + actions, hidden, depth, 1));
-  q2 = register_module("q2", make_mlp(features + actions, hidden, depth, 1));
-  target_q1 = register_module("target_q1", make_mlp(features + actions, hidden, depth, 1));
-  target_q2 = register_module("target_q2", make_mlp(features + actions, hidden, depth, 1));
+  actor = register_module("actor", trainer::make_relu_mlp(features, hidden, depth, 2 * actions));
+  q1 = register_module("q1", trainer::make_relu_mlp(features + actions, hidden, depth, 1));
+  q2 = register_module("q2", trainer::make_relu_mlp(features + actions, hidden, depth, 1));
+  target_q1 =
+      register_module("target_q1", trainer::make_relu_mlp(features + actions, hidden, depth, 1));
+  target_q2 =
+      register_module("target_q2", trainer::make_relu_mlp(features + actions, hidden, depth, 1));
   copy_parameters(*q1, *target_q1);
   copy_parameters(*q2, *target_q2);
   for (auto* target : {&target_head, &target_q1, &target_q2}) {
@@ -228,14 +207,8 @@ UpdateStats Learner::update(const ReplayBatch& batch, at::Generator& augmentatio
   stats.alpha = alpha.item<double>();
   stats.actor_loss = std::numeric_limits<double>::quiet_NaN();
   stats.entropy = std::numeric_limits<double>::quiet_NaN();
-  if (!std::isfinite(stats.critic_loss)) {
-    throw std::runtime_error("drq: the critic loss is not finite (" +
-                             std::to_string(stats.critic_loss) + ", Q mean " +
-                             std::to_string(stats.q_mean) + "): no step taken");
-  }
-  critic_optimizer_->zero_grad();
-  critic_loss.backward();
-  critic_optimizer_->step();
+  trainer::step_on_loss(critic_loss, stats.critic_loss, "drq: the critic loss",
+                        {critic_optimizer_.get()}, ", Q mean " + std::to_string(stats.q_mean));
 
   // The actor and the temperature, on the first copy's encoder output (which the actor does not
   // train; it is the one from before the critic's step, as DrQ-v2 reuses it).
@@ -252,13 +225,8 @@ UpdateStats Learner::update(const ReplayBatch& batch, at::Generator& augmentatio
     const torch::Tensor actor_loss =
         (alpha * policy.log_prob - torch::min(actor_q1, actor_q2)).mean();
     stats.actor_loss = actor_loss.item<double>();
-    if (!std::isfinite(stats.actor_loss)) {
-      throw std::runtime_error("drq: the actor loss is not finite (" +
-                               std::to_string(stats.actor_loss) + "): no step taken");
-    }
-    actor_optimizer_->zero_grad();
-    actor_loss.backward();
-    actor_optimizer_->step();
+    trainer::step_on_loss(actor_loss, stats.actor_loss, "drq: the actor loss",
+                          {actor_optimizer_.get()});
     const torch::Tensor log_prob = policy.log_prob.detach();
     stats.entropy = -log_prob.mean().item<double>();
     const torch::Tensor alpha_loss = (agent.log_alpha.exp() * (-log_prob - target_entropy_)).mean();

@@ -29,24 +29,6 @@ double seconds_since(Clock::time_point start) {
 
 constexpr const char* kConfigName = "DrqV2Config";
 
-using trainer::orthogonal_init;
-
-torch::nn::Sequential make_trunk(std::int64_t in, std::int64_t features) {
-  torch::nn::Sequential trunk(torch::nn::Linear(in, features),
-                              torch::nn::LayerNorm(torch::nn::LayerNormOptions({features})),
-                              torch::nn::Tanh());
-  orthogonal_init(*trunk, 1.0);
-  return trunk;
-}
-
-torch::nn::Sequential make_mlp(std::int64_t in, std::int64_t hidden, std::int64_t out) {
-  torch::nn::Sequential mlp(torch::nn::Linear(in, hidden), torch::nn::ReLU(),
-                            torch::nn::Linear(hidden, hidden), torch::nn::ReLU(),
-                            torch::nn::Linear(hidden, out));
-  orthogonal_init(*mlp, std::sqrt(2.0));
-  return mlp;
-}
-
 }  // namespace
 
 void DrqV2Config::validate() const {
@@ -82,27 +64,26 @@ std::vector<trainer::MemoryUse> memory_estimate(const InputLayout& input,
 Agent::Agent(InputLayout input, const DrqV2Config& config)
     : OffPolicyAgent(std::move(input), config), evaluation_noise_std_(config.noise_end) {
   const InputLayout& layout = this->input();
-  std::int64_t image_features = 0;
-  if (layout.has_image) {
-    trainer::ConvEncoder conv = trainer::make_conv_encoder(
-        config.encoder, layout.stack * layout.channels, layout.height, layout.width, "drqv2");
-    encoder = register_module("encoder", conv.layers);
-    image_features = conv.features;
-  }
+  const std::int64_t image_features = register_encoder(config.encoder, "drqv2");
   std::int64_t vector_features = 0;
   for (const std::int64_t size : layout.vector_sizes) vector_features += size;
   feature_size_ = image_features + vector_features;
   if (feature_size_ == 0) throw std::invalid_argument("drqv2: the observation has no input");
   const std::int64_t features = config.feature_dim;
   const std::int64_t actions = layout.action_size;
-  actor_trunk = register_module("actor_trunk", make_trunk(feature_size_, features));
-  actor_head = register_module("actor_head", make_mlp(features, config.hidden_dim, actions));
-  critic_trunk = register_module("critic_trunk", make_trunk(feature_size_, features));
-  q1 = register_module("q1", make_mlp(features + actions, config.hidden_dim, 1));
-  q2 = register_module("q2", make_mlp(features + actions, config.hidden_dim, 1));
-  target_trunk = register_module("target_trunk", make_trunk(feature_size_, features));
-  target_q1 = register_module("target_q1", make_mlp(features + actions, config.hidden_dim, 1));
-  target_q2 = register_module("target_q2", make_mlp(features + actions, config.hidden_dim, 1));
+  actor_trunk = register_module("actor_trunk", trainer::make_feature_head(feature_size_, features));
+  actor_head = register_module("actor_head",
+                               trainer::make_relu_mlp(features, config.hidden_dim, 2, actions));
+  critic_trunk =
+      register_module("critic_trunk", trainer::make_feature_head(feature_size_, features));
+  q1 = register_module("q1", trainer::make_relu_mlp(features + actions, config.hidden_dim, 2, 1));
+  q2 = register_module("q2", trainer::make_relu_mlp(features + actions, config.hidden_dim, 2, 1));
+  target_trunk =
+      register_module("target_trunk", trainer::make_feature_head(feature_size_, features));
+  target_q1 = register_module("target_q1",
+                              trainer::make_relu_mlp(features + actions, config.hidden_dim, 2, 1));
+  target_q2 = register_module("target_q2",
+                              trainer::make_relu_mlp(features + actions, config.hidden_dim, 2, 1));
   copy_parameters(*critic_trunk, *target_trunk);
   copy_parameters(*q1, *target_q1);
   copy_parameters(*q2, *target_q2);
@@ -211,16 +192,10 @@ UpdateStats Learner::update(const ReplayBatch& batch, std::int64_t env_steps,
   stats.q_mean = q1.mean().item<double>();
   stats.target_mean = target.mean().item<double>();
   lap(&UpdateTimes::critic);
-  if (!std::isfinite(stats.critic_loss)) {
-    throw std::runtime_error("drqv2: the critic loss is not finite (" +
-                             std::to_string(stats.critic_loss) + ", Q mean " +
-                             std::to_string(stats.q_mean) + "): no step taken");
-  }
-  if (encoder_optimizer_) encoder_optimizer_->zero_grad();
-  critic_optimizer_->zero_grad();
-  critic_loss.backward();
-  critic_optimizer_->step();
-  if (encoder_optimizer_) encoder_optimizer_->step();
+  std::vector<torch::optim::Optimizer*> critic_step{critic_optimizer_.get()};
+  if (encoder_optimizer_) critic_step.push_back(encoder_optimizer_.get());
+  trainer::step_on_loss(critic_loss, stats.critic_loss, "drqv2: the critic loss", critic_step,
+                        ", Q mean " + std::to_string(stats.q_mean));
   lap(&UpdateTimes::backward);
 
   // Actor: the critic's value of the policy's noisy action, on features the actor cannot move.
@@ -235,13 +210,8 @@ UpdateStats Learner::update(const ReplayBatch& batch, std::int64_t env_steps,
     actor_loss = actor_loss + config_.actor_preactivation_penalty * preactivation.square().mean();
   }
   stats.actor_loss = actor_loss.item<double>();
-  if (!std::isfinite(stats.actor_loss)) {
-    throw std::runtime_error("drqv2: the actor loss is not finite (" +
-                             std::to_string(stats.actor_loss) + "): no step taken");
-  }
-  actor_optimizer_->zero_grad();
-  actor_loss.backward();
-  actor_optimizer_->step();
+  trainer::step_on_loss(actor_loss, stats.actor_loss, "drqv2: the actor loss",
+                        {actor_optimizer_.get()});
   lap(&UpdateTimes::actor);
 
   soft_update(*agent.critic_trunk, *agent.target_trunk, config_.critic_tau);

@@ -19,6 +19,15 @@ OffPolicyAgent::OffPolicyAgent(InputLayout input, const OffPolicySettings& setti
   high_ = register_buffer("action_high", torch::tensor(input_.action_high, torch::kFloat32));
 }
 
+std::int64_t OffPolicyAgent::register_encoder(EncoderArchitecture architecture,
+                                              const std::string& who) {
+  if (!input_.has_image) return 0;
+  ConvEncoder conv = make_conv_encoder(architecture, input_.stack * input_.channels, input_.height,
+                                       input_.width, who);
+  encoder = register_module("encoder", conv.layers);
+  return conv.features;
+}
+
 torch::Tensor OffPolicyAgent::image_input(const torch::Tensor& images) const {
   const std::int64_t batch = images.size(0);
   const std::int64_t channels = input_.stack * input_.channels;

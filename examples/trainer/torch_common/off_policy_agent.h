@@ -66,6 +66,12 @@ class OffPolicyAgent : public torch::nn::Module {
 
   torch::nn::Sequential encoder{nullptr};
 
+ protected:
+  /// Registers `encoder` (make_conv_encoder of `architecture` over the input's stacked frames;
+  /// `who` names the algorithm in its errors) when the input has an image; returns the number of
+  /// features it gives, 0 when there is no image.
+  std::int64_t register_encoder(EncoderArchitecture architecture, const std::string& who);
+
  private:
   InputLayout input_;
   bool autocast_ = false;

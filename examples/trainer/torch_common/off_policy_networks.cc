@@ -4,9 +4,44 @@
 #include <cmath>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 
 namespace pixelgym::trainer {
+
+torch::nn::Sequential make_feature_head(std::int64_t in, std::int64_t features) {
+  torch::nn::Sequential head(torch::nn::Linear(in, features),
+                             torch::nn::LayerNorm(torch::nn::LayerNormOptions({features})),
+                             torch::nn::Tanh());
+  orthogonal_init(*head, 1.0);
+  return head;
+}
+
+torch::nn::Sequential make_relu_mlp(std::int64_t in, std::int64_t hidden, std::int64_t depth,
+                                    std::int64_t out) {
+  torch::nn::Sequential mlp;
+  std::int64_t width = in;
+  for (std::int64_t layer = 0; layer < depth; ++layer) {
+    mlp->push_back(torch::nn::Linear(width, hidden));
+    mlp->push_back(torch::nn::ReLU());
+    width = hidden;
+  }
+  mlp->push_back(torch::nn::Linear(width, out));
+  orthogonal_init(*mlp, std::sqrt(2.0));
+  return mlp;
+}
+
+void step_on_loss(const torch::Tensor& loss, double value, const std::string& what,
+                  const std::vector<torch::optim::Optimizer*>& optimizers,
+                  const std::string& detail) {
+  if (!std::isfinite(value)) {
+    throw std::runtime_error(what + " is not finite (" + std::to_string(value) + detail +
+                             "): no step taken");
+  }
+  for (auto* optimizer : optimizers) optimizer->zero_grad();
+  loss.backward();
+  for (auto* optimizer : optimizers) optimizer->step();
+}
 
 CpuAutocast::CpuAutocast(bool on) : on_(on) {
   if (!on_) return;

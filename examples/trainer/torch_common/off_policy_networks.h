@@ -1,12 +1,14 @@
-// What the off-policy learners (DrQ, DrQ-v2) share beyond the encoder: bfloat16 autocast of the
-// encoder where the CPU computes it natively, the target networks' copy and soft update, and the
-// memory estimate that refuses settings which cannot fit.
+// What the off-policy learners (DrQ, DrQ-v2) share beyond the encoder: the feature head and the
+// MLPs of their actors and critics, the guarded optimizer step, bfloat16 autocast of the encoder
+// where the CPU computes it natively, the target networks' copy and soft update, and the memory
+// estimate that refuses settings which cannot fit.
 #pragma once
 
 #include <ATen/autocast_mode.h>
 #include <torch/torch.h>
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "examples/trainer/torch_common/conv_encoder.h"
@@ -14,6 +16,24 @@
 #include "pixelgym/trainer/memory_budget.h"
 
 namespace pixelgym::trainer {
+
+/// The head between the encoder and the MLPs: Linear(in, features), LayerNorm, tanh; its weights
+/// orthogonal_init'ed with gain 1.
+torch::nn::Sequential make_feature_head(std::int64_t in, std::int64_t features);
+
+/// An MLP of `depth` hidden layers of `hidden` units, each Linear then ReLU, and a Linear to
+/// `out`; its weights orthogonal_init'ed with gain sqrt(2). Its layers are named "0", "1", ... in
+/// order, as checkpoints store them.
+torch::nn::Sequential make_relu_mlp(std::int64_t in, std::int64_t hidden, std::int64_t depth,
+                                    std::int64_t out);
+
+/// One gradient step on `loss`, whose value the caller has read as `value`: throws
+/// std::runtime_error "`what` is not finite (`value``detail`): no step taken" when it is NaN or
+/// infinite; otherwise zeroes the gradients of every optimizer, back-propagates `loss` and steps
+/// each optimizer in the order given.
+void step_on_loss(const torch::Tensor& loss, double value, const std::string& what,
+                  const std::vector<torch::optim::Optimizer*>& optimizers,
+                  const std::string& detail = "");
 
 /// Bfloat16 autocast of the CPU's operations for the scope of the guard (when `on`; otherwise it
 /// does nothing). Keep it to convolutions: LayerNorm under CPU autocast fails in LibTorch 1.13.

@@ -7,42 +7,24 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <random>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "pixelgym/envs/spaces/box.h"
-#include "pixelgym/envs/spaces/dict.h"
-#include "tests/examples/trainer/torch_common/config_round_trip.h"
+#include "tests/examples/trainer/torch_common/learner_test_support.h"
 
 namespace pixelgym::drq {
 namespace {
 
 using nlohmann::json;
+using trainer::testing::all_equal;
+using trainer::testing::parameter_copies;
+using trainer::testing::pixel_space;
+using trainer::testing::random_batch;
 
-DrqConfig parse(const json& in) {
-  DrqConfig config;
-  from_json(in, config);
-  return config;
-}
-
-void expect_refused(const json& in, const std::string& word) {
-  try {
-    parse(in);
-    ADD_FAILURE() << in.dump() << " was accepted; expected an error naming " << word;
-  } catch (const std::invalid_argument& error) {
-    EXPECT_NE(std::string(error.what()).find(word), std::string::npos) << error.what();
-  }
-}
-
-// Each member, changed alone, survives the JSON round trip (none is written but not read).
-TEST(DrqConfigTest, EveryMemberSurvivesTheJsonRoundTrip) {
-  trainer::testing::expect_every_member_round_trips<DrqConfig>(parse);
-}
+constexpr auto parse = trainer::testing::parse_config<DrqConfig>;
+constexpr auto expect_refused = trainer::testing::expect_refused<DrqConfig>;
 
 TEST(DrqConfigTest, JsonRoundTripsAndBadMembersAreNamed) {
   DrqConfig config;
@@ -72,24 +54,6 @@ TEST(DrqConfigTest, JsonRoundTripsAndBadMembersAreNamed) {
   expect_refused({{"encoder", "big"}}, "encoder");
 }
 
-TEST(DrqConfigTest, EveryShippedConfigParses) {
-  const std::filesystem::path folder =
-      std::filesystem::path(PIXELGYM_SOURCE_DIR) / "examples/trainer/drq/configs";
-  int parsed = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
-    if (entry.path().extension() != ".json") continue;
-    std::ifstream in(entry.path());
-    EXPECT_NO_THROW(parse(json::parse(in))) << entry.path();
-    ++parsed;
-  }
-  EXPECT_GT(parsed, 0);
-}
-
-spaces::Dict pixel_space(Shape pixels) {
-  return spaces::Dict({{"pixels", std::make_shared<spaces::Box>(0.0, 255.0, pixels, DType::kUInt8)},
-                       {"joint_pos", std::make_shared<spaces::Box>(-1.0, 1.0, Shape{2})}});
-}
-
 // A learner on 32x32 grey stacks of 3 with one state key (or the state key alone), and a batch
 // of random transitions whose reward is the sign of the action.
 struct Fixture {
@@ -105,42 +69,9 @@ struct Fixture {
     config.batch_size = 16;
     config.hidden_dim = 32;
     config.feature_dim = 16;
-    std::mt19937 rng(3);
-    const std::size_t b = 16;
-    batch.size = static_cast<std::int64_t>(b);
-    if (pixels) {
-      for (auto* images : {&batch.images, &batch.next_images}) {
-        images->assign(1, std::vector<std::uint8_t>(b * 3 * 32 * 32));
-        for (auto& v : (*images)[0]) v = static_cast<std::uint8_t>(rng() % 256);
-      }
-    }
-    for (auto* vectors : {&batch.vectors, &batch.next_vectors}) {
-      vectors->assign(1, std::vector<float>(b * 2));
-      for (auto& v : (*vectors)[0]) v = static_cast<float>(rng() % 100) / 100.0f;
-    }
-    batch.actions.resize(b);
-    batch.rewards.resize(b);
-    batch.discounts.assign(b, 0.0f);  // terminal: the target is the reward
-    for (std::size_t i = 0; i < b; ++i) {
-      batch.actions[i] = static_cast<float>(rng() % 200) / 100.0f - 1.0f;
-      batch.rewards[i] = batch.actions[i] > 0.0f ? 1.0f : -1.0f;
-    }
+    batch = random_batch(pixels);
   }
 };
-
-std::vector<torch::Tensor> copies(const torch::nn::Module& module) {
-  std::vector<torch::Tensor> out;
-  for (const auto& p : module.parameters()) out.push_back(p.detach().clone());
-  return out;
-}
-
-bool all_equal(const std::vector<torch::Tensor>& a, const std::vector<torch::Tensor>& b) {
-  if (a.size() != b.size()) return false;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    if (!torch::equal(a[i], b[i])) return false;
-  }
-  return true;
-}
 
 // The sample's log-probability is the Gaussian's at the pre-tanh value, less log(1 - tanh^2),
 // summed over the action's elements: computed here in double precision from the same draw.
@@ -229,21 +160,23 @@ TEST(DrqLearnerTest, TheActorAndTheTargetMoveOnTheirOwnPeriods) {
   f.config.critic_tau = 0.25;
   Learner learner(f.input, f.config);
   Agent& agent = learner.agent();
-  EXPECT_TRUE(all_equal(copies(*agent.q1), copies(*agent.target_q1)));
-  EXPECT_TRUE(all_equal(copies(*agent.critic_head), copies(*agent.target_head)));
+  EXPECT_TRUE(all_equal(parameter_copies(*agent.q1), parameter_copies(*agent.target_q1)));
+  EXPECT_TRUE(
+      all_equal(parameter_copies(*agent.critic_head), parameter_copies(*agent.target_head)));
   for (const auto& p : agent.target_head->parameters()) EXPECT_FALSE(p.requires_grad());
   at::Generator augmentation = at::detail::createCPUGenerator(1);
   at::Generator sampling = at::detail::createCPUGenerator(2);
   for (int u = 0; u < 5; ++u) {
-    const auto actor_before = copies(*agent.actor);
-    const auto target_before = copies(*agent.target_q1);
+    const auto actor_before = parameter_copies(*agent.actor);
+    const auto target_before = parameter_copies(*agent.target_q1);
     const UpdateStats stats = learner.update(f.batch, augmentation, sampling);
     const bool actor_due = u % 2 == 0;
-    EXPECT_EQ(!all_equal(actor_before, copies(*agent.actor)), actor_due) << "update " << u;
+    EXPECT_EQ(!all_equal(actor_before, parameter_copies(*agent.actor)), actor_due)
+        << "update " << u;
     EXPECT_EQ(std::isnan(stats.actor_loss), !actor_due) << "update " << u;
-    const auto target_after = copies(*agent.target_q1);
+    const auto target_after = parameter_copies(*agent.target_q1);
     if (u % 3 == 0) {
-      const auto critic = copies(*agent.q1);
+      const auto critic = parameter_copies(*agent.q1);
       for (std::size_t i = 0; i < critic.size(); ++i) {
         const torch::Tensor expected = target_before[i] + 0.25 * (critic[i] - target_before[i]);
         EXPECT_TRUE(torch::allclose(target_after[i], expected, 1e-5, 1e-6)) << "update " << u;
@@ -267,7 +200,7 @@ TEST(DrqLearnerTest, UpdatesFitAFixedBatchAndAreDeterministic) {
         for (int u = 0; u < 60; ++u) {
           losses->push_back(learner.update(f.batch, augmentation, sampling).critic_loss);
         }
-        return copies(learner.agent());
+        return parameter_copies(learner.agent());
       };
       std::vector<double> losses, again;
       const auto a = run(&losses);

@@ -6,43 +6,24 @@
 #include <ATen/CPUGeneratorImpl.h>
 #include <gtest/gtest.h>
 
-#include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <random>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "pixelgym/envs/spaces/box.h"
 #include "pixelgym/envs/spaces/dict.h"
 #include "pixelgym/envs/spaces/discrete.h"
-#include "tests/examples/trainer/torch_common/config_round_trip.h"
+#include "tests/examples/trainer/torch_common/learner_test_support.h"
 
 namespace pixelgym::drqv2 {
 namespace {
 
 using nlohmann::json;
+using trainer::testing::parameter_copies;
+using trainer::testing::pixel_space;
 
-DrqV2Config parse(const json& in) {
-  DrqV2Config config;
-  from_json(in, config);
-  return config;
-}
-
-void expect_refused(const json& in, const std::string& word) {
-  try {
-    parse(in);
-    ADD_FAILURE() << in.dump() << " was accepted; expected an error naming " << word;
-  } catch (const std::invalid_argument& error) {
-    EXPECT_NE(std::string(error.what()).find(word), std::string::npos) << error.what();
-  }
-}
-
-// Each member, changed alone, survives the JSON round trip (none is written but not read).
-TEST(DrqV2ConfigTest, EveryMemberSurvivesTheJsonRoundTrip) {
-  trainer::testing::expect_every_member_round_trips<DrqV2Config>(parse);
-}
+constexpr auto parse = trainer::testing::parse_config<DrqV2Config>;
+constexpr auto expect_refused = trainer::testing::expect_refused<DrqV2Config>;
 
 TEST(DrqV2ConfigTest, JsonRoundTripsAndBadMembersAreNamed) {
   DrqV2Config config;
@@ -73,21 +54,6 @@ TEST(DrqV2ConfigTest, JsonRoundTripsAndBadMembersAreNamed) {
   expect_refused({{"actor_preactivation_penalty", -0.1}}, "actor_preactivation_penalty");
 }
 
-// The configs shipped in examples/trainer/drqv2/configs (docs/drqv2.md's commands name them)
-// parse and validate.
-TEST(DrqV2ConfigTest, EveryShippedConfigParses) {
-  const std::filesystem::path folder =
-      std::filesystem::path(PIXELGYM_SOURCE_DIR) / "examples" / "trainer" / "drqv2" / "configs";
-  int parsed = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
-    if (entry.path().extension() != ".json") continue;
-    std::ifstream file(entry.path());
-    EXPECT_NO_THROW(parse(json::parse(file))) << entry.path();
-    ++parsed;
-  }
-  EXPECT_GE(parsed, 2);
-}
-
 TEST(DrqV2ConfigTest, NoiseFollowsItsSchedule) {
   DrqV2Config config;
   config.noise_start = 1.0;
@@ -97,11 +63,6 @@ TEST(DrqV2ConfigTest, NoiseFollowsItsSchedule) {
   EXPECT_DOUBLE_EQ(config.noise_std(50), 0.6);
   EXPECT_DOUBLE_EQ(config.noise_std(100), 0.2);
   EXPECT_DOUBLE_EQ(config.noise_std(1000), 0.2);
-}
-
-spaces::Dict pixel_space(Shape pixels) {
-  return spaces::Dict({{"pixels", std::make_shared<spaces::Box>(0.0, 255.0, pixels, DType::kUInt8)},
-                       {"joint_pos", std::make_shared<spaces::Box>(-1.0, 1.0, Shape{2})}});
 }
 
 // A learner on 32x32 gray stacks of 3 with one state key, and a batch of random transitions.
@@ -117,40 +78,17 @@ struct Fixture {
     config.hidden_dim = 32;
     config.feature_dim = 16;
     config.learning_rate = 1e-3;
-    std::mt19937 rng(3);
-    const std::size_t b = 16;
-    batch.size = static_cast<std::int64_t>(b);
-    for (auto* images : {&batch.images, &batch.next_images}) {
-      images->assign(1, std::vector<std::uint8_t>(b * 3 * 32 * 32));
-      for (auto& v : (*images)[0]) v = static_cast<std::uint8_t>(rng() % 256);
-    }
-    for (auto* vectors : {&batch.vectors, &batch.next_vectors}) {
-      vectors->assign(1, std::vector<float>(b * 2));
-      for (auto& v : (*vectors)[0]) v = static_cast<float>(rng() % 100) / 100.0f;
-    }
-    batch.actions.resize(b);
-    batch.rewards.resize(b);
-    batch.discounts.assign(b, 0.0f);  // terminal: the target is the reward
-    for (std::size_t i = 0; i < b; ++i) {
-      batch.actions[i] = static_cast<float>(rng() % 200) / 100.0f - 1.0f;
-      batch.rewards[i] = batch.actions[i] > 0.0f ? 1.0f : -1.0f;
-    }
+    batch = trainer::testing::random_batch(true);
   }
 };
-
-std::vector<torch::Tensor> copies(const torch::nn::Module& module) {
-  std::vector<torch::Tensor> out;
-  for (const auto& p : module.parameters()) out.push_back(p.detach().clone());
-  return out;
-}
 
 TEST(DrqV2LearnerTest, TheTargetCriticStartsEqualAndMovesByTau) {
   Fixture f;
   f.config.critic_tau = 0.25;
   Learner learner(f.input, f.config);
   Agent& agent = learner.agent();
-  const auto critic_before = copies(*agent.q1);
-  const auto target_before = copies(*agent.target_q1);
+  const auto critic_before = parameter_copies(*agent.q1);
+  const auto target_before = parameter_copies(*agent.target_q1);
   ASSERT_EQ(critic_before.size(), target_before.size());
   for (std::size_t i = 0; i < critic_before.size(); ++i) {
     EXPECT_TRUE(torch::equal(critic_before[i], target_before[i]));
@@ -158,8 +96,8 @@ TEST(DrqV2LearnerTest, TheTargetCriticStartsEqualAndMovesByTau) {
   at::Generator augmentation = at::detail::createCPUGenerator(1);
   at::Generator noise = at::detail::createCPUGenerator(2);
   learner.update(f.batch, 0, augmentation, noise);
-  const auto critic_after = copies(*agent.q1);
-  const auto target_after = copies(*agent.target_q1);
+  const auto critic_after = parameter_copies(*agent.q1);
+  const auto target_after = parameter_copies(*agent.target_q1);
   bool moved = false;
   for (std::size_t i = 0; i < critic_after.size(); ++i) {
     // target' = target + tau (critic' - target): the critic after its step.
@@ -180,7 +118,7 @@ TEST(DrqV2LearnerTest, UpdatesFitAFixedBatchAndAreDeterministic) {
     for (int u = 0; u < updates; ++u) {
       losses->push_back(learner.update(f.batch, 0, augmentation, noise).critic_loss);
     }
-    return copies(learner.agent());
+    return parameter_copies(learner.agent());
   };
   std::vector<double> losses, again;
   const auto a = run(60, &losses);

@@ -21,14 +21,12 @@
 #include "pixelgym/envs/spaces/box.h"
 #include "pixelgym/envs/spaces/dict.h"
 #include "pixelgym/envs/spaces/discrete.h"
+#include "tests/examples/trainer/torch_common/learner_test_support.h"
 
 namespace pixelgym::trainer {
 namespace {
 
-spaces::Dict pixel_space(Shape pixels) {
-  return spaces::Dict({{"pixels", std::make_shared<spaces::Box>(0.0, 255.0, pixels, DType::kUInt8)},
-                       {"joint_pos", std::make_shared<spaces::Box>(-1.0, 1.0, Shape{2})}});
-}
+using testing::pixel_space;
 
 TEST(InputLayoutTest, ReadsStacksAndRefusesWhatItCannotLearnFrom) {
   const spaces::Box action(-2.0, 2.0, Shape{2});
