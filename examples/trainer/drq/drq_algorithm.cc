@@ -6,13 +6,12 @@
 namespace pixelgym::drq {
 
 DrqStepLearner::DrqStepLearner(const vector::VectorEnv& env, const DrqConfig& config)
-    : OffPolicyStepLearner(env, trainer::validated(config),
-                           config.batch_size * config.augmented_copies, {"drq", "rng_sampling"}),
-      learner_(input(), config) {}
+    : OffPolicyStepLearnerWith(env, config, config.batch_size * config.augmented_copies,
+                               {"drq", "rng_sampling"}) {}
 
 trainer::UpdateSummary DrqStepLearner::update(const ReplayBatch& batch,
                                               std::int64_t /*env_steps*/) {
-  const UpdateStats update = learner_.update(batch, augmentation(), update_generator());
+  const UpdateStats update = learner().update(batch, augmentation(), update_generator());
   if (!std::isnan(update.actor_loss)) entropy_sum_ += update.entropy;
   alpha_ = update.alpha;
   return {update.critic_loss, update.actor_loss, update.q_mean, update.target_mean};
@@ -31,9 +30,9 @@ std::vector<std::string> DrqStepLearner::update_metric_names() const {
 }
 
 std::vector<trainer::NamedOptimizer> DrqStepLearner::optimizers() {
-  return {{"actor_optimizer", &learner_.actor_optimizer()},
-          {"critic_optimizer", &learner_.critic_optimizer()},
-          {"alpha_optimizer", &learner_.alpha_optimizer()}};
+  return {{"actor_optimizer", &learner().actor_optimizer()},
+          {"critic_optimizer", &learner().critic_optimizer()},
+          {"alpha_optimizer", &learner().alpha_optimizer()}};
 }
 
 }  // namespace pixelgym::drq

@@ -30,26 +30,20 @@ namespace pixelgym::drq {
 /// target_mean (means over the iteration's updates; actor_loss over its actor updates), alpha
 /// (the temperature after the last update), policy_entropy (minus the mean log-probability of
 /// the actor updates' samples), then the shared replay metrics.
-class DrqStepLearner final : public trainer::OffPolicyStepLearner {
+class DrqStepLearner final : public trainer::OffPolicyStepLearnerWith<Learner> {
  public:
   /// Throws std::invalid_argument for a config that fails validate(), an env that does not
   /// autoreset in SameStep mode or has another num_envs, and as input_layout for the spaces.
   DrqStepLearner(const vector::VectorEnv& env, const DrqConfig& config);
 
-  Learner& learner() { return learner_; }
-
  private:
-  std::shared_ptr<trainer::OffPolicyAgent> shared_agent() const override {
-    return learner_.agent_ptr();
-  }
   trainer::UpdateSummary update(const ReplayBatch& batch, std::int64_t env_steps) override;
   std::map<std::string, double> update_metrics(std::int64_t updates, std::int64_t actor_updates,
                                                std::int64_t env_steps) override;
   std::vector<std::string> update_metric_names() const override;
   std::vector<trainer::NamedOptimizer> optimizers() override;
-  void restored_updates(std::int64_t updates) override { learner_.set_updates(updates); }
+  void restored_updates(std::int64_t updates) override { learner().set_updates(updates); }
 
-  Learner learner_;
   double alpha_ = trainer::ProgressRow::kNone;  // after the iteration's last update
   double entropy_sum_ = 0.0;                    // over its actor updates
 };

@@ -27,18 +27,13 @@ namespace pixelgym::drqv2 {
 /// Its metrics (progress.csv's columns after the run's; runs before metrics were named by their
 /// algorithm also have PPO's five loss columns, left empty): critic_loss, actor_loss, q_mean,
 /// target_mean (means over the iteration's updates), noise_std, then the shared replay metrics.
-class DrqV2StepLearner final : public trainer::OffPolicyStepLearner {
+class DrqV2StepLearner final : public trainer::OffPolicyStepLearnerWith<Learner> {
  public:
   /// Throws std::invalid_argument for a config that fails validate(), an env that does not
   /// autoreset in SameStep mode or has another num_envs, and as input_layout for the spaces.
   DrqV2StepLearner(const vector::VectorEnv& env, const DrqV2Config& config);
 
-  Learner& learner() { return learner_; }
-
  private:
-  std::shared_ptr<trainer::OffPolicyAgent> shared_agent() const override {
-    return learner_.agent_ptr();
-  }
   torch::Tensor explore(const trainer::ObservationTensors& obs, std::int64_t env_steps,
                         at::Generator& exploration) override;
   trainer::UpdateSummary update(const ReplayBatch& batch, std::int64_t env_steps) override;
@@ -46,8 +41,6 @@ class DrqV2StepLearner final : public trainer::OffPolicyStepLearner {
                                                std::int64_t env_steps) override;
   std::vector<std::string> update_metric_names() const override;
   std::vector<trainer::NamedOptimizer> optimizers() override;
-
-  Learner learner_;
 };
 
 /// DrQ-v2's AlgorithmFactory: name "drqv2", the config a DrqV2Config (to_json / from_json).

@@ -133,4 +133,26 @@ class OffPolicyStepLearner : public StepLearner {
   std::unique_ptr<OffPolicyActor> actor_;
 };
 
+/// An OffPolicyStepLearner that owns the algorithm's `Learner`, made from (input(), config) once
+/// the shared part is: DrQ's and DrQ-v2's step learners derive from this. `Learner` has
+/// agent_ptr(), the agent the evaluation actor uses.
+template <typename Learner>
+class OffPolicyStepLearnerWith : public OffPolicyStepLearner {
+ public:
+  Learner& learner() { return learner_; }
+
+ protected:
+  /// `config` an OffPolicySettings with validate() (checked here, before anything is made).
+  template <typename Config>
+  OffPolicyStepLearnerWith(const vector::VectorEnv& env, const Config& config,
+                           std::int64_t batch_rows, OffPolicyNames names)
+      : OffPolicyStepLearner(env, validated(config), batch_rows, std::move(names)),
+        learner_(input(), config) {}
+
+  std::shared_ptr<OffPolicyAgent> shared_agent() const override { return learner_.agent_ptr(); }
+
+ private:
+  Learner learner_;
+};
+
 }  // namespace pixelgym::trainer
