@@ -2,6 +2,8 @@
 # (Release, in build/), then run.
 #   make demo   the main job
 #   make test   every test, through ctest (FormatCheck among them: see format-check)
+#   make test-egl    every test again with OpenGL through EGL (PIXELGYM_GL=egl), on the build of
+#                    make test (CI runs it after `make test`)
 #   make test-asan   every test, built with AddressSanitizer and UBSan in build-asan/ (CI runs it
 #                    after `make test`)
 #   make test-tsan   the tests labelled threads, built with ThreadSanitizer in build-tsan/ (CI runs
@@ -26,7 +28,7 @@ BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 PIXELGYM := $(BUILD_DIR)/examples/pixelgym
 
-.PHONY: all deps configure build demo test test-asan test-tsan fuzz install wheel deb format-check format goldens bench bench-report clean
+.PHONY: all deps configure build demo test test-egl test-asan test-tsan fuzz install wheel deb format-check format goldens bench bench-report clean
 
 all: build
 
@@ -54,6 +56,12 @@ demo: build
 
 test: build
 	ctest --test-dir $(BUILD_DIR) --output-on-failure --parallel $(JOBS)
+
+# The same tests drawing through EGL: PIXELGYM_GL=egl makes every renderer and env of
+# render_backend=auto use it (tests of OSMesa itself ask for it by name). The frames must be the
+# same bytes (tests/envs/render_backends_test.cc), so the goldens hold.
+test-egl: build
+	PIXELGYM_GL=egl ctest --test-dir $(BUILD_DIR) --output-on-failure --parallel $(JOBS)
 
 # AddressSanitizer (with LeakSanitizer) and UndefinedBehaviorSanitizer over every test, the fuzz
 # corpora's replays (Fuzz.*) among them, in a Debug build at -O1 (asserts on; warnings are not

@@ -19,7 +19,7 @@ install(TARGETS ${pixelgym_libraries} pixelgym_testing_gtest EXPORT pixelgymTarg
 # GL objects behind render/renderer.h) are for render/*.cc only; no installed header includes them.
 install(DIRECTORY engine envs render testing wrappers
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/pixelgym FILES_MATCHING PATTERN "*.h"
-        REGEX "/render/(gl|gl_library|gl_object|lod|mesh_arena|render_target|shader_programs|shadow_fit|shadow_pass|texture_cache|transforms)\\.h$"
+        REGEX "/render/(context_impl|gl|gl_library|gl_object|lod|mesh_arena|render_target|shader_programs|shadow_fit|shadow_pass|texture_cache|transforms)\\.h$"
         EXCLUDE)
 # The trainer's run (pixelgym::trainer_run), included as <pixelgym/trainer/algorithm.h>.
 if(TARGET pixelgym_trainer_run)
@@ -53,5 +53,7 @@ set(CPACK_DEBIAN_PACKAGE_SECTION science)
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
 # Headers include Eigen's; find_package(pixelgym) finds it and Threads.
 set(CPACK_DEBIAN_PACKAGE_DEPENDS "libeigen3-dev (>= 3.4), python3-numpy")
+# The EGL backend loads libEGL at run time (render_backend=egl; OSMesa draws without it).
+set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "libegl1, libegl-mesa0, libgl1-mesa-dri")
 set(CPACK_PACKAGING_INSTALL_PREFIX ${CMAKE_INSTALL_PREFIX})
 include(CPack)

@@ -8,9 +8,28 @@ namespace pixelgym::render {
 
 /// Which OpenGL implementation a context comes from.
 enum class GlBackend {
-  /// Mesa's off-screen GL (libOSMesa, llvmpipe): no display, no GPU. The default.
+  /// PIXELGYM_GL when it is set (auto, egl or osmesa), else the first that works of OSMesa and
+  /// EGL, in that order.
+  kAuto,
+  /// Mesa's off-screen GL (libOSMesa, llvmpipe): no display, no GPU; rasterizes in parallel with
+  /// private copies of Mesa (render/mesa_copy.h). Mesa 25.1 and later no longer ship it.
   kOSMesa,
+  /// EGL without a display: a GPU's EGL device where one exists, else Mesa's surfaceless platform
+  /// on llvmpipe (the same pixels as OSMesa). PIXELGYM_EGL_DEVICE picks a device: its index among
+  /// EGL's devices, cuda:N (the device of CUDA number N), surfaceless, or auto (the default).
+  kEgl,
 };
+
+/// "auto", "osmesa" or "egl". Throws std::invalid_argument naming `who`, the three names and
+/// what was given for any other text.
+GlBackend parse_gl_backend(const std::string& name, const std::string& who);
+/// The name parse_gl_backend reads.
+std::string gl_backend_name(GlBackend backend);
+/// `backend` with kAuto replaced by what PIXELGYM_GL names (kAuto when it is unset, empty or
+/// "auto"). Throws std::invalid_argument for a PIXELGYM_GL that parse_gl_backend refuses.
+GlBackend requested_gl_backend(GlBackend backend);
+
+struct ContextImpl;
 
 /// An RAII OpenGL 3.3 core context. One context belongs to one renderer and is used by one
 /// thread at a time (any thread, one after the other); contexts in different threads are
@@ -34,10 +53,12 @@ enum class GlBackend {
 /// count) before the first render to override this.
 class Context {
  public:
-  /// Creates a context of copy `mesa_copy` of Mesa (see MesaCopy; taken modulo max_copies()),
-  /// current on the calling thread. Throws std::runtime_error naming the backend and Mesa's
-  /// reason when it cannot be created, std::invalid_argument for mesa_copy < 0.
-  explicit Context(GlBackend backend = GlBackend::kOSMesa, int mesa_copy = 0);
+  /// Creates a context of `backend` (OSMesa: of copy `mesa_copy` of Mesa, see MesaCopy, taken
+  /// modulo max_copies(); EGL has one copy), current on the calling thread. Throws
+  /// std::runtime_error naming the backend and its reason when it cannot be created (kAuto: each
+  /// backend's), what to install when a library is missing; std::invalid_argument for
+  /// mesa_copy < 0 and a PIXELGYM_GL or PIXELGYM_EGL_DEVICE it cannot read.
+  explicit Context(GlBackend backend = GlBackend::kAuto, int mesa_copy = 0);
   /// Destroys the context, on any thread, provided no other thread has it current.
   ~Context();
   Context(const Context&) = delete;
@@ -68,10 +89,10 @@ class Context {
   };
   /// True when this context is current on the calling thread.
   bool is_current() const;
-  /// The implementation it was created with.
+  /// The implementation it was created with: kOSMesa or kEgl, never kAuto.
   GlBackend backend() const { return backend_; }
   /// The copy of Mesa the context is from (see MesaCopy): the one it was created for, or 0 when
-  /// that one could not be loaded.
+  /// that one could not be loaded (EGL: 0).
   int mesa_copy() const;
   /// GL_RENDERER and GL_VERSION, e.g. "llvmpipe (LLVM 15.0.6, 256 bits), 4.5 (Core Profile)
   /// Mesa 22.3.6". Binds the context for the call (as Scope).
@@ -82,9 +103,8 @@ class Context {
   int max_samples();
 
  private:
-  struct Impl;
   GlBackend backend_;
-  std::unique_ptr<Impl> impl_;
+  std::unique_ptr<ContextImpl> impl_;  // render/context_impl.h
 };
 
 }  // namespace pixelgym::render

@@ -14,7 +14,8 @@
 #endif
 #include <GL/gl.h>  // NOLINT: first, with GL_GLEXT_PROTOTYPES
 #include <GL/glext.h>
-#include <GL/osmesa.h>
+
+#include <string>
 
 /// X(Name) for every glName the renderer calls.
 #define PIXELGYM_GL_FUNCTIONS(X)    \
@@ -87,12 +88,28 @@
 
 namespace pixelgym::render {
 
-/// One library copy's GL entry points, as OSMesaGetProcAddress of that copy gives them.
+/// One GL library's entry points: a copy of libOSMesa's (OSMesaGetProcAddress of that copy), or
+/// EGL's (eglGetProcAddress).
 struct GlFunctions {
 #define PIXELGYM_GL_MEMBER(name) decltype(&::gl##name) name = nullptr;
   PIXELGYM_GL_FUNCTIONS(PIXELGYM_GL_MEMBER)
 #undef PIXELGYM_GL_MEMBER
 };
+
+/// What a GL library's get-proc-address gives (OSMesaGetProcAddress, eglGetProcAddress).
+using GlProc = void (*)();
+
+/// Fills `gl` with `get_proc_address("glName")` for every function of the table; returns the
+/// first name it gave null for, or "" when it gave them all.
+template <typename GetProcAddress>
+std::string load_gl_functions(GlFunctions& gl, GetProcAddress get_proc_address) {
+#define PIXELGYM_GL_LOAD(name)                                                 \
+  gl.name = reinterpret_cast<decltype(gl.name)>(get_proc_address("gl" #name)); \
+  if (gl.name == nullptr) return "gl" #name;
+  PIXELGYM_GL_FUNCTIONS(PIXELGYM_GL_LOAD)
+#undef PIXELGYM_GL_LOAD
+  return "";
+}
 
 /// The table of the copy whose context was last made current on this thread (Context sets it).
 extern thread_local const GlFunctions* current_gl_functions;

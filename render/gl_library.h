@@ -1,6 +1,8 @@
 // Private to render/: one loaded copy of libOSMesa and its entry points (see render/mesa_copy.h).
 #pragma once
 
+#include <GL/osmesa.h>
+
 #include "pixelgym/render/gl.h"
 
 namespace pixelgym::render {

@@ -12,11 +12,10 @@
 #include <stdexcept>
 #include <string>
 
+#include "pixelgym/render/context_impl.h"
 #include "pixelgym/render/gl_library.h"
 
 namespace pixelgym::render {
-
-thread_local const GlFunctions* current_gl_functions = nullptr;
 
 namespace {
 
@@ -26,24 +25,18 @@ constexpr int kDefaultCopies = 8;
 
 thread_local unsigned copies_ready_here = 1U;  // bit k: init_thread of copy k ran on this thread
 
+}  // namespace
+
 void default_llvmpipe_threads() {
   static std::once_flag once;
   std::call_once(once, [] {
-    // Read by llvmpipe when it creates a screen (on a copy's first context), and by private
-    // copies from the environment they are loaded with: see Context's comment.
+    // Read by llvmpipe when it creates a screen (on a copy's first context, or an EGL display's),
+    // and by private copies from the environment they are loaded with: see Context's comment.
     if (std::getenv("LP_NUM_THREADS") == nullptr) setenv("LP_NUM_THREADS", "0", 0);
   });
 }
 
-// Fills `library.gl` with `get_proc_address`; returns the first name it lacks, or "".
-std::string load_gl_functions(GlLibrary& library, OSMESAproc (*get_proc_address)(const char*)) {
-#define PIXELGYM_GL_LOAD(name)                                                                 \
-  library.gl.name = reinterpret_cast<decltype(library.gl.name)>(get_proc_address("gl" #name)); \
-  if (library.gl.name == nullptr) return "gl" #name;
-  PIXELGYM_GL_FUNCTIONS(PIXELGYM_GL_LOAD)
-#undef PIXELGYM_GL_LOAD
-  return "";
-}
+namespace {
 
 // Copy 0: the linked library.
 std::unique_ptr<GlLibrary> load_linked() {
@@ -52,7 +45,7 @@ std::unique_ptr<GlLibrary> load_linked() {
   library->make_current = &::OSMesaMakeCurrent;
   library->get_current_context = &::OSMesaGetCurrentContext;
   library->destroy_context = &::OSMesaDestroyContext;
-  const std::string missing = load_gl_functions(*library, &::OSMesaGetProcAddress);
+  const std::string missing = load_gl_functions(library->gl, &::OSMesaGetProcAddress);
   if (!missing.empty()) {
     throw std::runtime_error("Context: libOSMesa has no " + missing +
                              " (OSMesaGetProcAddress returned null)");
@@ -134,7 +127,7 @@ std::unique_ptr<GlLibrary> load_private(int copy, std::string& why, void*& handl
   auto* get_proc_address =
       reinterpret_cast<OSMESAproc (*)(const char*)>(symbol("OSMesaGetProcAddress"));
   if (!why.empty()) return nullptr;
-  const std::string missing = load_gl_functions(*library, get_proc_address);
+  const std::string missing = load_gl_functions(library->gl, get_proc_address);
   if (!missing.empty()) {
     why = file + " has no " + missing;
     return nullptr;

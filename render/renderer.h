@@ -45,7 +45,7 @@ struct RenderTargets {
 class ContextGroup {
  public:
   /// Throws std::invalid_argument for mesa_copy < 0.
-  explicit ContextGroup(int mesa_copy = 0, GlBackend backend = GlBackend::kOSMesa);
+  explicit ContextGroup(int mesa_copy = 0, GlBackend backend = GlBackend::kAuto);
   /// Drops the group's share of the context; the renderers made with it keep theirs.
   ~ContextGroup();
   ContextGroup(const ContextGroup&) = delete;
@@ -82,7 +82,7 @@ class Renderer {
   /// Draws with a context of its own, of copy `mesa_copy` of Mesa (see MesaCopy). Throws
   /// std::runtime_error when the GL context cannot be created or the shaders do not build,
   /// std::invalid_argument for mesa_copy < 0.
-  explicit Renderer(GlBackend backend = GlBackend::kOSMesa, int mesa_copy = 0);
+  explicit Renderer(GlBackend backend = GlBackend::kAuto, int mesa_copy = 0);
   /// Draws with `group`'s context (created now if it is the group's first renderer), which it
   /// keeps alive: the group object itself may go first. Throws as above.
   explicit Renderer(ContextGroup& group);

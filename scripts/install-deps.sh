@@ -14,8 +14,9 @@ PACKAGES=(
   clang-format
   # engine: physics, URDF parsing, mesh import, linear algebra
   libbullet-dev liburdfdom-dev libconsole-bridge-dev libtinyxml-dev libassimp-dev libeigen3-dev
-  # render: off-screen OpenGL (llvmpipe) and PNG files
-  libosmesa6-dev libpng-dev
+  # render: off-screen OpenGL (llvmpipe) through OSMesa or EGL (loaded at run time: libegl1,
+  # Mesa's EGL driver and llvmpipe's DRI driver; headers in libegl-dev), and PNG files
+  libosmesa6-dev libegl-dev libegl1 libegl-mesa0 libgl1-mesa-dri libpng-dev
   # wrappers: resize, colour conversion, H.264 video
   libopencv-dev
   # examples: the PPO trainer; OpenBLAS (pthreads) takes over libblas.so.3 from the reference

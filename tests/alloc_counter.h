@@ -10,8 +10,9 @@
 //
 // Counting is on only inside `count_allocations(body)`. Each allocation counted is attributed by
 // its call stack (backtrace + dladdr):
-// - kMesa: a frame in libOSMesa, libLLVM, libgallium or libglapi (llvmpipe mallocs while it
-//   draws: state validation and draw setup, which no caller can avoid);
+// - kMesa: a frame in libOSMesa, libLLVM, libgallium or libglapi, or, through EGL, in a DRI
+//   driver (swrast_dri.so), libEGL* or libGLdispatch (llvmpipe mallocs while it draws: state
+//   validation and draw setup, which no caller can avoid);
 // - else kOpenCv: a frame in libopencv_* (cv::resize's scratch tables, for one);
 // - else kBullet: a frame in Bullet's collision or dynamics libraries (libBullet*: the
 //   dispatcher's algorithm for a new pair of compound shapes, solver arrays growing). Not
@@ -72,7 +73,9 @@ inline AllocOwner owner_of_caller() {
     if (dladdr(frames[i], &info) == 0 || info.dli_fname == nullptr) continue;
     const char* name = info.dli_fname;
     if (std::strstr(name, "libOSMesa") != nullptr || std::strstr(name, "libLLVM") != nullptr ||
-        std::strstr(name, "libgallium") != nullptr || std::strstr(name, "libglapi") != nullptr) {
+        std::strstr(name, "libgallium") != nullptr || std::strstr(name, "libglapi") != nullptr ||
+        std::strstr(name, "_dri.so") != nullptr || std::strstr(name, "libEGL") != nullptr ||
+        std::strstr(name, "libGLdispatch") != nullptr) {
       return AllocOwner::kMesa;
     }
     if (std::strstr(name, "libopencv") != nullptr) {

@@ -66,7 +66,11 @@ std::vector<ParamSpec> TaskConfig::params() {
           {"shadows", d.shadows, "draw shadows in observations and render()"},
           {"msaa", d.msaa,
            "anti-aliasing samples per observation pixel: 0 (off), 2, 4, or 8 where the OpenGL "
-           "offers it (llvmpipe: at most 4; render() uses 4)"}};
+           "offers it (llvmpipe: at most 4; render() uses 4)"},
+          {"render_backend", render::gl_backend_name(d.render_backend),
+           "the OpenGL to draw with: auto (PIXELGYM_GL when set, else osmesa where it works, else "
+           "egl), osmesa or egl (a GPU's EGL device where one exists, else llvmpipe; "
+           "PIXELGYM_EGL_DEVICE picks one)"}};
 }
 
 TaskConfig TaskConfig::from_params(const Params& params, const std::vector<std::string>& cameras,
@@ -104,6 +108,8 @@ TaskConfig TaskConfig::from_params(const Params& params, const std::vector<std::
     throw std::invalid_argument(env + ": msaa must be 0, 2, 4 or 8, got " + std::to_string(msaa));
   }
   c.msaa = static_cast<int>(msaa);
+  c.render_backend =
+      render::parse_gl_backend(params.at("render_backend").as_string(), env + ": render_backend");
   return c;
 }
 
@@ -133,13 +139,27 @@ EnvDescription PixelEnv::describe(const Task& task, const TaskConfig& config) {
 }
 
 PixelRenderResources::PixelRenderResources(int mesa_copy, bool share_context)
-    : group_(mesa_copy), share_context_(share_context) {}
+    : mesa_copy_(mesa_copy), share_context_(share_context) {
+  if (mesa_copy < 0) {
+    throw std::invalid_argument("PixelRenderResources: mesa_copy must be >= 0, got " +
+                                std::to_string(mesa_copy));
+  }
+}
 
 PixelRenderResources::~PixelRenderResources() = default;
 
-std::unique_ptr<render::Renderer> PixelRenderResources::make_renderer() {
-  if (share_context_) return std::make_unique<render::Renderer>(group_);
-  return std::make_unique<render::Renderer>(group_.backend(), group_.mesa_copy());
+bool PixelRenderResources::context_created() const {
+  for (const auto& group : groups_) {
+    if (group != nullptr && group->created()) return true;
+  }
+  return false;
+}
+
+std::unique_ptr<render::Renderer> PixelRenderResources::make_renderer(render::GlBackend backend) {
+  if (!share_context_) return std::make_unique<render::Renderer>(backend, mesa_copy_);
+  std::unique_ptr<render::ContextGroup>& group = groups_[static_cast<std::size_t>(backend)];
+  if (group == nullptr) group = std::make_unique<render::ContextGroup>(mesa_copy_, backend);
+  return std::make_unique<render::Renderer>(*group);
 }
 
 PixelEnv::PixelEnv(std::unique_ptr<Task> task, TaskConfig config, std::string name,
@@ -186,8 +206,9 @@ PixelEnv::~PixelEnv() = default;
 
 render::Renderer& PixelEnv::renderer() {
   if (renderer_ == nullptr) {
-    renderer_ = render_resources_ != nullptr ? render_resources_->make_renderer()
-                                             : std::make_unique<render::Renderer>();
+    renderer_ = render_resources_ != nullptr
+                    ? render_resources_->make_renderer(config_.render_backend)
+                    : std::make_unique<render::Renderer>(config_.render_backend);
   }
   return *renderer_;
 }

@@ -1,6 +1,7 @@
 // PixelEnv: the one environment class that runs every pixel task.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -111,10 +112,10 @@ class PixelEnv final : public Env {
 };
 
 /// What the pixel envs that one thread steps share to draw (RenderResources, made by make_vec
-/// through EnvSpec::make_render_resources): one GL context group (render::ContextGroup) in copy
-/// `mesa_copy` of Mesa, or, without sharing, only the copy (each env's context of its own in it).
-/// Frames are byte-identical whatever is shared. The envs given one must be stepped by one thread
-/// at a time (render::ContextGroup).
+/// through EnvSpec::make_render_resources): one GL context group (render::ContextGroup) per
+/// render_backend the envs ask for, in copy `mesa_copy` of Mesa, or, without sharing, only the copy
+/// (each env's context of its own in it). Frames are byte-identical whatever is shared. The envs
+/// given one must be stepped by one thread at a time (render::ContextGroup).
 class PixelRenderResources final : public RenderResources {
  public:
   /// Throws std::invalid_argument for mesa_copy < 0.
@@ -122,18 +123,19 @@ class PixelRenderResources final : public RenderResources {
   ~PixelRenderResources() override;
 
   /// The copy of Mesa asked for (see render::MesaCopy).
-  int mesa_copy() const { return group_.mesa_copy(); }
-  /// Whether the renderers it makes share one GL context.
+  int mesa_copy() const { return mesa_copy_; }
+  /// Whether the renderers it makes share one GL context (one per backend).
   bool shares_context() const { return share_context_; }
-  /// Whether a renderer made with these resources has created the shared GL context yet.
-  bool context_created() const { return group_.created(); }
-  /// A renderer for one env: with the group's context when shared, else with one of its own in
-  /// the copy. Throws as render::Renderer's constructors.
-  std::unique_ptr<render::Renderer> make_renderer();
+  /// Whether a renderer made with these resources has created a shared GL context yet.
+  bool context_created() const;
+  /// A renderer for one env drawing with `backend`: with that backend's shared context when
+  /// shared, else with one of its own in the copy. Throws as render::Renderer's constructors.
+  std::unique_ptr<render::Renderer> make_renderer(render::GlBackend backend);
 
  private:
-  render::ContextGroup group_;
+  int mesa_copy_;
   bool share_context_;
+  std::array<std::unique_ptr<render::ContextGroup>, 3> groups_;  // by GlBackend asked for
 };
 
 /// The registry entry of a pixel task: the shared TaskConfig keys plus `extra_params`; the

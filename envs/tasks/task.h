@@ -15,6 +15,7 @@
 #include "pixelgym/envs/space.h"
 #include "pixelgym/envs/value.h"
 #include "pixelgym/render/camera.h"
+#include "pixelgym/render/context.h"
 
 namespace pixelgym {
 
@@ -43,6 +44,9 @@ struct TaskConfig {
   /// it moves; with it such a part is a continuous fainter line. Off by default in the v0 ids,
   /// whose observations stay as they were (render() frames always use 4).
   int msaa = 0;
+  /// The OpenGL the env draws with (render::GlBackend): auto (PIXELGYM_GL when set, else OSMesa
+  /// where it works, else EGL), osmesa or egl. On llvmpipe both draw the same bytes.
+  render::GlBackend render_backend = render::GlBackend::kAuto;
 
   /// Whether observations hold the image (obs_mode is not "state").
   bool has_pixels() const { return obs_mode != "state"; }
@@ -55,7 +59,8 @@ struct TaskConfig {
   static std::vector<ParamSpec> params();
   /// Reads resolved kwargs; `cameras` are the task's camera names. Throws std::invalid_argument,
   /// naming `env` and the key, for a size outside [16, 8192], an unknown obs_mode or camera,
-  /// action_repeat outside [1, 1000], or msaa other than 0, 2, 4 or 8.
+  /// action_repeat outside [1, 1000], msaa other than 0, 2, 4 or 8, or a render_backend other than
+  /// auto, egl or osmesa.
   static TaskConfig from_params(const Params& params, const std::vector<std::string>& cameras,
                                 const std::string& env);
 };

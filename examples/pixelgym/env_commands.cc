@@ -17,6 +17,7 @@
 #include "pixelgym/envs/suggestions.h"
 #include "pixelgym/envs/vector/async_vector_env.h"
 #include "pixelgym/envs/vector/make_vec.h"
+#include "pixelgym/render/context.h"
 #include "pixelgym/testing/snapshot.h"
 #include "pixelgym/wrappers/wrapper_spec.h"
 
@@ -134,7 +135,25 @@ std::vector<std::vector<std::string>> observation_rows(const Space& space) {
   return rows;
 }
 
-// From the spec and Registry::describe alone: no env, Bullet world or GL context is built.
+// The OpenGL a pixel env of these --set kwargs would draw with: its backend and GL_RENDERER,
+// from a context made for the purpose; or "none" and why, when no backend works here (info
+// still answers everything else).
+std::string renderer_line(const std::vector<std::string>& sets) {
+  std::string requested = "auto";
+  for (const std::string& set : sets) {
+    if (set.rfind("render_backend=", 0) == 0) requested = set.substr(15);
+  }
+  try {
+    render::Context context(render::parse_gl_backend(requested, "render_backend"));
+    return render::gl_backend_name(context.backend()) + " (" + context.description() +
+           "; render_backend=" + requested + ")";
+  } catch (const std::exception& error) {
+    return "none works here (render_backend=" + requested + "): " + error.what();
+  }
+}
+
+// From the spec and Registry::describe: no env or Bullet world is built (a GL context only to
+// name the renderer of a pixel env).
 int run_info(const InfoArguments& args) {
   const EnvDescription description = describe_env(args.id, args.sets, args.wraps);
   // The time limit the kwargs give, before a time_limit wrapper.
@@ -159,8 +178,12 @@ int run_info(const InfoArguments& args) {
             << "cameras:           " << cameras << "\n"
             << "render_modes:      " << join(description.metadata.render_modes) << "\n"
             << "render_fps:        " << description.metadata.render_fps << "\n"
-            << "max_episode_steps: " << limit(description.max_episode_steps) << "\n"
-            << "config (--set key=value):\n";
+            << "max_episode_steps: " << limit(description.max_episode_steps) << "\n";
+  const bool draws =
+      std::any_of(spec->params.begin(), spec->params.end(),
+                  [](const ParamSpec& param) { return param.name == "render_backend"; });
+  if (draws) std::cout << "renderer:          " << renderer_line(args.sets) << "\n";
+  std::cout << "config (--set key=value):\n";
   std::vector<std::vector<std::string>> rows = {{"key", "type", "default", "description"}};
   for (const ParamSpec& param : spec->params) {
     rows.push_back(

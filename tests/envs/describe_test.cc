@@ -85,7 +85,8 @@ INSTANTIATE_TEST_SUITE_P(AllEnvs, DescribeTest, ::testing::ValuesIn(registered_i
 TEST(DescribeTest, TheCountersSeeAWorldAndAContext) {
   const int contexts = g_gl_contexts;
   const long allocations = g_bullet_allocations;
-  std::unique_ptr<Env> env = make("CartPoleSwingup-v0");
+  // The counter sees OSMesa's contexts: this env draws with OSMesa whatever PIXELGYM_GL says.
+  std::unique_ptr<Env> env = make("CartPoleSwingup-v0", {{"render_backend", "osmesa"}});
   env->reset(0);
   EXPECT_EQ(g_gl_contexts, contexts + 1);
   EXPECT_GT(g_bullet_allocations, allocations);

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 namespace pixelgym::render {
 namespace {
@@ -38,9 +39,9 @@ class ScopedEnv {
   bool had_ = false;
 };
 
-std::string creation_error() {
+std::string creation_error(GlBackend backend = GlBackend::kOSMesa) {
   try {
-    Context context;
+    Context context(backend);
   } catch (const std::runtime_error& error) {
     return error.what();
   }
@@ -63,8 +64,101 @@ TEST(ContextTest, AVersionCappedBelowThreeThreeIsRefusedNamingTheOverride) {
 
 TEST(ContextTest, TheNamedSoftwareDriversWork) {
   const ScopedEnv driver("GALLIUM_DRIVER", "llvmpipe");
-  Context context;
+  Context context(GlBackend::kOSMesa);
   EXPECT_THAT(context.description(), HasSubstr("llvmpipe"));
+}
+
+TEST(ContextTest, EglDrawsWithLlvmpipeOnAMachineWithoutAGpu) {
+  Context context(GlBackend::kEgl);
+  EXPECT_EQ(context.backend(), GlBackend::kEgl);
+  EXPECT_THAT(context.description(), HasSubstr("llvmpipe"));
+  EXPECT_EQ(context.mesa_copy(), 0);
+  EXPECT_GE(context.max_samples(), 4);
+}
+
+TEST(ContextTest, PixelgymGlPicksTheBackendOfAutoAndAnUnknownOneIsRefused) {
+  {
+    const ScopedEnv gl("PIXELGYM_GL", "egl");
+    EXPECT_EQ(Context().backend(), GlBackend::kEgl);
+    // A backend asked for by name is not overridden.
+    EXPECT_EQ(Context(GlBackend::kOSMesa).backend(), GlBackend::kOSMesa);
+  }
+  {
+    const ScopedEnv gl("PIXELGYM_GL", "osmesa");
+    EXPECT_EQ(Context().backend(), GlBackend::kOSMesa);
+  }
+  const ScopedEnv gl("PIXELGYM_GL", "vulkan");
+  try {
+    Context context;
+    ADD_FAILURE() << "PIXELGYM_GL=vulkan made a context";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_STREQ(error.what(), "PIXELGYM_GL must be auto, egl or osmesa, got \"vulkan\"");
+  }
+  EXPECT_THROW(parse_gl_backend("EGL", "render_backend"), std::invalid_argument);
+  EXPECT_EQ(gl_backend_name(parse_gl_backend("egl", "render_backend")), "egl");
+}
+
+TEST(ContextTest, AnEglDeviceThatDoesNotExistIsRefusedNamingTheDevicesThereAre) {
+  {
+    const ScopedEnv device("PIXELGYM_EGL_DEVICE", "9");
+    try {
+      Context context(GlBackend::kEgl);
+      ADD_FAILURE() << "device 9 was opened";
+    } catch (const std::invalid_argument& error) {
+      EXPECT_THAT(error.what(), HasSubstr("PIXELGYM_EGL_DEVICE must be an EGL device index, "
+                                          "cuda:N, surfaceless or auto, got \"9\": this "
+                                          "machine's EGL offers"));
+    }
+  }
+  {
+    // No NVIDIA device here, so no CUDA number 0.
+    const ScopedEnv device("PIXELGYM_EGL_DEVICE", "cuda:0");
+    EXPECT_THROW(
+        {
+          try {
+            Context context(GlBackend::kEgl);
+          } catch (const std::invalid_argument& error) {
+            EXPECT_THAT(error.what(), HasSubstr("names no EGL device with that CUDA number"));
+            throw;
+          }
+        },
+        std::invalid_argument);
+  }
+  // A failure is not kept: the corrected variable opens the display.
+  const ScopedEnv device("PIXELGYM_EGL_DEVICE", "surfaceless");
+  EXPECT_THAT(Context(GlBackend::kEgl).description(), HasSubstr("llvmpipe"));
+}
+
+TEST(ContextTest, AutoSaysEachBackendsReasonWhenNoneWorks) {
+  const ScopedEnv driver("GALLIUM_DRIVER", "bogus");
+  const ScopedEnv gl("PIXELGYM_GL", "auto");
+  try {
+    Context context;
+    ADD_FAILURE() << "a context was made with GALLIUM_DRIVER=bogus";
+  } catch (const std::runtime_error& error) {
+    EXPECT_THAT(error.what(), HasSubstr("no OpenGL backend works here"));
+    EXPECT_THAT(error.what(), HasSubstr("\n  osmesa: Context: GALLIUM_DRIVER is \"bogus\""));
+    EXPECT_THAT(error.what(), HasSubstr("\n  egl: Context: EGL could not open"));
+  }
+}
+
+TEST(ContextTest, AnEglContextCurrentOnAnotherThreadIsAnErrorNamingThat) {
+  Context context(GlBackend::kEgl);  // current on this thread
+  std::string error;
+  std::thread([&] {
+    try {
+      context.make_current();
+    } catch (const std::runtime_error& e) {
+      error = e.what();
+    }
+  }).join();
+  EXPECT_THAT(error, HasSubstr("EGL_BAD_ACCESS: the context is current on another thread"));
+  context.release();
+  std::thread([&] {
+    context.make_current();
+    EXPECT_TRUE(context.is_current());
+    context.release();
+  }).join();
 }
 
 }  // namespace

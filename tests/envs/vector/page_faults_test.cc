@@ -31,8 +31,8 @@ long page_faults_on_this_thread() {
 // page while other tests load the machine, say) comes now and then, and the fewest leaves it out.
 long fewest_page_faults_stepping(const std::string& id, int copy, int warmup, int steps,
                                  int windows) {
-  std::unique_ptr<Env> env =
-      make(id, {}, MakeOptions{std::make_shared<PixelRenderResources>(copy, false)});
+  std::unique_ptr<Env> env = make(id, {{"render_backend", "osmesa"}},
+                                  MakeOptions{std::make_shared<PixelRenderResources>(copy, false)});
   Rng rng(3);
   std::vector<Value> actions;
   for (int k = 0; k < 64; ++k) actions.push_back(env->action_space().sample(rng));
