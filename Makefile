@@ -4,6 +4,8 @@
 #   make test   every test, through ctest (FormatCheck among them: see format-check)
 #   make test-egl    every test again with OpenGL through EGL (PIXELGYM_GL=egl), on the build of
 #                    make test (CI runs it after `make test`)
+#   make test-no-osmesa   builds without OSMesa (-DPIXELGYM_OSMESA=OFF, as for a Mesa >= 25.1) in
+#                    build-no-osmesa/ and runs the render and task tests there, on EGL (CI runs it)
 #   make test-asan   every test, built with AddressSanitizer and UBSan in build-asan/ (CI runs it
 #                    after `make test`)
 #   make test-tsan   the tests labelled threads, built with ThreadSanitizer in build-tsan/ (CI runs
@@ -28,7 +30,7 @@ BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 PIXELGYM := $(BUILD_DIR)/examples/pixelgym
 
-.PHONY: all deps configure build demo test test-egl test-asan test-tsan fuzz install wheel deb format-check format goldens bench bench-report clean
+.PHONY: all deps configure build demo test test-egl test-no-osmesa test-asan test-tsan fuzz install wheel deb format-check format goldens bench bench-report clean
 
 all: build
 
@@ -62,6 +64,16 @@ test: build
 # same bytes (tests/envs/render_backends_test.cc), so the goldens hold.
 test-egl: build
 	PIXELGYM_GL=egl ctest --test-dir $(BUILD_DIR) --output-on-failure --parallel $(JOBS)
+
+# A build without OSMesa (what a distribution whose Mesa no longer ships it builds): the render and
+# task tests (ctest label render_tasks: tests/render and tests/envs) must pass drawing through EGL;
+# the tests of OSMesa itself skip, saying so.
+NO_OSMESA_BUILD_DIR ?= build-no-osmesa
+test-no-osmesa: deps
+	cmake -S . -B $(NO_OSMESA_BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DPIXELGYM_OSMESA=OFF \
+	  -DPIXELGYM_BUILD_BENCH=OFF -DPIXELGYM_BUILD_PYTHON=OFF
+	cmake --build $(NO_OSMESA_BUILD_DIR) --parallel $(JOBS) --target render_task_tests
+	ctest --test-dir $(NO_OSMESA_BUILD_DIR) -L render_tasks --output-on-failure --parallel $(JOBS)
 
 # AddressSanitizer (with LeakSanitizer) and UndefinedBehaviorSanitizer over every test, the fuzz
 # corpora's replays (Fuzz.*) among them, in a Debug build at -O1 (asserts on; warnings are not

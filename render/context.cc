@@ -30,6 +30,15 @@ std::string gl_backend_name(GlBackend backend) {
   return "auto";
 }
 
+bool gl_backend_built(GlBackend backend) {
+#if PIXELGYM_HAS_OSMESA
+  (void)backend;
+  return true;
+#else
+  return backend != GlBackend::kOSMesa;
+#endif
+}
+
 GlBackend requested_gl_backend(GlBackend backend) {
   if (backend != GlBackend::kAuto) return backend;
   const char* variable = std::getenv("PIXELGYM_GL");

@@ -25,6 +25,9 @@ enum class GlBackend {
 GlBackend parse_gl_backend(const std::string& name, const std::string& who);
 /// The name parse_gl_backend reads.
 std::string gl_backend_name(GlBackend backend);
+/// Whether this build can draw with `backend`: all but kOSMesa in a build configured with
+/// -DPIXELGYM_OSMESA=OFF (then kAuto means EGL).
+bool gl_backend_built(GlBackend backend);
 /// `backend` with kAuto replaced by what PIXELGYM_GL names (kAuto when it is unset, empty or
 /// "auto"). Throws std::invalid_argument for a PIXELGYM_GL that parse_gl_backend refuses.
 GlBackend requested_gl_backend(GlBackend backend);

@@ -7,9 +7,12 @@
 
 #include "pixelgym/render/context_impl.h"
 #include "pixelgym/render/gl.h"
+#if PIXELGYM_HAS_OSMESA
 #include "pixelgym/render/gl_library.h"
+#endif
 
 namespace pixelgym::render {
+#if PIXELGYM_HAS_OSMESA
 namespace {
 
 // libOSMesa draws with a software Gallium driver, and with GALLIUM_DRIVER naming one it cannot
@@ -100,5 +103,12 @@ class OSMesaContextImpl final : public ContextImpl {
 std::unique_ptr<ContextImpl> make_osmesa_context(int mesa_copy) {
   return std::make_unique<OSMesaContextImpl>(mesa_copy);
 }
+#else
+std::unique_ptr<ContextImpl> make_osmesa_context(int /*mesa_copy*/) {
+  throw std::runtime_error(
+      "Context: this pixelgym was built without OSMesa (configured with -DPIXELGYM_OSMESA=OFF, "
+      "for a Mesa that no longer ships it): use render_backend=egl");
+}
+#endif
 
 }  // namespace pixelgym::render

@@ -13,7 +13,9 @@
 #include <string>
 
 #include "pixelgym/render/context_impl.h"
+#if PIXELGYM_HAS_OSMESA
 #include "pixelgym/render/gl_library.h"
+#endif
 
 namespace pixelgym::render {
 
@@ -23,7 +25,9 @@ namespace {
 constexpr int kMostCopies = 16;
 constexpr int kDefaultCopies = 8;
 
+#if PIXELGYM_HAS_OSMESA
 thread_local unsigned copies_ready_here = 1U;  // bit k: init_thread of copy k ran on this thread
+#endif
 
 }  // namespace
 
@@ -36,6 +40,7 @@ void default_llvmpipe_threads() {
   });
 }
 
+#if PIXELGYM_HAS_OSMESA
 namespace {
 
 // Copy 0: the linked library.
@@ -173,6 +178,11 @@ const GlLibrary& library(int copy) {
 }
 
 }  // namespace
+#else
+constexpr const char* kBuiltWithout =
+    "this pixelgym was built without OSMesa (configured with -DPIXELGYM_OSMESA=OFF): it draws "
+    "with EGL (render_backend=egl)";
+#endif
 
 int MesaCopy::max_copies() {
   const char* text = std::getenv("PIXELGYM_MESA_COPIES");
@@ -193,9 +203,15 @@ int MesaCopy::resolve(int copy) {
                                 std::to_string(copy));
   }
   default_llvmpipe_threads();
+#if PIXELGYM_HAS_OSMESA
   return library(copy % max_copies()).copy;
+#else
+  max_copies();  // refuses a PIXELGYM_MESA_COPIES it cannot read, as with OSMesa
+  return 0;
+#endif
 }
 
+#if PIXELGYM_HAS_OSMESA
 bool MesaCopy::loaded(int copy) {
   if (copy < 0 || copy >= kMostCopies) return false;
   Copies& all = copies();
@@ -241,5 +257,15 @@ const GlLibrary& library_for_new_context(int copy) {
   default_llvmpipe_threads();
   return library(copy % MesaCopy::max_copies());
 }
+
+#else
+bool MesaCopy::loaded(int /*copy*/) { return false; }
+
+std::string MesaCopy::why_not(int copy) {
+  return copy < 0 || copy >= kMostCopies ? "" : kBuiltWithout;
+}
+
+std::size_t MesaCopy::private_malloc_in_use() { return 0; }
+#endif
 
 }  // namespace pixelgym::render

@@ -57,7 +57,15 @@ std::vector<Frame> frames_with_copy(int copy, int count) {
   return frames;
 }
 
-TEST(MesaCopyTest, AContextIsOfTheCopyItIsGiven) {
+// Copies are OSMesa's: a build without it (-DPIXELGYM_OSMESA=OFF) has none to test.
+class MesaCopyTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!gl_backend_built(GlBackend::kOSMesa)) GTEST_SKIP() << "built without OSMesa";
+  }
+};
+
+TEST_F(MesaCopyTest, AContextIsOfTheCopyItIsGiven) {
   {
     const Context linked;
     EXPECT_EQ(linked.mesa_copy(), 0);
@@ -75,7 +83,7 @@ TEST(MesaCopyTest, AContextIsOfTheCopyItIsGiven) {
   EXPECT_THROW(Context(GlBackend::kOSMesa, -1), std::invalid_argument);
 }
 
-TEST(MesaCopyTest, EveryCopyDrawsTheSameBytes) {
+TEST_F(MesaCopyTest, EveryCopyDrawsTheSameBytes) {
   const std::vector<Frame> expected = frames_with_copy(0, 3);
   ASSERT_NE(expected[0].rgb, std::vector<std::uint8_t>(kSize * kSize * 3, 0));  // not blank
   for (const int copy : {1, 2, 3}) {
@@ -88,7 +96,7 @@ TEST(MesaCopyTest, EveryCopyDrawsTheSameBytes) {
 
 // Two threads that did not load the copies they draw with (the main thread did) draw at once,
 // each with its own copy, and give the bytes of one thread drawing with copy 0.
-TEST(MesaCopyTest, ThreadsDrawWithDifferentCopiesAtOnce) {
+TEST_F(MesaCopyTest, ThreadsDrawWithDifferentCopiesAtOnce) {
   constexpr int kFrames = 8;
   for (const int copy : {4, 5}) EXPECT_EQ(MesaCopy::resolve(copy), copy) << MesaCopy::why_not(copy);
   const std::vector<Frame> expected = frames_with_copy(0, kFrames);
@@ -110,7 +118,7 @@ TEST(MesaCopyTest, ThreadsDrawWithDifferentCopiesAtOnce) {
 
 // A renderer made on one thread in a copy and drawn and destroyed on others (as a vector env's
 // worker 0 envs move between the caller and worker thread 0).
-TEST(MesaCopyTest, ARendererOfACopyMovesBetweenThreads) {
+TEST_F(MesaCopyTest, ARendererOfACopyMovesBetweenThreads) {
   const std::vector<Frame> expected = frames_with_copy(0, 2);
   auto renderer = std::make_unique<Renderer>(GlBackend::kOSMesa, 6);
   Frame first;
@@ -120,7 +128,7 @@ TEST(MesaCopyTest, ARendererOfACopyMovesBetweenThreads) {
   std::thread([&] { renderer.reset(); }).join();
 }
 
-TEST(MesaCopyTest, CopyNumbersWrapAtTheLimitAndTheLimitIsChecked) {
+TEST_F(MesaCopyTest, CopyNumbersWrapAtTheLimitAndTheLimitIsChecked) {
   ASSERT_EQ(std::getenv("PIXELGYM_MESA_COPIES"), nullptr) << "the test sets it itself";
   EXPECT_EQ(MesaCopy::max_copies(), 8);
   EXPECT_EQ(MesaCopy::resolve(9), 1);

@@ -14,6 +14,7 @@
 #include "pixelgym/envs/registry.h"
 #include "pixelgym/envs/rng.h"
 #include "pixelgym/envs/tasks/pixel_env.h"
+#include "pixelgym/render/context.h"
 #include "pixelgym/render/mesa_copy.h"
 
 namespace pixelgym {
@@ -56,6 +57,7 @@ long fewest_page_faults_stepping(const std::string& id, int copy, int warmup, in
 }
 
 TEST(MesaCopyPageFaults, APrivateCopyStepsWithoutPageFaultsPerStep) {
+  if (!render::gl_backend_built(render::GlBackend::kOSMesa)) GTEST_SKIP() << "built without OSMesa";
   constexpr int kWarmup = 2000;
   constexpr int kSteps = 400;
   constexpr int kWindows = 3;
