@@ -134,6 +134,11 @@ TEST(ContextTest, AnEglDeviceThatDoesNotExistIsRefusedNamingTheDevicesThereAre) 
 }
 
 TEST(ContextTest, AutoSaysEachBackendsReasonWhenNoneWorks) {
+#if defined(__SANITIZE_ADDRESS__)
+  // Mesa's EGL leaks 6 KB when a display fails to open, in the DRI driver it then unloads: the
+  // stacks name no module, so lsan.supp cannot suppress them (docs/reliability.md).
+  GTEST_SKIP() << "Mesa's EGL leaks on this failure path, in a driver it unloads";
+#endif
   const ScopedEnv driver("GALLIUM_DRIVER", "bogus");
   const ScopedEnv gl("PIXELGYM_GL", "auto");
   try {
