@@ -113,7 +113,15 @@ TEST(PixelgymCliTest, InfoShowsSpacesAndConfigKeys) {
 // driver, so creating a context fails or crashes, as the snapshot shows) it still prints every
 // env's spaces, each observation key's range, the cameras and the time limit.
 TEST(PixelgymCliTest, InfoShowsRangesCamerasAndLimitsWithoutOpenGl) {
+#if defined(__SANITIZE_ADDRESS__)
+  // info's renderer line tries EGL too, and Mesa's EGL leaks 6 KB when its display fails to open,
+  // in a driver it unloads (no module to suppress: docs/reliability.md); the leak check is off for
+  // these runs only.
+  const std::string broken_gl =
+      "GALLIUM_DRIVER=no-such-driver ASAN_OPTIONS=\"$ASAN_OPTIONS detect_leaks=0\"";
+#else
   const std::string broken_gl = "GALLIUM_DRIVER=no-such-driver";
+#endif
   EXPECT_NE(
       run("snapshot CartPoleSwingup-v0 --out " + fresh_output("no_gl.png"), broken_gl).exit_code,
       0);
