@@ -64,6 +64,39 @@ void add_info(ValueDict& infos, const Info& info, int i, int n) {
 
 }  // namespace
 
+void check_reset_mask(const VectorEnv& envs, const Array& reset_mask) {
+  const int n = envs.num_envs();
+  if (reset_mask.dtype() != DType::kBool || reset_mask.shape() != Shape{n}) {
+    throw std::invalid_argument(envs.name() + ": reset() reset_mask must be bool (" +
+                                std::to_string(n) + ",), got " + reset_mask.to_string());
+  }
+  const bool* mask = reset_mask.data<bool>();
+  if (std::none_of(mask, mask + n, [](bool b) { return b; })) {
+    throw std::invalid_argument(envs.name() + ": reset() reset_mask must have a true entry, got " +
+                                reset_mask.to_string());
+  }
+}
+
+void check_actions(const VectorEnv& envs, const Value& actions, const char* method) {
+  const std::string reason = envs.action_space().layout_mismatch(actions);
+  if (!reason.empty()) {
+    throw std::invalid_argument(envs.name() + ": " + method + " actions must be laid out as " +
+                                envs.action_space().to_string() + ", got " + actions.to_string() +
+                                ": " + reason);
+  }
+}
+
+void check_none_ended(const VectorEnv& envs, const std::vector<std::uint8_t>& ended,
+                      const char* method) {
+  if (envs.autoreset_mode() != AutoresetMode::kDisabled) return;
+  for (std::size_t i = 0; i < ended.size(); ++i) {
+    if (ended[i] == 0) continue;
+    throw ResetNeeded(envs.name() + ": " + method + " env " + std::to_string(i) +
+                      "'s episode ended at the previous step and autoreset is Disabled; reset "
+                      "it first with reset(seed, options, reset_mask)");
+  }
+}
+
 BatchRunner::BatchRunner(std::string type_name, int num_envs, AutoresetMode autoreset)
     : type_name_(std::move(type_name)), num_envs_(num_envs) {
   if (num_envs < 1) {
@@ -101,7 +134,7 @@ std::vector<Array> BatchRunner::render() {
 const Space& BatchRunner::single_observation_space() const { return envs_[0]->observation_space(); }
 const Space& BatchRunner::single_action_space() const { return envs_[0]->action_space(); }
 
-void BatchRunner::build(const EnvFactory& make_env) {
+void BatchRunner::build(const EnvFactory& make_env, const BatchBuffers* buffers) {
   const auto n = static_cast<std::size_t>(num_envs_);
   envs_.resize(n);
   errors_.assign(n, nullptr);
@@ -130,6 +163,7 @@ void BatchRunner::build(const EnvFactory& make_env) {
     }
     observation_space_ = batch_space(first.observation_space(), num_envs_);
     action_space_ = batch_space(first.action_space(), num_envs_);
+    if (buffers != nullptr) check_buffers(*buffers);
   } catch (...) {
     destroy_envs();
     throw;
@@ -138,12 +172,19 @@ void BatchRunner::build(const EnvFactory& make_env) {
   static_cast<Metadata&>(metadata_) = envs_[0]->metadata();
   metadata_.autoreset_mode = mode;
 
-  const Value obs = observation_space_->zeros();
+  if (buffers != nullptr) {
+    step_result_.obs = buffers->obs;
+    step_result_.rewards = buffers->rewards;
+    step_result_.terminated = buffers->terminated;
+    step_result_.truncated = buffers->truncated;
+  } else {
+    step_result_.obs = observation_space_->zeros();
+    step_result_.rewards = Array(DType::kFloat64, {num_envs_});
+    step_result_.terminated = Array(DType::kBool, {num_envs_});
+    step_result_.truncated = Array(DType::kBool, {num_envs_});
+  }
+  const Value obs = step_result_.obs;
   reset_result_.obs = obs;
-  step_result_.obs = obs;
-  step_result_.rewards = Array(DType::kFloat64, {num_envs_});
-  step_result_.terminated = Array(DType::kBool, {num_envs_});
-  step_result_.truncated = Array(DType::kBool, {num_envs_});
   actions_ = action_space_->zeros();
   if (metadata_.autoreset_mode == AutoresetMode::kSameStep)
     final_obs_ = observation_space_->zeros();
@@ -162,6 +203,23 @@ void BatchRunner::build(const EnvFactory& make_env) {
   env_infos_.assign(n, nullptr);
   autoreset_.assign(n, 0);
   final_.assign(n, 0);
+}
+
+void BatchRunner::check_buffers(const BatchBuffers& buffers) const {
+  const std::string reason = observation_space_->layout_mismatch(buffers.obs);
+  const Shape rows{num_envs_};
+  const auto fits = [&rows](const Array& array, DType dtype) {
+    return array.dtype() == dtype && array.shape() == rows;
+  };
+  if (!reason.empty() || !fits(buffers.rewards, DType::kFloat64) ||
+      !fits(buffers.terminated, DType::kBool) || !fits(buffers.truncated, DType::kBool)) {
+    throw std::invalid_argument(
+        name() + ": the buffers given must be laid out as " + observation_space_->to_string() +
+        " and float64 / bool / bool (" + std::to_string(num_envs_) + ",), got " +
+        buffers.obs.to_string() + ", " + buffers.rewards.to_string() + ", " +
+        buffers.terminated.to_string() + ", " + buffers.truncated.to_string() +
+        (reason.empty() ? "" : ": " + reason));
+  }
 }
 
 void BatchRunner::destroy_envs() noexcept {
@@ -255,8 +313,12 @@ void BatchRunner::throw_first_error(bool poison) {
     for (auto& other : errors_) other = nullptr;
     if (poison) failed_ = true;
     std::string env_name = envs_[i] != nullptr ? envs_[i]->name() : "not built";
-    rethrow_with_context(error, name() + ": env " + std::to_string(i) + " (" + env_name + "): ");
+    rethrow_with_context(error, name() + ": " + env_context(static_cast<int>(i), env_name) + ": ");
   }
+}
+
+std::string BatchRunner::env_context(int i, const std::string& env_name) const {
+  return "env " + std::to_string(i) + " (" + env_name + ")";
 }
 
 void BatchRunner::require_usable(const char* method) const {
@@ -267,25 +329,15 @@ void BatchRunner::require_usable(const char* method) const {
   }
 }
 
-void BatchRunner::check_reset_mask(const Array& reset_mask) const {
-  if (reset_mask.dtype() != DType::kBool || reset_mask.shape() != Shape{num_envs_}) {
-    throw std::invalid_argument(name() + ": reset() reset_mask must be bool (" +
-                                std::to_string(num_envs_) + ",), got " + reset_mask.to_string());
-  }
-  const bool* mask = reset_mask.data<bool>();
-  if (std::none_of(mask, mask + num_envs_, [](bool b) { return b; })) {
-    throw std::invalid_argument(name() + ": reset() reset_mask must have a true entry, got " +
-                                reset_mask.to_string());
-  }
-  if (failed_) {
-    throw ResetNeeded(name() +
-                      ": reset() with a mask after a failed call; call reset() without a mask");
-  }
-}
-
 const VectorResetResult& BatchRunner::do_reset(std::optional<std::uint64_t> seed,
                                                const Options& options, const Array* reset_mask) {
-  if (reset_mask != nullptr) check_reset_mask(*reset_mask);
+  if (reset_mask != nullptr) {
+    check_reset_mask(*this, *reset_mask);
+    if (failed_) {
+      throw ResetNeeded(name() +
+                        ": reset() with a mask after a failed call; call reset() without a mask");
+    }
+  }
   require_usable("reset()");
   seed_ = seed;
   options_ = &options;
@@ -319,20 +371,8 @@ void BatchRunner::begin_step(const Value& actions, const char* method, bool wait
     throw ResetNeeded(name() + ": " + method + " after a failed call; call reset() first");
   }
   if (!has_reset_) throw ResetNeeded(name() + ": " + method + " called before reset()");
-  const std::string reason = action_space_->layout_mismatch(actions);
-  if (!reason.empty()) {
-    throw std::invalid_argument(name() + ": " + method + " actions must be laid out as " +
-                                action_space_->to_string() + ", got " + actions.to_string() + ": " +
-                                reason);
-  }
-  if (metadata_.autoreset_mode == AutoresetMode::kDisabled) {
-    for (std::size_t i = 0; i < autoreset_.size(); ++i) {
-      if (autoreset_[i] == 0) continue;
-      throw ResetNeeded(name() + ": " + method + " env " + std::to_string(i) +
-                        "'s episode ended at the previous step and autoreset is Disabled; reset "
-                        "it first with reset(seed, options, reset_mask)");
-    }
-  }
+  check_actions(*this, actions, method);
+  check_none_ended(*this, autoreset_, method);
   copy_value(actions, actions_);
   phase_ = Phase::kStep;
   step_pending_ = true;

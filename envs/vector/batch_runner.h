@@ -21,6 +21,29 @@ namespace pixelgym::vector {
 /// them: make_vec's factory hands env i the resources of the thread that runs it.
 using EnvFactory = std::function<std::unique_ptr<Env>(int index)>;
 
+/// Arrays a BatchRunner writes its results into instead of allocating its own: ProcessVectorEnv's
+/// workers write their rows of the batch, in memory shared with the parent process.
+struct BatchBuffers {
+  /// Laid out as the runner's observation_space().
+  Value obs;
+  /// float64 (num_envs,).
+  Array rewards;
+  /// bool (num_envs,) each.
+  Array terminated;
+  Array truncated;
+};
+
+/// Throws std::invalid_argument naming `envs` unless `reset_mask` is a bool (num_envs,) array
+/// with a true entry (VectorEnv::reset's mask).
+void check_reset_mask(const VectorEnv& envs, const Array& reset_mask);
+/// Throws std::invalid_argument naming `envs` and `method` unless `actions` are laid out as
+/// envs.action_space().
+void check_actions(const VectorEnv& envs, const Value& actions, const char* method);
+/// Under kDisabled, throws ResetNeeded naming the first env whose entry of `ended` is set (its
+/// episode ended at the last step and it was not reset since).
+void check_none_ended(const VectorEnv& envs, const std::vector<std::uint8_t>& ended,
+                      const char* method);
+
 /// The VectorEnv that owns and runs `num_envs()` envs; its subclasses say on which threads
 /// (SyncVectorEnv: a loop on the caller; AsyncVectorEnv: a pool of workers). It knows nothing
 /// of what the envs do inside (rendering included).
@@ -77,8 +100,10 @@ class BatchRunner : public VectorEnv {
   /// Builds the envs with `make_env` (through run_all: on the threads that will run them), checks
   /// that their spaces agree and allocates every buffer. Subclass constructors call it last.
   /// Throws what make_env throws (with the env index), destroying the envs already built, or
-  /// std::invalid_argument when an env's spaces differ from env 0's or cannot be batched.
-  void build(const EnvFactory& make_env);
+  /// std::invalid_argument when an env's spaces differ from env 0's or cannot be batched. With
+  /// `buffers`, observations, rewards and flags go into those arrays (std::invalid_argument
+  /// unless they are laid out as the batch); the others are allocated here.
+  void build(const EnvFactory& make_env, const BatchBuffers* buffers = nullptr);
   /// Destroys the envs through run_all. AsyncVectorEnv's destructor calls it while its workers
   /// still run; the base destructor destroys what is left on the calling thread.
   void destroy_envs() noexcept;
@@ -105,6 +130,8 @@ class BatchRunner : public VectorEnv {
   const VectorStepResult& end_step(const char* method);
   /// Whether begin_step has started a step that end_step has not yet finished.
   bool step_pending() const { return step_pending_; }
+  /// How an env's error names it after name(): "env 3 (TimeLimit<CartPoleSwingup>)".
+  virtual std::string env_context(int i, const std::string& env_name) const;
 
  private:
   enum class Phase : std::uint8_t { kBuild, kReset, kStep, kClose, kDestroy };
@@ -112,7 +139,7 @@ class BatchRunner : public VectorEnv {
   void run_phase(Phase phase);
   void step_env(int i);
   void require_usable(const char* method) const;
-  void check_reset_mask(const Array& reset_mask) const;
+  void check_buffers(const BatchBuffers& buffers) const;
   // Throws the lowest-index error recorded by run_env, if any, and forgets them all.
   void throw_first_error(bool poison);
   void batch_infos(Info& infos, bool any_final);

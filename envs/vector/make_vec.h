@@ -18,13 +18,21 @@ enum class VectorMode : std::uint8_t {
   kSync,
   /// AsyncVectorEnv: a pool of worker threads.
   kAsync,
+  /// ProcessVectorEnv: worker processes writing into shared memory.
+  kProcess,
 };
+
+/// "sync", "async" or "process".
+const char* vector_mode_name(VectorMode mode);
+/// The mode `name` spells (as vector_mode_name, case-insensitive). Throws std::invalid_argument
+/// listing the names.
+VectorMode parse_vector_mode(const std::string& name);
 
 /// make_vec's settings beside the env's own kwargs.
 struct VectorOptions {
   /// Which runner make_vec builds.
   VectorMode mode = VectorMode::kSync;
-  /// AsyncVectorEnv's worker threads: 0 for one per core; clamped to num_envs. Ignored by kSync.
+  /// AsyncVectorEnv's worker threads: 0 for one per core; clamped to num_envs. Only kAsync.
   int num_threads = 0;
   /// What the vector env does with an env whose episode ended (see AutoresetMode).
   AutoresetMode autoreset = AutoresetMode::kNextStep;
@@ -32,13 +40,17 @@ struct VectorOptions {
   /// one context per thread, whose compiled shaders, meshes and framebuffers its envs share);
   /// false gives every env a context of its own. Frames are byte-identical either way.
   bool share_gl_contexts = true;
+  /// ProcessVectorEnv's worker processes: 0 for one per core; clamped to num_envs. Only kProcess.
+  int num_workers = 0;
 };
 
 /// `num_envs` copies of `registry.make(id, kwargs, options)`, each passed through `wrap` (when set;
 /// see EnvWrapping, and wrappers::wrapping for the `--wrap` text form), run as `options` say.
 ///
-/// Rendering resources: make_vec owns what the envs share. For each thread that runs envs
-/// (SyncVectorEnv: one; AsyncVectorEnv: worker w runs env i when w = i % threads) it makes the
+/// Rendering resources: make_vec owns what the envs share. Under kProcess, each worker process
+/// makes the spec's render resources once (make_render_resources(0, share_gl_contexts)) for its
+/// envs, and `like` (env(i)) is a DescribedEnv with the wrapping applied. For each thread that runs
+/// envs (SyncVectorEnv: one; AsyncVectorEnv: worker w runs env i when w = i % threads) it makes the
 /// spec's render resources once (EnvSpec::make_render_resources(w, share_gl_contexts)) and hands
 /// them to each env of that thread through MakeOptions. So for the pixel tasks the envs of worker
 /// w draw with copy w of Mesa (render::MesaCopy: threads with different copies rasterize in

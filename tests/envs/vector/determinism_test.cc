@@ -7,11 +7,13 @@
 // step_wait() (they run on worker thread 0), and the vector envs run with GL contexts shared per
 // thread (their default) and, sync and on 2 threads, with a context per env. Workers 1-3 draw with
 // private copies of Mesa (render::MesaCopy), so their frames are compared with copy 0's too.
+// ProcessVectorEnv runs with 1, 2 and 3 worker processes under each autoreset mode.
 #include <gtest/gtest.h>
 
 #include <optional>
 #include <ostream>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -94,6 +96,18 @@ void expect_same(const Trajectory& expected, const VectorEnv& env, const Value& 
   }
 }
 
+std::string describe(VectorMode mode, int count) {
+  switch (mode) {
+    case VectorMode::kSync:
+      return "sync";
+    case VectorMode::kAsync:
+      return std::to_string(count) + " threads";
+    case VectorMode::kProcess:
+      return std::to_string(count) + " worker processes";
+  }
+  return "";
+}
+
 class VectorDeterminismTest : public ::testing::TestWithParam<Case> {};
 
 TEST_P(VectorDeterminismTest, SyncAndPoolsEqualSingleEnvsByteForByte) {
@@ -111,16 +125,18 @@ TEST_P(VectorDeterminismTest, SyncAndPoolsEqualSingleEnvsByteForByte) {
       for (const EnvStep& step : row) ended = ended || step.terminated || step.truncated;
     }
     EXPECT_TRUE(ended) << "no episode ended: the autoreset is not exercised";
-    // {threads (0: sync), shared GL contexts}
-    const std::pair<int, bool> runners[] = {{0, true}, {1, true},  {2, true},
-                                            {4, true}, {0, false}, {2, false}};
-    for (const auto& [threads, shared] : runners) {
-      const std::string runner =
-          std::to_string(num_envs) + " envs, " +
-          (threads == 0 ? std::string("sync") : std::to_string(threads) + " threads") +
-          (shared ? "" : ", a GL context per env");
-      const VectorOptions options{threads == 0 ? VectorMode::kSync : VectorMode::kAsync, threads,
-                                  AutoresetMode::kNextStep, shared};
+    // {mode, threads or workers, shared GL contexts}
+    const std::tuple<VectorMode, int, bool> runners[] = {
+        {VectorMode::kSync, 0, true},    {VectorMode::kAsync, 1, true},
+        {VectorMode::kAsync, 2, true},   {VectorMode::kAsync, 4, true},
+        {VectorMode::kSync, 0, false},   {VectorMode::kAsync, 2, false},
+        {VectorMode::kProcess, 1, true}, {VectorMode::kProcess, 2, true},
+        {VectorMode::kProcess, 3, true}};
+    for (const auto& [mode, threads, shared] : runners) {
+      const std::string runner = std::to_string(num_envs) + " envs, " + describe(mode, threads) +
+                                 (shared ? "" : ", a GL context per env");
+      VectorOptions options{mode, threads, AutoresetMode::kNextStep, shared};
+      options.num_workers = threads;
       const auto env =
           make_vec(c.id, num_envs, c.kwargs, pixelgym::wrappers::wrapping(c.wrappers), options);
       auto* pool = dynamic_cast<AsyncVectorEnv*>(env.get());
@@ -186,13 +202,16 @@ TEST_P(VectorDeterminismTest, SameStepAndDisabledEqualSingleEnvsByteForByte) {
     actions = batched_actions(probe->action_space());
   }
   const auto expected = one_by_one_same_step(c, num_envs, actions);
-  for (const AutoresetMode mode : {AutoresetMode::kSameStep, AutoresetMode::kDisabled}) {
-    for (const int threads : {0, 1, 2, 4}) {
+  const std::pair<VectorMode, int> runners[] = {
+      {VectorMode::kSync, 0},  {VectorMode::kAsync, 1},   {VectorMode::kAsync, 2},
+      {VectorMode::kAsync, 4}, {VectorMode::kProcess, 2}, {VectorMode::kProcess, 3}};
+  for (const AutoresetMode autoreset : {AutoresetMode::kSameStep, AutoresetMode::kDisabled}) {
+    for (const auto& [mode, threads] : runners) {
       const std::string runner =
-          std::string(mode == AutoresetMode::kSameStep ? "SameStep, " : "Disabled, ") +
-          (threads == 0 ? std::string("sync") : std::to_string(threads) + " threads");
-      const VectorOptions options{threads == 0 ? VectorMode::kSync : VectorMode::kAsync, threads,
-                                  mode};
+          std::string(autoreset == AutoresetMode::kSameStep ? "SameStep, " : "Disabled, ") +
+          describe(mode, threads);
+      VectorOptions options{mode, threads, autoreset};
+      options.num_workers = threads;
       const auto env =
           make_vec(c.id, num_envs, c.kwargs, pixelgym::wrappers::wrapping(c.wrappers), options);
       const Value& first = env->reset(kSeed).obs;
@@ -214,7 +233,7 @@ TEST_P(VectorDeterminismTest, SameStepAndDisabledEqualSingleEnvsByteForByte) {
           EXPECT_EQ(step.terminated.data<bool>()[i], want.step.terminated) << where;
           EXPECT_EQ(step.truncated.data<bool>()[i], want.step.truncated) << where;
           const bool done = want.final.has_value();
-          if (mode == AutoresetMode::kDisabled) {
+          if (autoreset == AutoresetMode::kDisabled) {
             // The step returns the last observation; the caller resets by mask below.
             EXPECT_TRUE(batch_slot(step.obs, i).equals(done ? *want.final : want.step.obs))
                 << where;

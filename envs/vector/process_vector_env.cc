@@ -1,0 +1,852 @@
+#include "pixelgym/envs/vector/process_vector_env.h"
+
+#include <poll.h>
+#include <sys/mman.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <cstring>
+#include <stdexcept>
+#include <thread>
+#include <utility>
+
+#include "pixelgym/envs/errors.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/envs/vector/batch_space.h"
+
+namespace pixelgym::vector {
+namespace {
+
+// What the parent asks a worker; the worker answers every command with one reply.
+enum class Op : std::uint8_t { kReset = 1, kStep, kRender, kClose };
+// A reply's first byte.
+enum class Status : std::uint8_t { kOk = 0, kError = 1 };
+// The standard type an error is rethrown as.
+enum class ErrorKind : std::uint8_t { kRuntime, kInvalidArgument, kOutOfRange, kResetNeeded };
+
+// How long the parent waits in poll() before it asks the kernel whether a worker has ended
+// (a dead worker's socket normally says so at once; this catches one whose socket another
+// process still holds).
+constexpr int kPollMs = 100;
+// How long ending the workers waits for each to exit before killing it.
+constexpr std::chrono::seconds kExitWait{5};
+
+std::string process_name(const std::string& id, int num_envs) {
+  return "ProcessVectorEnv(" + (id.empty() ? std::string() : id + ", ") +
+         "num_envs=" + std::to_string(num_envs) + ")";
+}
+
+// ---- The messages: length-prefixed frames of plain bytes. ----------------------------------
+
+class Writer {
+ public:
+  explicit Writer(Status status) { u8(static_cast<std::uint8_t>(status)); }
+  explicit Writer(Op op) { u8(static_cast<std::uint8_t>(op)); }
+
+  void u8(std::uint8_t v) { out_.push_back(static_cast<char>(v)); }
+  void u64(std::uint64_t v) { bytes(&v, sizeof v); }
+  void bytes(const void* data, std::size_t n) { out_.append(static_cast<const char*>(data), n); }
+  void str(const std::string& s) {
+    u64(s.size());
+    out_.append(s);
+  }
+  void array(const Array& a) {
+    u8(static_cast<std::uint8_t>(a.dtype()));
+    u64(a.shape().size());
+    for (std::int64_t d : a.shape()) u64(static_cast<std::uint64_t>(d));
+    bytes(a.raw_data(), a.nbytes());
+  }
+  void value(const Value& v) {
+    if (v.is_array()) {
+      u8(0);
+      array(v.array());
+    } else if (v.is_dict()) {
+      u8(1);
+      u64(v.dict().size());
+      for (std::size_t k = 0; k < v.dict().size(); ++k) {
+        str(v.dict().keys()[k]);
+        value(v.dict().values()[k]);
+      }
+    } else {
+      u8(2);
+      u64(v.tuple().size());
+      for (const Value& item : v.tuple().items()) value(item);
+    }
+  }
+  void params(const Params& params) {
+    u64(params.size());
+    for (const auto& [key, param] : params) {
+      str(key);
+      u8(static_cast<std::uint8_t>(param.type()));
+      switch (param.type()) {
+        case ParamType::kBool:
+          u8(param.as_bool() ? 1 : 0);
+          break;
+        case ParamType::kInt:
+          u64(static_cast<std::uint64_t>(param.as_int()));
+          break;
+        case ParamType::kFloat: {
+          const double d = param.as_float();
+          bytes(&d, sizeof d);
+          break;
+        }
+        case ParamType::kString:
+          str(param.as_string());
+          break;
+      }
+    }
+  }
+  const std::string& frame() const { return out_; }
+
+ private:
+  std::string out_;
+};
+
+class Reader {
+ public:
+  explicit Reader(const std::string& in) : in_(in) {}
+
+  std::uint8_t u8() { return static_cast<std::uint8_t>(*take(1)); }
+  std::uint64_t u64() {
+    std::uint64_t v = 0;
+    std::memcpy(&v, take(sizeof v), sizeof v);
+    return v;
+  }
+  std::string str() {
+    const std::uint64_t n = u64();
+    return std::string(take(n), n);
+  }
+  Array array() {
+    const auto dtype = static_cast<DType>(u8());
+    Shape shape(u64());
+    for (std::int64_t& d : shape) d = static_cast<std::int64_t>(u64());
+    Array a(dtype, shape);
+    std::memcpy(a.raw_data(), take(a.nbytes()), a.nbytes());
+    return a;
+  }
+  Value value() {
+    switch (u8()) {
+      case 0:
+        return array();
+      case 1: {
+        ValueDict dict;
+        for (std::uint64_t n = u64(); n > 0; --n) {
+          std::string key = str();
+          dict.insert(key, value());
+        }
+        return dict;
+      }
+      default: {
+        std::vector<Value> items(u64());
+        for (Value& item : items) item = value();
+        return ValueTuple(std::move(items));
+      }
+    }
+  }
+  Params params() {
+    Params params;
+    for (std::uint64_t n = u64(); n > 0; --n) {
+      std::string key = str();
+      switch (static_cast<ParamType>(u8())) {
+        case ParamType::kBool:
+          params.emplace(key, Param(u8() != 0));
+          break;
+        case ParamType::kInt:
+          params.emplace(key, Param(static_cast<long long>(u64())));
+          break;
+        case ParamType::kFloat: {
+          double d = 0;
+          std::memcpy(&d, take(sizeof d), sizeof d);
+          params.emplace(key, Param(d));
+          break;
+        }
+        case ParamType::kString:
+          params.emplace(key, Param(str()));
+          break;
+      }
+    }
+    return params;
+  }
+
+ private:
+  const char* take(std::uint64_t n) {
+    if (n > in_.size() - pos_)
+      throw std::runtime_error("ProcessVectorEnv: a message was cut short");
+    const char* at = in_.data() + pos_;
+    pos_ += n;
+    return at;
+  }
+  const std::string& in_;
+  std::size_t pos_ = 0;
+};
+
+// Sends one frame; false when the other end is gone.
+bool send_frame(int fd, const std::string& payload) {
+  const std::uint64_t n = payload.size();
+  std::string frame(reinterpret_cast<const char*>(&n), sizeof n);
+  frame += payload;
+  std::size_t sent = 0;
+  while (sent < frame.size()) {
+    const ssize_t k = ::send(fd, frame.data() + sent, frame.size() - sent, MSG_NOSIGNAL);
+    if (k < 0 && errno == EINTR) continue;
+    if (k <= 0) return false;
+    sent += static_cast<std::size_t>(k);
+  }
+  return true;
+}
+
+bool receive_exactly(int fd, char* data, std::size_t n) {
+  std::size_t got = 0;
+  while (got < n) {
+    const ssize_t k = ::recv(fd, data + got, n - got, 0);
+    if (k < 0 && errno == EINTR) continue;
+    if (k <= 0) return false;
+    got += static_cast<std::size_t>(k);
+  }
+  return true;
+}
+
+// Receives one frame (blocking); false when the other end is gone.
+bool receive_frame(int fd, std::string& payload) {
+  std::uint64_t n = 0;
+  if (!receive_exactly(fd, reinterpret_cast<char*>(&n), sizeof n)) return false;
+  payload.resize(n);
+  return receive_exactly(fd, payload.data(), n);
+}
+
+Writer error_reply() {
+  Writer reply(Status::kError);
+  ErrorKind kind = ErrorKind::kRuntime;
+  std::string message;
+  try {
+    throw;
+  } catch (const ResetNeeded& e) {
+    kind = ErrorKind::kResetNeeded;
+    message = e.what();
+  } catch (const std::invalid_argument& e) {
+    kind = ErrorKind::kInvalidArgument;
+    message = e.what();
+  } catch (const std::out_of_range& e) {
+    kind = ErrorKind::kOutOfRange;
+    message = e.what();
+  } catch (const std::exception& e) {
+    message = e.what();
+  } catch (...) {
+    message = "an exception of unknown type";
+  }
+  reply.u8(static_cast<std::uint8_t>(kind));
+  reply.str(message);
+  return reply;
+}
+
+// ---- Values in shared memory. -------------------------------------------------------------
+
+constexpr std::size_t kAlign = 64;
+
+std::size_t aligned(std::size_t n) { return (n + kAlign - 1) / kAlign * kAlign; }
+
+std::size_t layout_bytes(const Value& value) {
+  std::size_t bytes = 0;
+  for (const Array& leaf : value.leaves()) bytes += aligned(leaf.nbytes());
+  return bytes;
+}
+
+// A Value of `like`'s structure, dtypes and shapes whose arrays are carved from `cursor`.
+Value place(const Value& like, std::byte*& cursor, const std::shared_ptr<void>& owner) {
+  if (like.is_array()) {
+    const Array& a = like.array();
+    Array placed = Array::from_external(cursor, a.dtype(), a.shape(), owner);
+    cursor += aligned(a.nbytes());
+    return placed;
+  }
+  if (like.is_dict()) {
+    ValueDict dict;
+    for (std::size_t k = 0; k < like.dict().size(); ++k) {
+      dict.insert(like.dict().keys()[k], place(like.dict().values()[k], cursor, owner));
+    }
+    return dict;
+  }
+  std::vector<Value> items;
+  for (const Value& item : like.tuple().items()) items.push_back(place(item, cursor, owner));
+  return ValueTuple(std::move(items));
+}
+
+// Rows [begin, end) of every array of a batch, as views.
+Value rows(const Value& batch, std::int64_t begin, std::int64_t end) {
+  if (batch.is_array()) return batch.array().slice(begin, end);
+  if (batch.is_dict()) {
+    ValueDict dict;
+    for (std::size_t k = 0; k < batch.dict().size(); ++k) {
+      dict.insert(batch.dict().keys()[k], rows(batch.dict().values()[k], begin, end));
+    }
+    return dict;
+  }
+  std::vector<Value> items;
+  for (const Value& item : batch.tuple().items()) items.push_back(rows(item, begin, end));
+  return ValueTuple(std::move(items));
+}
+
+// A zero batch of `n` rows with the structure of `part` (whose arrays' leading axis is rows).
+Value grown(const Value& part, std::int64_t n) {
+  if (part.is_array()) {
+    Shape shape = part.array().shape();
+    shape.at(0) = n;
+    return Array(part.array().dtype(), shape);
+  }
+  if (part.is_dict()) {
+    ValueDict dict;
+    for (std::size_t k = 0; k < part.dict().size(); ++k) {
+      dict.insert(part.dict().keys()[k], grown(part.dict().values()[k], n));
+    }
+    return dict;
+  }
+  std::vector<Value> items;
+  for (const Value& item : part.tuple().items()) items.push_back(grown(item, n));
+  return ValueTuple(std::move(items));
+}
+
+// Adds a worker's batched infos (leading axis: its `count` envs) to `infos` (leading axis: all
+// `n` envs) at rows [first, first + count): Dicts are merged key by key, as Gymnasium batches
+// infos; anything else is copied into its rows.
+void merge_rows(ValueDict& infos, const ValueDict& part, std::int64_t first, std::int64_t count,
+                std::int64_t n) {
+  for (std::size_t k = 0; k < part.size(); ++k) {
+    const std::string& key = part.keys()[k];
+    const Value& value = part.values()[k];
+    if (value.is_dict()) {
+      if (!infos.contains(key)) infos.insert(key, ValueDict{});
+      merge_rows(infos.at(key).dict(), value.dict(), first, count, n);
+      continue;
+    }
+    if (!infos.contains(key)) infos.insert(key, grown(value, n));
+    try {
+      copy_value(value, rows(infos.at(key), first, first + count));
+    } catch (const std::exception& e) {
+      throw std::invalid_argument("info \"" + key + "\" of envs " + std::to_string(first) + "-" +
+                                  std::to_string(first + count - 1) +
+                                  " does not batch with another worker's: " + e.what());
+    }
+  }
+}
+
+std::string describe_exit(int status) {
+  if (WIFSIGNALED(status)) {
+    const int sig = WTERMSIG(status);
+    const char* what = ::strsignal(sig);
+    return "killed by signal " + std::to_string(sig) +
+           (what != nullptr ? " (" + std::string(what) + ")" : "");
+  }
+  if (WIFEXITED(status)) return "exited with status " + std::to_string(WEXITSTATUS(status));
+  return "ended";
+}
+
+// The BatchRunner a worker runs its envs with: a loop, whose results go to the worker's rows of
+// the shared batch and whose errors name the envs by their index in the whole vector env.
+class WorkerRunner final : public BatchRunner {
+ public:
+  WorkerRunner(int first, int count, int total, int worker, const EnvFactory& make_env,
+               AutoresetMode autoreset, const BatchBuffers& buffers)
+      : BatchRunner("ProcessVectorEnv", count, autoreset),
+        first_(first),
+        worker_(worker),
+        name_(process_name("", total)),
+        total_(total) {
+    build([&](int j) { return make_env(first_ + j); }, &buffers);
+    if (env(0).spec() != nullptr) name_ = process_name(env(0).spec()->id, total_);
+  }
+  ~WorkerRunner() override { destroy_envs(); }
+
+  std::string name() const override { return name_; }
+  std::string id() const { return env(0).spec() != nullptr ? env(0).spec()->id : ""; }
+
+ protected:
+  void start_all() override {
+    for (int j = 0; j < num_envs(); ++j) run_env(j);
+  }
+  void wait_all() override {}
+  std::string env_context(int j, const std::string& env_name) const override {
+    return "env " + std::to_string(first_ + j) + " (" + env_name + ") on worker " +
+           std::to_string(worker_) + " (pid " + std::to_string(::getpid()) + ")";
+  }
+
+ private:
+  int first_;
+  int worker_;
+  std::string name_;
+  int total_;
+};
+
+}  // namespace
+
+// The shared mapping: the batch arrays the parent and the workers both see.
+struct ProcessVectorEnv::Shared {
+  explicit Shared(std::size_t size) : bytes(std::max<std::size_t>(size, kAlign)) {
+    void* at = ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
+    if (at == MAP_FAILED) {
+      throw std::runtime_error("ProcessVectorEnv: cannot map " + std::to_string(bytes) +
+                               " bytes of shared memory: " + std::strerror(errno));
+    }
+    base = static_cast<std::byte*>(at);
+  }
+  ~Shared() { ::munmap(base, bytes); }
+  Shared(const Shared&) = delete;
+  Shared& operator=(const Shared&) = delete;
+
+  std::size_t bytes;
+  std::byte* base = nullptr;
+};
+
+struct ProcessVectorEnv::Worker {
+  int first = 0;  // its envs: [first, first + count)
+  int count = 0;
+  pid_t pid = -1;
+  int fd = -1;  // the parent's end of its socket
+  bool reaped = false;
+  int status = 0;  // as waitpid says, once reaped
+
+  std::string describe() const {
+    return "pid " + std::to_string(pid) + ", envs " + std::to_string(first) +
+           (count > 1 ? "-" + std::to_string(first + count - 1) : "");
+  }
+};
+
+int ProcessVectorEnv::workers_for(int num_envs, int num_workers) {
+  if (num_workers < 0) {
+    throw std::invalid_argument(
+        "ProcessVectorEnv: num_workers must be >= 0 (0: one per core), got " +
+        std::to_string(num_workers));
+  }
+  if (num_workers == 0) {
+    num_workers = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  }
+  return std::max(1, std::min(num_workers, num_envs));
+}
+
+ProcessVectorEnv::ProcessVectorEnv(int num_envs, const WorkerFactory& make_worker_envs,
+                                   std::shared_ptr<const Env> like, int num_workers,
+                                   AutoresetMode autoreset)
+    : num_envs_(num_envs), like_(std::move(like)) {
+  if (num_envs < 1) {
+    throw std::invalid_argument("ProcessVectorEnv: num_envs must be >= 1, got num_envs = " +
+                                std::to_string(num_envs));
+  }
+  if (like_ == nullptr) throw std::invalid_argument("ProcessVectorEnv: no `like` env given");
+  const int workers = workers_for(num_envs, num_workers);
+  observation_space_ = batch_space(like_->observation_space(), num_envs);
+  action_space_ = batch_space(like_->action_space(), num_envs);
+  static_cast<Metadata&>(metadata_) = like_->metadata();
+  metadata_.autoreset_mode = autoreset;
+
+  // The batch, in memory the workers will share.
+  const Value obs = observation_space_->zeros();
+  const Value actions = action_space_->zeros();
+  const Array flags(DType::kBool, {num_envs});
+  const Array rewards(DType::kFloat64, {num_envs});
+  shared_ = std::make_shared<Shared>(layout_bytes(obs) + layout_bytes(actions) +
+                                     2 * aligned(flags.nbytes()) + aligned(rewards.nbytes()));
+  const std::shared_ptr<void> owner(shared_, shared_->base);
+  std::byte* cursor = shared_->base;
+  step_result_.obs = place(obs, cursor, owner);
+  reset_result_.obs = step_result_.obs;
+  actions_ = place(actions, cursor, owner);
+  step_result_.rewards = place(rewards, cursor, owner).array();
+  step_result_.terminated = place(flags, cursor, owner).array();
+  step_result_.truncated = place(flags, cursor, owner).array();
+  ended_.assign(static_cast<std::size_t>(num_envs), 0);
+
+  workers_.resize(static_cast<std::size_t>(workers));
+  for (int w = 0; w < workers; ++w) {
+    Worker& worker = workers_[static_cast<std::size_t>(w)];
+    worker.count = num_envs / workers + (w < num_envs % workers ? 1 : 0);
+    worker.first = w == 0 ? 0
+                          : workers_[static_cast<std::size_t>(w - 1)].first +
+                                workers_[static_cast<std::size_t>(w - 1)].count;
+  }
+  try {
+    for (int w = 0; w < workers; ++w) start_worker(w, make_worker_envs);
+    // Each worker says, unasked, whether it built its envs.
+    std::vector<std::string> replies =
+        await(std::vector<std::uint8_t>(workers_.size(), 1), {}, "the constructor");
+    throw_first_error(replies, false);
+    id_ = Reader(replies[0]).str();
+  } catch (...) {
+    end_workers();
+    throw;
+  }
+}
+
+ProcessVectorEnv::~ProcessVectorEnv() { end_workers(); }
+
+void ProcessVectorEnv::start_worker(int w, const WorkerFactory& make_worker_envs) {
+  Worker& worker = workers_[static_cast<std::size_t>(w)];
+  int ends[2];
+  if (::socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, ends) != 0) {
+    throw std::runtime_error(name() + ": cannot start worker " + std::to_string(w) +
+                             ": socketpair: " + std::strerror(errno));
+  }
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    const int error = errno;
+    ::close(ends[0]);
+    ::close(ends[1]);
+    throw std::runtime_error(name() + ": cannot start worker " + std::to_string(w) +
+                             ": fork: " + std::strerror(error));
+  }
+  if (pid > 0) {
+    ::close(ends[1]);
+    worker.pid = pid;
+    worker.fd = ends[0];
+    return;
+  }
+
+  // The worker. It keeps only its own end of its socket: a worker that holds another's would
+  // keep the parent from seeing that one die.
+  ::close(ends[0]);
+  for (int v = 0; v < w; ++v) ::close(workers_[static_cast<std::size_t>(v)].fd);
+  const int fd = ends[1];
+  {
+    std::unique_ptr<WorkerRunner> runner;
+    try {
+      const EnvFactory make_env = make_worker_envs(w);
+      const Env& like = *like_;
+      const EnvFactory checked = [&](int i) {
+        std::unique_ptr<Env> env = make_env(i);
+        if (env != nullptr && (!env->observation_space().equals(like.observation_space()) ||
+                               !env->action_space().equals(like.action_space()))) {
+          throw std::invalid_argument("its spaces " + env->observation_space().to_string() + " / " +
+                                      env->action_space().to_string() +
+                                      " differ from those the vector env was laid out "
+                                      "for: " +
+                                      like.observation_space().to_string() + " / " +
+                                      like.action_space().to_string());
+        }
+        return env;
+      };
+      BatchBuffers buffers{rows(step_result_.obs, worker.first, worker.first + worker.count),
+                           step_result_.rewards.slice(worker.first, worker.first + worker.count),
+                           step_result_.terminated.slice(worker.first, worker.first + worker.count),
+                           step_result_.truncated.slice(worker.first, worker.first + worker.count)};
+      runner = std::make_unique<WorkerRunner>(worker.first, worker.count, num_envs_, w, checked,
+                                              metadata_.autoreset_mode, buffers);
+      Writer made(Status::kOk);
+      made.str(runner->id());
+      if (!send_frame(fd, made.frame())) ::_exit(0);
+    } catch (...) {
+      send_frame(fd, error_reply().frame());
+      ::_exit(1);
+    }
+    const Value my_actions = rows(actions_, worker.first, worker.first + worker.count);
+    std::string command;
+    while (receive_frame(fd, command)) {
+      Writer reply(Status::kOk);
+      Op op = Op::kClose;
+      try {
+        Reader in(command);
+        op = static_cast<Op>(in.u8());
+        switch (op) {
+          case Op::kReset: {
+            std::optional<std::uint64_t> seed;
+            if (in.u8() != 0) seed = in.u64();
+            const Params options = in.params();
+            if (in.u8() != 0) {
+              Array mask(DType::kBool, {worker.count});
+              for (int j = 0; j < worker.count; ++j) mask.data<bool>()[j] = in.u8() != 0;
+              reply.value(runner->reset(seed, options, mask).infos);
+            } else {
+              reply.value(runner->reset(seed, options).infos);
+            }
+            break;
+          }
+          case Op::kStep:
+            reply.value(runner->step(my_actions).infos);
+            break;
+          case Op::kRender: {
+            const std::vector<Array> frames = runner->render();
+            reply.u64(frames.size());
+            for (const Array& frame : frames) reply.array(frame);
+            break;
+          }
+          case Op::kClose:
+            runner->close();
+            break;
+        }
+      } catch (...) {
+        reply = error_reply();
+      }
+      if (!send_frame(fd, reply.frame()) || op == Op::kClose) break;
+    }
+  }
+  // Not exit(): the parent's atexit handlers and static destructors are the parent's.
+  ::_exit(0);
+}
+
+std::vector<std::string> ProcessVectorEnv::call(const std::vector<std::string>& commands,
+                                                const char* method) {
+  const std::size_t n = workers_.size();
+  std::vector<std::uint8_t> pending(n, 0);
+  std::vector<std::uint8_t> died(n, 0);
+  for (std::size_t w = 0; w < n; ++w) {
+    if (commands[w].empty()) continue;
+    if (send_frame(workers_[w].fd, commands[w])) {
+      pending[w] = 1;
+    } else {
+      died[w] = 1;
+    }
+  }
+  return await(std::move(pending), std::move(died), method);
+}
+
+std::vector<std::string> ProcessVectorEnv::await(std::vector<std::uint8_t> pending,
+                                                 std::vector<std::uint8_t> died,
+                                                 const char* method) {
+  const std::size_t n = workers_.size();
+  std::vector<std::string> replies(n);
+  died.resize(n, 0);
+  std::vector<pollfd> fds;
+  std::vector<std::size_t> which;
+  for (;;) {
+    fds.clear();
+    which.clear();
+    for (std::size_t w = 0; w < n; ++w) {
+      if (pending[w] == 0) continue;
+      fds.push_back(pollfd{workers_[w].fd, POLLIN, 0});
+      which.push_back(w);
+    }
+    if (fds.empty()) break;
+    const int ready = ::poll(fds.data(), fds.size(), kPollMs);
+    if (ready < 0 && errno != EINTR) {
+      throw std::runtime_error(name() + ": " + method + ": poll: " + std::strerror(errno));
+    }
+    for (std::size_t k = 0; k < fds.size(); ++k) {
+      const std::size_t w = which[k];
+      if (fds[k].revents != 0) {
+        pending[w] = 0;
+        if (!receive_frame(workers_[w].fd, replies[w])) died[w] = 1;
+      } else if (ready == 0 && !workers_[w].reaped) {
+        // No word for a while: has it ended without its socket saying so?
+        int status = 0;
+        if (::waitpid(workers_[w].pid, &status, WNOHANG) == workers_[w].pid) {
+          workers_[w].reaped = true;
+          workers_[w].status = status;
+          pending[w] = 0;
+          died[w] = 1;
+        }
+      }
+    }
+  }
+  for (std::size_t w = 0; w < n; ++w) {
+    if (died[w] == 0) continue;
+    Worker& worker = workers_[w];
+    // Its socket closed as it ended: it is exiting or gone. Wait briefly to say how it ended.
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+    while (!worker.reaped && std::chrono::steady_clock::now() < deadline) {
+      int status = 0;
+      const pid_t got = ::waitpid(worker.pid, &status, WNOHANG);
+      if (got == worker.pid || (got < 0 && errno == ECHILD)) {
+        worker.reaped = true;
+        worker.status = got == worker.pid ? status : 0;
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    dead_ = true;
+    throw std::runtime_error(
+        name() + ": " + method + ": worker " + std::to_string(w) + " (" + worker.describe() + ") " +
+        (worker.reaped ? describe_exit(worker.status) : "closed its connection") +
+        "; the vector env cannot go on: close() it and make another");
+  }
+  return replies;
+}
+
+void ProcessVectorEnv::throw_first_error(std::vector<std::string>& replies, bool poison) {
+  for (std::string& reply : replies) {
+    if (reply.empty()) continue;
+    Reader in(reply);
+    if (static_cast<Status>(in.u8()) == Status::kOk) {
+      reply.erase(0, 1);
+      continue;
+    }
+    if (poison) failed_ = true;
+    const auto kind = static_cast<ErrorKind>(in.u8());
+    const std::string message = in.str();
+    switch (kind) {
+      case ErrorKind::kResetNeeded:
+        throw ResetNeeded(message);
+      case ErrorKind::kInvalidArgument:
+        throw std::invalid_argument(message);
+      case ErrorKind::kOutOfRange:
+        throw std::out_of_range(message);
+      case ErrorKind::kRuntime:
+        break;
+    }
+    throw std::runtime_error(message);
+  }
+}
+
+void ProcessVectorEnv::end_workers() noexcept {
+  // A worker whose socket closes destroys its envs and exits.
+  for (Worker& worker : workers_) {
+    if (worker.fd >= 0) ::close(worker.fd);
+    worker.fd = -1;
+  }
+  const auto deadline = std::chrono::steady_clock::now() + kExitWait;
+  for (Worker& worker : workers_) {
+    if (worker.pid <= 0 || worker.reaped) continue;
+    for (;;) {
+      int status = 0;
+      const pid_t got = ::waitpid(worker.pid, &status, WNOHANG);
+      if (got == worker.pid || (got < 0 && errno != EINTR)) break;
+      if (std::chrono::steady_clock::now() >= deadline) {
+        ::kill(worker.pid, SIGKILL);
+        while (::waitpid(worker.pid, &status, 0) < 0 && errno == EINTR) {
+        }
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    worker.reaped = true;
+  }
+}
+
+std::string ProcessVectorEnv::name() const { return process_name(id_, num_envs_); }
+
+const Env& ProcessVectorEnv::env(int i) const {
+  if (i < 0 || i >= num_envs_) throw std::out_of_range(name() + ": no env " + std::to_string(i));
+  return *like_;
+}
+
+int ProcessVectorEnv::num_workers() const { return static_cast<int>(workers_.size()); }
+
+int ProcessVectorEnv::worker_pid(int w) const {
+  if (w < 0 || w >= num_workers()) {
+    throw std::out_of_range(name() + ": no worker " + std::to_string(w));
+  }
+  return workers_[static_cast<std::size_t>(w)].pid;
+}
+
+void ProcessVectorEnv::require_usable(const char* method) const {
+  if (closed_) throw ResetNeeded(name() + ": " + method + " called after close()");
+  if (dead_) {
+    throw ResetNeeded(name() + ": " + method +
+                      " called after a worker died; close() this vector env and make another");
+  }
+}
+
+const VectorResetResult& ProcessVectorEnv::do_reset(std::optional<std::uint64_t> seed,
+                                                    const Options& options,
+                                                    const Array* reset_mask) {
+  if (reset_mask != nullptr) {
+    check_reset_mask(*this, *reset_mask);
+    if (failed_) {
+      throw ResetNeeded(name() +
+                        ": reset() with a mask after a failed call; call reset() without a mask");
+    }
+  }
+  require_usable("reset()");
+  std::vector<std::string> commands(workers_.size());
+  for (std::size_t w = 0; w < workers_.size(); ++w) {
+    const Worker& worker = workers_[w];
+    const bool* mask = reset_mask != nullptr ? reset_mask->data<bool>() + worker.first : nullptr;
+    if (mask != nullptr && std::none_of(mask, mask + worker.count, [](bool b) { return b; })) {
+      continue;
+    }
+    Writer command(Op::kReset);
+    command.u8(seed ? 1 : 0);
+    command.u64(seed ? *seed + static_cast<std::uint64_t>(worker.first) : 0);
+    command.params(options);
+    command.u8(mask != nullptr ? 1 : 0);
+    for (int j = 0; mask != nullptr && j < worker.count; ++j) command.u8(mask[j] ? 1 : 0);
+    commands[w] = command.frame();
+  }
+  std::vector<std::string> replies = call(commands, "reset()");
+  throw_first_error(replies, true);
+  if (reset_mask == nullptr) {
+    failed_ = false;
+    has_reset_ = true;
+  }
+  reset_result_.infos.clear();
+  try {
+    for (std::size_t w = 0; w < workers_.size(); ++w) {
+      if (replies[w].empty()) continue;
+      const Worker& worker = workers_[w];
+      merge_rows(reset_result_.infos, Reader(replies[w]).value().dict(), worker.first, worker.count,
+                 num_envs_);
+    }
+  } catch (const std::invalid_argument& e) {
+    failed_ = true;
+    throw std::invalid_argument(name() + ": " + e.what());
+  }
+  for (int i = 0; i < num_envs_; ++i) {
+    if (reset_mask == nullptr || reset_mask->data<bool>()[i])
+      ended_[static_cast<std::size_t>(i)] = 0;
+  }
+  return reset_result_;
+}
+
+const VectorStepResult& ProcessVectorEnv::do_step(const Value& actions) {
+  require_usable("step()");
+  if (failed_) throw ResetNeeded(name() + ": step() after a failed call; call reset() first");
+  if (!has_reset_) throw ResetNeeded(name() + ": step() called before reset()");
+  check_actions(*this, actions, "step()");
+  check_none_ended(*this, ended_, "step()");
+  copy_value(actions, actions_);
+  const std::vector<std::string> commands(workers_.size(), Writer(Op::kStep).frame());
+  std::vector<std::string> replies = call(commands, "step()");
+  throw_first_error(replies, true);
+  step_result_.infos.clear();
+  try {
+    for (std::size_t w = 0; w < workers_.size(); ++w) {
+      const Worker& worker = workers_[w];
+      merge_rows(step_result_.infos, Reader(replies[w]).value().dict(), worker.first, worker.count,
+                 num_envs_);
+    }
+  } catch (const std::invalid_argument& e) {
+    failed_ = true;
+    throw std::invalid_argument(name() + ": " + e.what());
+  }
+  const bool* terminated = step_result_.terminated.data<bool>();
+  const bool* truncated = step_result_.truncated.data<bool>();
+  for (std::size_t i = 0; i < ended_.size(); ++i) {
+    ended_[i] = terminated[i] || truncated[i] ? 1 : 0;
+  }
+  return step_result_;
+}
+
+std::vector<Array> ProcessVectorEnv::render() {
+  require_usable("render()");
+  const std::vector<std::string> commands(workers_.size(), Writer(Op::kRender).frame());
+  std::vector<std::string> replies = call(commands, "render()");
+  throw_first_error(replies, false);
+  std::vector<Array> frames;
+  frames.reserve(static_cast<std::size_t>(num_envs_));
+  for (const std::string& reply : replies) {
+    Reader in(reply);
+    for (std::uint64_t k = in.u64(); k > 0; --k) frames.push_back(in.array());
+  }
+  return frames;
+}
+
+void ProcessVectorEnv::close() {
+  if (closed_) return;
+  closed_ = true;
+  std::vector<std::string> replies;
+  std::exception_ptr error;
+  if (!dead_) {
+    try {
+      replies =
+          call(std::vector<std::string>(workers_.size(), Writer(Op::kClose).frame()), "close()");
+    } catch (...) {
+      error = std::current_exception();
+    }
+  }
+  end_workers();
+  if (error) std::rethrow_exception(error);
+  throw_first_error(replies, false);
+}
+
+}  // namespace pixelgym::vector
