@@ -123,6 +123,7 @@ class ProcessVectorEnv final : public VectorEnv {
   Value actions_;                    // in shared memory, laid out as action_space()
   std::vector<std::uint8_t> ended_;  // kDisabled: env i's episode ended at the last step
 
+  bool spin_ = false;  // workers <= cores: wait without sleeping first
   bool has_reset_ = false;
   bool failed_ = false;
   bool dead_ = false;  // a worker died: only close() is left

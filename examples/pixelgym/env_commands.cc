@@ -17,6 +17,7 @@
 #include "pixelgym/envs/suggestions.h"
 #include "pixelgym/envs/vector/async_vector_env.h"
 #include "pixelgym/envs/vector/make_vec.h"
+#include "pixelgym/envs/vector/process_vector_env.h"
 #include "pixelgym/render/context.h"
 #include "pixelgym/testing/snapshot.h"
 #include "pixelgym/wrappers/wrapper_spec.h"
@@ -409,14 +410,20 @@ struct BenchArguments : EnvArguments {
   int num_envs = 0;  // 0: one Env in a loop; else a vector env
   int threads = 0;   // with num_envs: 0 for SyncVectorEnv, else AsyncVectorEnv's worker threads
   bool threads_given = false;
+  int workers = 0;  // with num_envs: ProcessVectorEnv's worker processes (0: none)
+  bool workers_given = false;
 };
 
 // `num_envs` envs in a vector env, stepped with seeded random actions (a pool of batches drawn
 // before timing) until `steps` env steps are done; autoreset NextStep.
 int run_vector_bench(const BenchArguments& args) {
-  const vector::VectorOptions options{
+  vector::VectorOptions options{
       args.threads == 0 ? vector::VectorMode::kSync : vector::VectorMode::kAsync, args.threads,
       vector::AutoresetMode::kNextStep};
+  if (args.workers_given) {
+    options.mode = vector::VectorMode::kProcess;
+    options.num_workers = args.workers;
+  }
   const std::unique_ptr<vector::VectorEnv> env =
       vector::make_vec(args.id, args.num_envs, parse_sets(args.id, args.sets),
                        wrappers::wrapping(args.wraps), options);
@@ -438,12 +445,14 @@ int run_vector_bench(const BenchArguments& args) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::int64_t env_steps = static_cast<std::int64_t>(batches) * args.num_envs;
-  const int threads =
-      args.threads == 0 ? 1 : dynamic_cast<const vector::AsyncVectorEnv&>(*env).num_threads();
+  std::string runner = "SyncVectorEnv, one thread";
+  if (const auto* pool = dynamic_cast<const vector::AsyncVectorEnv*>(env.get())) {
+    runner = "AsyncVectorEnv, " + std::to_string(pool->num_threads()) + " threads";
+  } else if (const auto* workers = dynamic_cast<const vector::ProcessVectorEnv*>(env.get())) {
+    runner = "ProcessVectorEnv, " + std::to_string(workers->num_workers()) + " worker processes";
+  }
   std::cout << args.id << ": " << env_steps << " env steps (" << batches << " batches of "
-            << args.num_envs << " envs, " << resets << " resets) in " << seconds << " s, "
-            << (args.threads == 0 ? std::string("SyncVectorEnv, one thread")
-                                  : "AsyncVectorEnv, " + std::to_string(threads) + " threads")
+            << args.num_envs << " envs, " << resets << " resets) in " << seconds << " s, " << runner
             << "\n";
   std::cout << "steps_per_s=" << static_cast<long>(std::lround(env_steps / seconds)) << "\n";
   env->close();
@@ -451,10 +460,16 @@ int run_vector_bench(const BenchArguments& args) {
 }
 
 int run_bench(const BenchArguments& args) {
+  if (args.threads_given && args.workers_given) {
+    throw UsageError("bench --threads " + std::to_string(args.threads) + " --workers " +
+                     std::to_string(args.workers) +
+                     ": a vector env runs on threads or on worker processes; give one of them");
+  }
   if (args.num_envs > 0) return run_vector_bench(args);
-  if (args.threads_given) {
-    throw UsageError("bench --threads " + std::to_string(args.threads) +
-                     ": threads step a vector env; give --num-envs N with it");
+  if (args.threads_given || args.workers_given) {
+    throw UsageError(std::string("bench ") + (args.threads_given ? "--threads " : "--workers ") +
+                     std::to_string(args.threads_given ? args.threads : args.workers) +
+                     ": threads and workers step a vector env; give --num-envs N with it");
   }
   std::unique_ptr<Env> env = make_env(args.id, args.sets, args.wraps);
   RandomRollout random(*env, args.seed);
@@ -476,7 +491,8 @@ void declare_bench(CLI::App& bench, BenchArguments& args) {
   bench.description(
       "Step an env with seeded random actions (resetting when done) and print steps_per_s= for "
       "physics + render + observation, one env on this thread, or with --num-envs N a vector env "
-      "of N (--threads T workers); --set obs_mode=state for physics alone");
+      "of N (--threads T threads, or --workers W processes); --set obs_mode=state for physics "
+      "alone");
   add_id_argument(bench, args.id, "CartPoleSwingup-v1");
   add_checked_option(bench, "--steps", args.steps, "Steps to time", integer_in(1));
   add_seed_option(bench, args.seed, "Seed for the reset and the random actions");
@@ -491,6 +507,12 @@ void declare_bench(CLI::App& bench, BenchArguments& args) {
                      "without --num-envs",
                      integer_in(0))
       ->each([&args](const std::string&) { args.threads_given = true; });
+  add_checked_option(bench, "--workers", args.workers,
+                     "With --num-envs: a ProcessVectorEnv of W worker processes (0: one per "
+                     "core; clamped to N), each stepping its block of envs and writing into "
+                     "shared memory; refused without --num-envs or with --threads",
+                     integer_in(0))
+      ->each([&args](const std::string&) { args.workers_given = true; });
   add_env_options(bench, args);
 }
 
