@@ -12,6 +12,7 @@
 
 #include "pixelgym/envs/registry.h"
 #include "pixelgym/envs/vector/async_vector_env.h"
+#include "pixelgym/envs/vector/process_vector_env.h"
 #include "pixelgym/envs/vector/make_vec.h"
 #include "pixelgym/wrappers/wrapper_spec.h"
 #include "python/bindings.h"
@@ -26,9 +27,10 @@ using vector::VectorEnv;
 vector::VectorMode parse_mode(const std::string& mode) {
   if (mode == "async") return vector::VectorMode::kAsync;
   if (mode == "sync") return vector::VectorMode::kSync;
+  if (mode == "process") return vector::VectorMode::kProcess;
   throw std::invalid_argument(
-      "make_vec: mode must be \"async\" (the thread pool) or \"sync\" (a "
-      "loop on the calling thread), got \"" +
+      "make_vec: mode must be \"async\" (the thread pool), \"process\" (worker processes) "
+      "or \"sync\" (a loop on the calling thread), got \"" +
       mode + "\"");
 }
 
@@ -44,11 +46,12 @@ class VectorHandle {
  public:
   VectorHandle(const std::string& id, int num_envs, const py::dict& kwargs,
                const std::vector<std::string>& wrappers, const std::string& mode, int num_threads,
-               const std::string& autoreset_mode, bool share_gl_contexts)
+               const std::string& autoreset_mode, bool share_gl_contexts, int num_workers)
       : id_(id), wrappers_(wrappers) {
     vector::VectorOptions options;
     options.mode = parse_mode(mode);
     options.num_threads = num_threads;
+    options.num_workers = num_workers;
     options.autoreset = vector::parse_autoreset_mode(autoreset_mode);
     options.share_gl_contexts = share_gl_contexts;
     kwargs_ = params_from_python(kwargs, id);
@@ -134,6 +137,10 @@ class VectorHandle {
     const auto* async = dynamic_cast<const AsyncVectorEnv*>(env_.get());
     return async != nullptr ? async->num_threads() : 1;
   }
+  int num_workers() const {
+    const auto* workers = dynamic_cast<const vector::ProcessVectorEnv*>(env_.get());
+    return workers != nullptr ? workers->num_workers() : 0;
+  }
   std::string autoreset_mode() const { return vector::autoreset_mode_name(env_->autoreset_mode()); }
   std::shared_ptr<Space> space(const Space& space) const {
     return std::shared_ptr<Space>(env_, const_cast<Space*>(&space));
@@ -202,11 +209,11 @@ void bind_vector(py::module_& module) {
   py::class_<VectorHandle>(module, "VectorEnv",
                            "num_envs pixelgym envs stepped as one (C++): use pixelgym.make_vec.")
       .def(py::init<const std::string&, int, const py::dict&, const std::vector<std::string>&,
-                    const std::string&, int, const std::string&, bool>(),
+                    const std::string&, int, const std::string&, bool, int>(),
            py::arg("id"), py::arg("num_envs"), py::arg("kwargs") = py::dict(),
            py::arg("wrappers") = std::vector<std::string>{}, py::arg("mode") = "async",
            py::arg("num_threads") = 0, py::arg("autoreset_mode") = "NextStep",
-           py::arg("share_gl_contexts") = true)
+           py::arg("share_gl_contexts") = true, py::arg("num_workers") = 0)
       .def("reset", &VectorHandle::reset, py::arg("seed") = py::none(),
            py::arg("options") = py::none(), py::arg("reset_mask") = py::none(),
            "Resets every env (env i with seed + i), or those of reset_mask: (obs, infos).")
@@ -221,6 +228,8 @@ void bind_vector(py::module_& module) {
       .def_property_readonly("num_envs", &VectorHandle::num_envs)
       .def_property_readonly("num_threads", &VectorHandle::num_threads,
                              "Threads that run envs, the caller's included (1 for mode sync).")
+      .def_property_readonly("num_workers", &VectorHandle::num_workers,
+                             "Worker processes that run envs (mode process; 0 otherwise).")
       .def_property_readonly("autoreset_mode", &VectorHandle::autoreset_mode,
                              "\"NextStep\", \"SameStep\" or \"Disabled\".")
       .def_property_readonly("single_observation_space", &VectorHandle::single_observation_space)

@@ -63,8 +63,11 @@ def _row(obs, i):
 
 class VectorEnv(CoreBacked, _Base):
     """``num_envs`` copies of a pixelgym env stepped as one by the C++ vector env: a thread pool
-    (``mode="async"``, ``num_threads`` workers, 0 for one per core) or a loop on the calling
-    thread (``mode="sync"``). The GIL is released while C++ steps, so other Python threads run.
+    (``mode="async"``, ``num_threads`` workers, 0 for one per core), worker processes writing
+    into shared memory (``mode="process"``, ``num_workers`` of them, 0 for one per core: envs
+    registered in C++ reach them; make it before anything draws on a GPU in this process), or a
+    loop on the calling thread (``mode="sync"``). The GIL is released while C++ steps, so other
+    Python threads run.
 
     Gymnasium 1.x's protocol: ``reset(seed=None, options=None) -> (obs, infos)`` resets env i
     with ``seed + i`` (or ``seed[i]`` for a list); ``step(actions) -> (obs, rewards,
@@ -86,7 +89,7 @@ class VectorEnv(CoreBacked, _Base):
 
     def __init__(self, id, num_envs=1, *, num_threads=0, autoreset_mode="NextStep", wrap=(),
                  mode="async", share_gl_contexts=True, copy=False, render_mode="rgb_array",
-                 **kwargs):
+                 num_workers=0, **kwargs):
         if render_mode not in (None, "rgb_array"):
             raise ValueError(
                 f"{id}: render_mode must be 'rgb_array' (the default) or None, got "
@@ -96,10 +99,11 @@ class VectorEnv(CoreBacked, _Base):
         wrap = wrap_list(wrap)
         num_envs = _count("num_envs", num_envs, 1)
         num_threads = _count("num_threads", num_threads, 0)
+        num_workers = _count("num_workers", num_workers, 0)
         self._core = _core.VectorEnv(id, num_envs, kwargs, wrap, mode, num_threads,
-                                     _mode_name(autoreset_mode), share_gl_contexts)
+                                     _mode_name(autoreset_mode), share_gl_contexts, num_workers)
         self._id = id
-        self._args = dict(num_envs=num_envs, num_threads=num_threads,
+        self._args = dict(num_envs=num_envs, num_threads=num_threads, num_workers=num_workers,
                           autoreset_mode=_mode_name(autoreset_mode), wrap=tuple(wrap),
                           mode=mode, share_gl_contexts=share_gl_contexts, copy=copy,
                           render_mode=render_mode, **kwargs)
@@ -218,6 +222,11 @@ class VectorEnv(CoreBacked, _Base):
         return self._core.num_threads
 
     @property
+    def num_workers(self):
+        """Worker processes that run envs (mode="process"; 0 otherwise)."""
+        return self._core.num_workers
+
+    @property
     def autoreset_mode(self):
         """"NextStep", "SameStep" or "Disabled"."""
         return self._core.autoreset_mode
@@ -249,13 +258,14 @@ def _remake(env_id, args):
 
 
 def make_vec(id, num_envs=1, *, num_threads=0, autoreset_mode="NextStep", wrap=(), mode="async",
-             share_gl_contexts=True, copy=False, render_mode="rgb_array", **kwargs):
+             share_gl_contexts=True, copy=False, render_mode="rgb_array", num_workers=0,
+             **kwargs):
     """A VectorEnv of ``num_envs`` copies of env ``id`` made with ``kwargs`` (typed C++ kwargs,
     as ``make``) and the pixelgym wrappers in ``wrap``; see VectorEnv. Also gymnasium's
     ``vector_entry_point`` for ``pixelgym/<ID>``."""
     return VectorEnv(id, num_envs, num_threads=num_threads, autoreset_mode=autoreset_mode,
                      wrap=wrap, mode=mode, share_gl_contexts=share_gl_contexts, copy=copy,
-                     render_mode=render_mode, **kwargs)
+                     render_mode=render_mode, num_workers=num_workers, **kwargs)
 
 
 def make_vec_registered(pixelgym_id, num_envs=1, **kwargs):
