@@ -1,28 +1,31 @@
-// Vector-env scaling: total env steps per second of SyncVectorEnv and AsyncVectorEnv at 1, 2, 4,
-// 8 and 16 envs, each beside the single-env loop in the same run.
+// Vector-env scaling: total env steps per second of SyncVectorEnv, AsyncVectorEnv and
+// ProcessVectorEnv at 1, 2, 4, 8 and 16 envs, each beside the single-env loop in the same run.
 //
 // For each env count N the configurations are built, warmed up, and then stepped in turn, round
 // after round: the single-env loop, N envs stepped one after the other in a plain loop (no vector
 // env, each env with a GL context of its own: what N separate envs cost by themselves),
-// SyncVectorEnv, and AsyncVectorEnv with 1 and 2 threads (the vector envs share one GL context per
-// thread, their default). Every configuration does the same work: env i is seeded i and steps
-// through row i of one pool of 64 seeded random batched actions, in a cycle (reset when done).
-// The single-env loop steps those same N envs, but one at a time: 64 steps of env 0 alone, then
-// 64 of env 1, and so on, so that it measures one env stepped alone (its caches warm) over the
-// states the batch visits. (A step's cost depends on the state: the arm's steps/s alone ranges
-// over 10% between seeds, so a baseline of one seed would compare different work.) Each block
-// runs for about `block_ms` of wall time. A configuration's ratio to the single-env loop is taken
-// within each round (so drift on a shared machine hits both alike) and the medians over rounds
-// are printed.
+// SyncVectorEnv, AsyncVectorEnv with 1 and 2 threads (the vector envs share one GL context per
+// thread, their default) and ProcessVectorEnv with 1 and 2 worker processes. Every configuration
+// does the same work: env i is seeded i and steps through row i of one pool of 64 seeded random
+// batched actions, in a cycle (reset when done). The single-env loop steps those same N envs, but
+// one at a time: 64 steps of env 0 alone, then 64 of env 1, and so on, so that it measures one env
+// stepped alone (its caches warm) over the states the batch visits. (A step's cost depends on the
+// state: the arm's steps/s alone ranges over 10% between seeds, so a baseline of one seed would
+// compare different work.) Each block runs for about `block_ms` of wall time. A configuration's
+// ratio to the single-env loop is taken within each round (so drift on a shared machine hits both
+// alike) and the medians over rounds are printed.
 //
 // usage: vector_bench [IDS] [rounds] [block_ms] [max_envs] [cpu]
 //   IDS: comma-separated env ids (default CartPoleSwingup-v0,ArmReach-v0), 84x84 (their default)
 //   cpu: time the one-thread configurations (the loops and sync) by the thread's CPU time
-//        instead of wall time, and skip the async ones: steadier on a busy machine, for
+//        instead of wall time, and skip the others: steadier on a busy machine, for
 //        decisions about per-env costs (another process taking the core does not count)
 // Prints a table per id and, per id, the two figures the vector-env issue sets targets for:
 //   <id> two_threads_over_one_8envs=   AsyncVectorEnv(2 threads) / SyncVectorEnv at 8 envs
 //   <id> one_thread_8envs_over_loop=   SyncVectorEnv at 8 envs / the single-env loop
+// and, for the worker processes at 8 and 16 envs:
+//   <id> two_workers_over_one_<N>envs=      ProcessVectorEnv(2 workers) / (1 worker)
+//   <id> two_workers_over_two_threads_<N>envs=  ProcessVectorEnv(2) / AsyncVectorEnv(2 threads)
 #include <time.h>
 
 #include <algorithm>
@@ -165,7 +168,8 @@ int main(int argc, char** argv) {
   const double block = (argc > 3 ? std::atof(argv[3]) : 250.0) / 1000.0;
   const int max_envs = argc > 4 ? std::atoi(argv[4]) : 16;
   cpu_time = argc > 5 && std::string(argv[5]) == "cpu";
-  const char* names[] = {"loop, own contexts", "sync", "async 1 thread", "async 2 threads"};
+  const char* names[] = {"loop, own contexts", "sync",      "async 1 thread",
+                         "async 2 threads",    "1 process", "2 processes"};
   for (const std::string& id : ids) {
     std::vector<Row> rows;
     for (int n = 1; n <= max_envs; n *= 2) {
@@ -188,12 +192,16 @@ int main(int argc, char** argv) {
                          },
                          {},
                          {}});
-      const vector::VectorOptions modes[] = {
+      vector::VectorOptions modes[] = {
           {vector::VectorMode::kSync, 0, vector::AutoresetMode::kNextStep},
           {vector::VectorMode::kAsync, 1, vector::AutoresetMode::kNextStep},
           {vector::VectorMode::kAsync, 2, vector::AutoresetMode::kNextStep},
+          {vector::VectorMode::kProcess, 0, vector::AutoresetMode::kNextStep},
+          {vector::VectorMode::kProcess, 0, vector::AutoresetMode::kNextStep},
       };
-      for (int m = 0; m < (cpu_time ? 1 : 3); ++m) {
+      modes[3].num_workers = 1;
+      modes[4].num_workers = 2;
+      for (int m = 0; m < (cpu_time ? 1 : 5); ++m) {
         std::shared_ptr<vector::VectorEnv> env = vector::make_vec(id, n, {}, {}, modes[m]);
         env->reset(0);
         auto next = std::make_shared<std::size_t>(0);
@@ -237,6 +245,13 @@ int main(int argc, char** argv) {
       std::printf("%s two_threads_over_one_8envs=%.2f\n", id.c_str(),
                   row.ratios[3] / row.ratios[1]);
       std::printf("%s one_thread_8envs_over_loop=%.2f\n", id.c_str(), row.ratios[1]);
+    }
+    for (const Row& row : rows) {
+      if (row.num_envs < 8 || row.ratios.size() < 6) continue;
+      std::printf("%s two_workers_over_one_%denvs=%.2f\n", id.c_str(), row.num_envs,
+                  row.ratios[5] / row.ratios[4]);
+      std::printf("%s two_workers_over_two_threads_%denvs=%.2f\n", id.c_str(), row.num_envs,
+                  row.ratios[5] / row.ratios[3]);
     }
     std::fflush(stdout);
   }

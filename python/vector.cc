@@ -12,8 +12,8 @@
 
 #include "pixelgym/envs/registry.h"
 #include "pixelgym/envs/vector/async_vector_env.h"
-#include "pixelgym/envs/vector/process_vector_env.h"
 #include "pixelgym/envs/vector/make_vec.h"
+#include "pixelgym/envs/vector/process_vector_env.h"
 #include "pixelgym/wrappers/wrapper_spec.h"
 #include "python/bindings.h"
 #include "python/convert.h"
