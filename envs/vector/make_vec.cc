@@ -72,7 +72,8 @@ std::unique_ptr<VectorEnv> make_vec(const Registry& registry, const std::string&
       });
     };
     return std::make_unique<ProcessVectorEnv>(num_envs, make_worker_envs, std::move(like),
-                                              options.num_workers, options.autoreset);
+                                              options.num_workers, options.autoreset,
+                                              options.caller_steps_envs);
   }
   const bool async = options.mode == VectorMode::kAsync;
   const int threads = async ? AsyncVectorEnv::threads_for(num_envs, options.num_threads) : 1;

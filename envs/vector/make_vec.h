@@ -42,6 +42,10 @@ struct VectorOptions {
   bool share_gl_contexts = true;
   /// ProcessVectorEnv's worker processes: 0 for one per core; clamped to num_envs. Only kProcess.
   int num_workers = 0;
+  /// kProcess: whether the calling process runs worker 0's envs itself (as AsyncVectorEnv's
+  /// calling thread runs thread 0's), so that W workers are W - 1 child processes and the caller;
+  /// false puts every env in a child process (see ProcessVectorEnv).
+  bool caller_steps_envs = true;
 };
 
 /// `num_envs` copies of `registry.make(id, kwargs, options)`, each passed through `wrap` (when set;

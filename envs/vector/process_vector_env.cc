@@ -407,6 +407,52 @@ class WorkerRunner final : public BatchRunner {
   int total_;
 };
 
+// Runs `command` on `runner` (the envs of one worker, whose actions are `actions`) and returns
+// the reply; `content` false when the reply says only "done" (a reset or step without infos).
+Writer serve(WorkerRunner& runner, const std::string& command, const Value& actions,
+             bool& content) {
+  Writer reply(Status::kOk);
+  content = true;
+  const auto infos = [&](const Info& batched) {
+    content = !batched.empty();
+    if (content) reply.value(batched);
+  };
+  try {
+    Reader in(command);
+    switch (static_cast<Op>(in.u8())) {
+      case Op::kReset: {
+        std::optional<std::uint64_t> seed;
+        if (in.u8() != 0) seed = in.u64();
+        const Params options = in.params();
+        if (in.u8() != 0) {
+          Array mask(DType::kBool, {runner.num_envs()});
+          for (int j = 0; j < runner.num_envs(); ++j) mask.data<bool>()[j] = in.u8() != 0;
+          infos(runner.reset(seed, options, mask).infos);
+        } else {
+          infos(runner.reset(seed, options).infos);
+        }
+        break;
+      }
+      case Op::kStep:
+        infos(runner.step(actions).infos);
+        break;
+      case Op::kRender: {
+        const std::vector<Array> frames = runner.render();
+        reply.u64(frames.size());
+        for (const Array& frame : frames) reply.array(frame);
+        break;
+      }
+      case Op::kClose:
+        runner.close();
+        break;
+    }
+  } catch (...) {
+    content = true;
+    return error_reply();
+  }
+  return reply;
+}
+
 }  // namespace
 
 // The shared mapping: how a call is going, then the batch arrays the parent and the workers both
@@ -447,17 +493,24 @@ struct ProcessVectorEnv::Shared {
   std::byte* data = nullptr;  // the arrays
 };
 
+// The envs a worker runs, and where its actions are.
+struct ProcessVectorEnv::Block {
+  std::unique_ptr<WorkerRunner> runner;
+  Value actions;  // its rows of the action batch
+};
+
 struct ProcessVectorEnv::Worker {
   int first = 0;  // its envs: [first, first + count)
   int count = 0;
   pid_t pid = -1;
-  int fd = -1;  // the parent's end of its socket
+  int fd = -1;       // the parent's end of its socket
+  bool own = false;  // the calling process's own share: no process, no socket
   bool reaped = false;
   int status = 0;  // as waitpid says, once reaped
 
   std::string describe() const {
-    return "pid " + std::to_string(pid) + ", envs " + std::to_string(first) +
-           (count > 1 ? "-" + std::to_string(first + count - 1) : "");
+    return (own ? "this process" : "pid " + std::to_string(pid)) + ", envs " +
+           std::to_string(first) + (count > 1 ? "-" + std::to_string(first + count - 1) : "");
   }
 };
 
@@ -475,7 +528,7 @@ int ProcessVectorEnv::workers_for(int num_envs, int num_workers) {
 
 ProcessVectorEnv::ProcessVectorEnv(int num_envs, const WorkerFactory& make_worker_envs,
                                    std::shared_ptr<const Env> like, int num_workers,
-                                   AutoresetMode autoreset)
+                                   AutoresetMode autoreset, bool caller_steps_envs)
     : num_envs_(num_envs), like_(std::move(like)) {
   if (num_envs < 1) {
     throw std::invalid_argument("ProcessVectorEnv: num_envs must be >= 1, got num_envs = " +
@@ -515,21 +568,69 @@ ProcessVectorEnv::ProcessVectorEnv(int num_envs, const WorkerFactory& make_worke
                           : workers_[static_cast<std::size_t>(w - 1)].first +
                                 workers_[static_cast<std::size_t>(w - 1)].count;
   }
+  const int first_child = caller_steps_envs ? 1 : 0;
+  if (caller_steps_envs) {
+    workers_[0].pid = ::getpid();
+    workers_[0].own = true;
+  }
   try {
-    shared_->control->remaining.store(workers);
-    for (int w = 0; w < workers; ++w) start_worker(w, make_worker_envs);
-    // Each worker says, unasked, whether it built its envs.
-    std::vector<std::string> replies =
-        await(std::vector<std::uint8_t>(workers_.size(), 1), {}, "the constructor");
+    shared_->control->remaining.store(workers - first_child);
+    for (int w = first_child; w < workers; ++w) start_worker(w, make_worker_envs);
+    // The children were forked before this process builds any env of its own. Each says,
+    // unasked, whether it built its envs.
+    std::string own;
+    if (caller_steps_envs) {
+      try {
+        own_ = build_block(0, make_worker_envs);
+        Writer made(Status::kOk);
+        made.str(own_->runner->id());
+        own = made.frame();
+      } catch (...) {
+        own = error_reply().frame();
+      }
+    }
+    std::vector<std::uint8_t> pending;
+    for (int w = 0; w < workers; ++w) pending.push_back(w >= first_child ? 1 : 0);
+    std::vector<std::string> replies = await(pending, {}, "the constructor");
+    if (caller_steps_envs) replies[0] = own;
     throw_first_error(replies, false);
     id_ = Reader(replies[0]).str();
   } catch (...) {
+    own_.reset();
     end_workers();
     throw;
   }
 }
 
 ProcessVectorEnv::~ProcessVectorEnv() { end_workers(); }
+
+std::unique_ptr<ProcessVectorEnv::Block> ProcessVectorEnv::build_block(
+    int w, const WorkerFactory& make_worker_envs) {
+  const Worker& worker = workers_[static_cast<std::size_t>(w)];
+  const EnvFactory make_env = make_worker_envs(w);
+  const Env& like = *like_;
+  const EnvFactory checked = [&](int i) {
+    std::unique_ptr<Env> env = make_env(i);
+    if (env != nullptr && (!env->observation_space().equals(like.observation_space()) ||
+                           !env->action_space().equals(like.action_space()))) {
+      throw std::invalid_argument(
+          "its spaces " + env->observation_space().to_string() + " / " +
+          env->action_space().to_string() + " differ from those the vector env was laid out for: " +
+          like.observation_space().to_string() + " / " + like.action_space().to_string());
+    }
+    return env;
+  };
+  const std::int64_t begin = worker.first;
+  const std::int64_t end = worker.first + worker.count;
+  const BatchBuffers buffers{
+      rows(step_result_.obs, begin, end), step_result_.rewards.slice(begin, end),
+      step_result_.terminated.slice(begin, end), step_result_.truncated.slice(begin, end)};
+  auto block = std::make_unique<Block>();
+  block->runner = std::make_unique<WorkerRunner>(worker.first, worker.count, num_envs_, w, checked,
+                                                 metadata_.autoreset_mode, buffers);
+  block->actions = rows(actions_, begin, end);
+  return block;
+}
 
 void ProcessVectorEnv::start_worker(int w, const WorkerFactory& make_worker_envs) {
   Worker& worker = workers_[static_cast<std::size_t>(w)];
@@ -556,7 +657,10 @@ void ProcessVectorEnv::start_worker(int w, const WorkerFactory& make_worker_envs
   // The worker. It keeps only its own end of its socket: a worker that holds another's would
   // keep the parent from seeing that one die.
   ::close(ends[0]);
-  for (int v = 0; v < w; ++v) ::close(workers_[static_cast<std::size_t>(v)].fd);
+  for (int v = 0; v < w; ++v) {
+    if (workers_[static_cast<std::size_t>(v)].fd >= 0)
+      ::close(workers_[static_cast<std::size_t>(v)].fd);
+  }
   const int fd = ends[1];
   Shared& shared = *shared_;
   // Sends `reply` unless it says only "done" (`content` false), then counts this worker done,
@@ -571,81 +675,21 @@ void ProcessVectorEnv::start_worker(int w, const WorkerFactory& make_worker_envs
     return true;
   };
   {
-    std::unique_ptr<WorkerRunner> runner;
+    std::unique_ptr<Block> block;
     try {
-      const EnvFactory make_env = make_worker_envs(w);
-      const Env& like = *like_;
-      const EnvFactory checked = [&](int i) {
-        std::unique_ptr<Env> env = make_env(i);
-        if (env != nullptr && (!env->observation_space().equals(like.observation_space()) ||
-                               !env->action_space().equals(like.action_space()))) {
-          throw std::invalid_argument("its spaces " + env->observation_space().to_string() + " / " +
-                                      env->action_space().to_string() +
-                                      " differ from those the vector env was laid out "
-                                      "for: " +
-                                      like.observation_space().to_string() + " / " +
-                                      like.action_space().to_string());
-        }
-        return env;
-      };
-      BatchBuffers buffers{rows(step_result_.obs, worker.first, worker.first + worker.count),
-                           step_result_.rewards.slice(worker.first, worker.first + worker.count),
-                           step_result_.terminated.slice(worker.first, worker.first + worker.count),
-                           step_result_.truncated.slice(worker.first, worker.first + worker.count)};
-      runner = std::make_unique<WorkerRunner>(worker.first, worker.count, num_envs_, w, checked,
-                                              metadata_.autoreset_mode, buffers);
+      block = build_block(w, make_worker_envs);
       Writer made(Status::kOk);
-      made.str(runner->id());
+      made.str(block->runner->id());
       if (!answer(made, true)) ::_exit(0);
     } catch (...) {
       answer(error_reply(), true);
       ::_exit(1);
     }
-    const Value my_actions = rows(actions_, worker.first, worker.first + worker.count);
     std::string command;
     while ((spin_ && readable_within(fd, kSpin), receive_frame(fd, command))) {
-      Writer reply(Status::kOk);
-      Op op = Op::kClose;
-      bool content = true;  // false: nothing to say but "done" (no infos)
-      const auto infos = [&](const Info& batched) {
-        content = !batched.empty();
-        if (content) reply.value(batched);
-      };
-      try {
-        Reader in(command);
-        op = static_cast<Op>(in.u8());
-        switch (op) {
-          case Op::kReset: {
-            std::optional<std::uint64_t> seed;
-            if (in.u8() != 0) seed = in.u64();
-            const Params options = in.params();
-            if (in.u8() != 0) {
-              Array mask(DType::kBool, {worker.count});
-              for (int j = 0; j < worker.count; ++j) mask.data<bool>()[j] = in.u8() != 0;
-              infos(runner->reset(seed, options, mask).infos);
-            } else {
-              infos(runner->reset(seed, options).infos);
-            }
-            break;
-          }
-          case Op::kStep:
-            infos(runner->step(my_actions).infos);
-            break;
-          case Op::kRender: {
-            const std::vector<Array> frames = runner->render();
-            reply.u64(frames.size());
-            for (const Array& frame : frames) reply.array(frame);
-            break;
-          }
-          case Op::kClose:
-            runner->close();
-            break;
-        }
-      } catch (...) {
-        reply = error_reply();
-        content = true;
-      }
-      if (!answer(reply, content) || op == Op::kClose) break;
+      bool content = true;
+      const Writer reply = serve(*block->runner, command, block->actions, content);
+      if (!answer(reply, content) || static_cast<Op>(command.at(0)) == Op::kClose) break;
     }
   }
   // Not exit(): the parent's atexit handlers and static destructors are the parent's.
@@ -657,10 +701,11 @@ std::vector<std::string> ProcessVectorEnv::call(const std::vector<std::string>& 
   const std::size_t n = workers_.size();
   std::vector<std::uint8_t> pending(n, 0);
   std::vector<std::uint8_t> died(n, 0);
+  const std::size_t first_child = own_ != nullptr ? 1 : 0;
   std::int32_t asked = 0;
-  for (std::size_t w = 0; w < n; ++w) asked += commands[w].empty() ? 0 : 1;
+  for (std::size_t w = first_child; w < n; ++w) asked += commands[w].empty() ? 0 : 1;
   shared_->control->remaining.store(asked);
-  for (std::size_t w = 0; w < n; ++w) {
+  for (std::size_t w = first_child; w < n; ++w) {
     if (commands[w].empty()) continue;
     if (send_frame(workers_[w].fd, commands[w])) {
       pending[w] = 1;
@@ -668,7 +713,15 @@ std::vector<std::string> ProcessVectorEnv::call(const std::vector<std::string>& 
       died[w] = 1;
     }
   }
-  return await(std::move(pending), std::move(died), method);
+  // This process's own envs step while the children step theirs.
+  std::string own;
+  if (own_ != nullptr && !commands[0].empty()) {
+    bool content = true;
+    own = serve(*own_->runner, commands[0], own_->actions, content).frame();
+  }
+  std::vector<std::string> replies = await(std::move(pending), std::move(died), method);
+  if (own_ != nullptr) replies[0] = std::move(own);
+  return replies;
 }
 
 std::vector<std::string> ProcessVectorEnv::await(std::vector<std::uint8_t> pending,
@@ -795,6 +848,7 @@ void ProcessVectorEnv::end_workers() noexcept {
   // A worker whose socket closes destroys its envs and exits.
   for (Worker& worker : workers_) {
     if (worker.fd >= 0) ::close(worker.fd);
+    if (worker.own) worker.reaped = true;
     worker.fd = -1;
   }
   const auto deadline = std::chrono::steady_clock::now() + kExitWait;

@@ -56,7 +56,8 @@ class ProcessVectorEnv final : public VectorEnv {
   /// factory throws, naming the env (the workers are ended first).
   ProcessVectorEnv(int num_envs, const WorkerFactory& make_worker_envs,
                    std::shared_ptr<const Env> like, int num_workers = 0,
-                   AutoresetMode autoreset = AutoresetMode::kNextStep);
+                   AutoresetMode autoreset = AutoresetMode::kNextStep,
+                   bool caller_steps_envs = true);
   ~ProcessVectorEnv() override;
 
   /// Closes every env (in its worker), then ends the workers. Calling it again does nothing.
@@ -95,7 +96,10 @@ class ProcessVectorEnv final : public VectorEnv {
  private:
   struct Worker;
   struct Shared;
+  struct Block;
 
+  // Builds worker w's envs (in the process that will run them).
+  std::unique_ptr<Block> build_block(int w, const WorkerFactory& make_worker_envs);
   void start_worker(int w, const WorkerFactory& make_worker_envs);
   // Sends `command` to each worker for which it is not empty and returns each one's reply (empty
   // for those not called), in worker order; a dead worker throws (see Errors).
@@ -117,6 +121,7 @@ class ProcessVectorEnv final : public VectorEnv {
   VectorMetadata metadata_;
   std::shared_ptr<Shared> shared_;
   std::vector<Worker> workers_;
+  std::unique_ptr<Block> own_;  // caller_steps_envs: worker 0's envs, in this process
 
   VectorResetResult reset_result_;
   VectorStepResult step_result_;

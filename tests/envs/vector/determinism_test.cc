@@ -7,9 +7,11 @@
 // step_wait() (they run on worker thread 0), and the vector envs run with GL contexts shared per
 // thread (their default) and, sync and on 2 threads, with a context per env. Workers 1-3 draw with
 // private copies of Mesa (render::MesaCopy), so their frames are compared with copy 0's too.
-// ProcessVectorEnv runs with 1, 2 and 3 worker processes under each autoreset mode.
+// ProcessVectorEnv runs with 1, 2 and 3 workers under each autoreset mode, the calling process
+// running worker 0 (its default) or every worker a child (a negative count below).
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -103,7 +105,8 @@ std::string describe(VectorMode mode, int count) {
     case VectorMode::kAsync:
       return std::to_string(count) + " threads";
     case VectorMode::kProcess:
-      return std::to_string(count) + " worker processes";
+      return std::to_string(std::abs(count)) +
+             (count < 0 ? " workers, every one a child" : " workers, the caller's included");
   }
   return "";
 }
@@ -131,12 +134,13 @@ TEST_P(VectorDeterminismTest, SyncAndPoolsEqualSingleEnvsByteForByte) {
         {VectorMode::kAsync, 2, true},   {VectorMode::kAsync, 4, true},
         {VectorMode::kSync, 0, false},   {VectorMode::kAsync, 2, false},
         {VectorMode::kProcess, 1, true}, {VectorMode::kProcess, 2, true},
-        {VectorMode::kProcess, 3, true}};
+        {VectorMode::kProcess, 3, true}, {VectorMode::kProcess, -2, true}};
     for (const auto& [mode, threads, shared] : runners) {
       const std::string runner = std::to_string(num_envs) + " envs, " + describe(mode, threads) +
                                  (shared ? "" : ", a GL context per env");
       VectorOptions options{mode, threads, AutoresetMode::kNextStep, shared};
-      options.num_workers = threads;
+      options.num_workers = std::abs(threads);
+      options.caller_steps_envs = threads >= 0;
       const auto env =
           make_vec(c.id, num_envs, c.kwargs, pixelgym::wrappers::wrapping(c.wrappers), options);
       auto* pool = dynamic_cast<AsyncVectorEnv*>(env.get());
@@ -211,7 +215,8 @@ TEST_P(VectorDeterminismTest, SameStepAndDisabledEqualSingleEnvsByteForByte) {
           std::string(autoreset == AutoresetMode::kSameStep ? "SameStep, " : "Disabled, ") +
           describe(mode, threads);
       VectorOptions options{mode, threads, autoreset};
-      options.num_workers = threads;
+      options.num_workers = std::abs(threads);
+      options.caller_steps_envs = threads >= 0;
       const auto env =
           make_vec(c.id, num_envs, c.kwargs, pixelgym::wrappers::wrapping(c.wrappers), options);
       const Value& first = env->reset(kSeed).obs;

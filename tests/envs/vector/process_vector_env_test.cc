@@ -1,7 +1,8 @@
-// ProcessVectorEnv: a task registered by the user reaches the workers and runs there (one pid per
-// worker), infos and renders come back batched in env order, an env's error names the env and
-// its worker, and a worker killed mid-step makes step() throw within a second, after which close()
-// returns and no worker is left. (Byte-for-byte equality with SyncVectorEnv on the pixel tasks,
+// ProcessVectorEnv, with worker 0 run by the calling process (the default) and with every worker
+// a child: a task registered by the user reaches the workers and runs there (one pid per worker),
+// infos and renders come back batched in env order, an env's error names the env and its worker,
+// and a worker killed mid-step makes step() throw within a second, after which close() returns
+// and no child is left. (Byte-for-byte equality with SyncVectorEnv on the pixel tasks,
 // under every autoreset mode, is in determinism_test.cc.)
 #include "pixelgym/envs/vector/process_vector_env.h"
 
@@ -92,12 +93,16 @@ struct UserRegistry : Registry {
   }
 };
 
+// Whether the calling process runs worker 0 (VectorOptions::caller_steps_envs).
+class ProcessVectorEnvTest : public ::testing::TestWithParam<bool> {};
+
 std::unique_ptr<VectorEnv> make_process(const Registry& registry, int num_envs, int workers,
                                         AutoresetMode mode = AutoresetMode::kNextStep) {
   VectorOptions options;
   options.mode = VectorMode::kProcess;
   options.num_workers = workers;
   options.autoreset = mode;
+  options.caller_steps_envs = ProcessVectorEnvTest::GetParam();
   return make_vec(registry, "Pid-v0", num_envs, {}, nullptr, options);
 }
 
@@ -108,7 +113,7 @@ Array actions(std::vector<std::int64_t> values) {
 
 bool alive(int pid) { return ::kill(pid, 0) == 0 || errno != ESRCH; }
 
-TEST(ProcessVectorEnvTest, AUsersTaskRunsInTheWorkersAndMatchesSync) {
+TEST_P(ProcessVectorEnvTest, AUsersTaskRunsInTheWorkersAndMatchesSync) {
   const UserRegistry registry;
   const auto process = make_process(registry, 5, 2, AutoresetMode::kSameStep);
   VectorOptions sync_options;
@@ -121,13 +126,14 @@ TEST(ProcessVectorEnvTest, AUsersTaskRunsInTheWorkersAndMatchesSync) {
   const Options options{{"offset", 0.5}};
   const VectorResetResult& reset = process->reset(10, options);
   EXPECT_TRUE(reset.obs.equals(sync->reset(10, options).obs));
-  // Envs 0-2 ran in worker 0, envs 3-4 in worker 1: two processes, neither this one.
+  // Envs 0-2 ran in worker 0 (this process, or a child), envs 3-4 in worker 1 (a child).
   const std::int64_t* pids = reset.infos.at("pid").array().data<std::int64_t>();
   EXPECT_EQ(pids[0], workers.worker_pid(0));
   EXPECT_EQ(pids[2], workers.worker_pid(0));
   EXPECT_EQ(pids[3], workers.worker_pid(1));
   EXPECT_NE(pids[0], pids[4]);
-  EXPECT_NE(pids[0], ::getpid());
+  EXPECT_EQ(pids[0] == ::getpid(), GetParam());
+  EXPECT_NE(pids[4], ::getpid());
 
   for (int t = 0; t < 4; ++t) {
     const Array a = actions({0, 0, 0, 0, 0});
@@ -151,12 +157,12 @@ TEST(ProcessVectorEnvTest, AUsersTaskRunsInTheWorkersAndMatchesSync) {
   for (std::size_t i = 0; i < frames.size(); ++i) EXPECT_TRUE(frames[i].equals(sync_frames[i]));
 
   process->close();
-  EXPECT_FALSE(alive(workers.worker_pid(0)));
+  EXPECT_EQ(alive(workers.worker_pid(0)), GetParam());  // this process, or a child ended
   EXPECT_FALSE(alive(workers.worker_pid(1)));
   EXPECT_THROW(process->step(actions({0, 0, 0, 0, 0})), ResetNeeded);
 }
 
-TEST(ProcessVectorEnvTest, AnEnvErrorNamesTheEnvAndItsWorkerAndAResetRecovers) {
+TEST_P(ProcessVectorEnvTest, AnEnvErrorNamesTheEnvAndItsWorkerAndAResetRecovers) {
   const UserRegistry registry;
   const auto env = make_process(registry, 4, 2);
   const auto& workers = dynamic_cast<const ProcessVectorEnv&>(*env);
@@ -177,7 +183,7 @@ TEST(ProcessVectorEnvTest, AnEnvErrorNamesTheEnvAndItsWorkerAndAResetRecovers) {
   EXPECT_EQ(env->step(actions({0, 0, 0, 0})).rewards.data<double>()[3], 4.0);
 }
 
-TEST(ProcessVectorEnvTest, AWorkerKilledMidStepIsAnErrorNamingItWithinASecond) {
+TEST_P(ProcessVectorEnvTest, AWorkerKilledMidStepIsAnErrorNamingItWithinASecond) {
   const UserRegistry registry;
   const auto env = make_process(registry, 4, 2);
   const auto& workers = dynamic_cast<const ProcessVectorEnv&>(*env);
@@ -207,23 +213,25 @@ TEST(ProcessVectorEnvTest, AWorkerKilledMidStepIsAnErrorNamingItWithinASecond) {
   env->close();
   EXPECT_LT(std::chrono::steady_clock::now() - closing, std::chrono::seconds(2));
   EXPECT_FALSE(alive(victim));
-  EXPECT_FALSE(alive(survivor));
+  EXPECT_EQ(alive(survivor), GetParam());
 }
 
-TEST(ProcessVectorEnvTest, DestroyingWithoutCloseEndsTheWorkers) {
+TEST_P(ProcessVectorEnvTest, DestroyingWithoutCloseEndsTheWorkers) {
   const UserRegistry registry;
   std::vector<int> pids;
   {
     const auto env = make_process(registry, 3, 3);
     const auto& workers = dynamic_cast<const ProcessVectorEnv&>(*env);
-    for (int w = 0; w < workers.num_workers(); ++w) pids.push_back(workers.worker_pid(w));
+    for (int w = GetParam() ? 1 : 0; w < workers.num_workers(); ++w) {
+      pids.push_back(workers.worker_pid(w));
+    }
     env->reset(1);
   }
-  ASSERT_EQ(pids.size(), 3U);
+  ASSERT_EQ(pids.size(), GetParam() ? 2U : 3U);
   for (const int pid : pids) EXPECT_FALSE(alive(pid)) << pid;
 }
 
-TEST(ProcessVectorEnvTest, BadArgumentsAndAFailingFactory) {
+TEST_P(ProcessVectorEnvTest, BadArgumentsAndAFailingFactory) {
   const UserRegistry registry;
   EXPECT_THROW(make_process(registry, 2, -1), std::invalid_argument);
   EXPECT_EQ(ProcessVectorEnv::workers_for(3, 8), 3);
@@ -237,7 +245,7 @@ TEST(ProcessVectorEnvTest, BadArgumentsAndAFailingFactory) {
             return std::make_unique<PidEnv>();
           });
         },
-        like, 2);
+        like, 2, AutoresetMode::kNextStep, GetParam());
     ADD_FAILURE() << "no error";
   } catch (const std::runtime_error& e) {
     EXPECT_THAT(e.what(), HasSubstr("env 2 (not built) on worker 1"));
@@ -251,12 +259,17 @@ TEST(ProcessVectorEnvTest, BadArgumentsAndAFailingFactory) {
           return EnvFactory(
               [](int) -> std::unique_ptr<Env> { return std::make_unique<PidEnv>(3); });
         },
-        like, 1);
+        like, 2, AutoresetMode::kNextStep, GetParam());
     ADD_FAILURE() << "no error";
   } catch (const std::invalid_argument& e) {
     EXPECT_THAT(e.what(), HasSubstr("differ from those the vector env was laid out for"));
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(Workers, ProcessVectorEnvTest, ::testing::Bool(),
+                         [](const ::testing::TestParamInfo<bool>& param_info) {
+                           return param_info.param ? "CallerStepsWorker0" : "AllInChildren";
+                         });
 
 }  // namespace
 }  // namespace pixelgym::vector
