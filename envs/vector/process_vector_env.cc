@@ -465,9 +465,15 @@ struct ProcessVectorEnv::Shared {
     alignas(kAlign) std::atomic<std::int32_t> parent_sleeping{0};
   };
   // Whether worker w sent a reply frame for the current call (else: done, nothing to report).
+  // Also: steps ordered (a step has no arguments to send, the actions being in the batch: the
+  // parent bumps `steps` instead of sending a frame) and whether the worker sleeps (the parent
+  // then sends an empty frame to wake it).
   struct alignas(kAlign) Slot {
     std::atomic<std::int32_t> sent{0};
+    std::atomic<std::uint32_t> steps{0};
+    std::atomic<std::int32_t> sleeping{0};
   };
+  static_assert(std::atomic<std::uint32_t>::is_always_lock_free);
   static_assert(std::atomic<std::int32_t>::is_always_lock_free);
 
   Shared(int workers, std::size_t size)
@@ -685,8 +691,42 @@ void ProcessVectorEnv::start_worker(int w, const WorkerFactory& make_worker_envs
       answer(error_reply(), true);
       ::_exit(1);
     }
+    Shared::Slot& slot = shared.slots[w];
+    std::uint32_t steps = 0;
     std::string command;
-    while ((spin_ && readable_within(fd, kSpin), receive_frame(fd, command))) {
+    // The next command: a step ordered through `slot`, or a frame on the socket (empty frames
+    // are wakeups). False: the parent is gone.
+    const auto next_command = [&] {
+      const auto ordered = [&] { return slot.steps.load(std::memory_order_acquire) != steps; };
+      for (;;) {
+        const auto deadline = std::chrono::steady_clock::now() + kSpin;
+        bool readable = false;
+        for (unsigned k = 1; spin_ && !readable && !ordered(); ++k) {
+          if (k % 8 == 0) {
+            readable = readable_within(fd, std::chrono::microseconds(0));
+            if (std::chrono::steady_clock::now() >= deadline) break;
+          }
+          ::sched_yield();
+        }
+        if (!readable && !ordered()) {
+          slot.sleeping.store(1);
+          if (!ordered()) {
+            pollfd in{fd, POLLIN, 0};
+            while (::poll(&in, 1, -1) < 0 && errno == EINTR) {
+            }
+          }
+          slot.sleeping.store(0);
+        }
+        if (ordered()) {
+          ++steps;
+          command.assign(1, static_cast<char>(Op::kStep));
+          return true;
+        }
+        if (!receive_frame(fd, command)) return false;
+        if (!command.empty()) return true;
+      }
+    };
+    while (next_command()) {
       bool content = true;
       const Writer reply = serve(*block->runner, command, block->actions, content);
       if (!answer(reply, content) || static_cast<Op>(command.at(0)) == Op::kClose) break;
@@ -707,11 +747,15 @@ std::vector<std::string> ProcessVectorEnv::call(const std::vector<std::string>& 
   shared_->control->remaining.store(asked);
   for (std::size_t w = first_child; w < n; ++w) {
     if (commands[w].empty()) continue;
-    if (send_frame(workers_[w].fd, commands[w])) {
-      pending[w] = 1;
+    Shared::Slot& slot = shared_->slots[w];
+    bool sent = true;
+    if (static_cast<Op>(commands[w][0]) == Op::kStep) {
+      slot.steps.fetch_add(1);
+      if (slot.sleeping.load() != 0) sent = send_frame(workers_[w].fd, std::string());
     } else {
-      died[w] = 1;
+      sent = send_frame(workers_[w].fd, commands[w]);
     }
+    (sent ? pending : died)[w] = 1;
   }
   // This process's own envs step while the children step theirs.
   std::string own;
