@@ -112,6 +112,21 @@ TEST(PixelgymCliTest, InfoShowsSpacesAndConfigKeys) {
 // info answers from the spec (Registry::describe): with OpenGL broken (GALLIUM_DRIVER names no
 // driver, so creating a context fails or crashes, as the snapshot shows) it still prints every
 // env's spaces, each observation key's range, the cameras and the time limit.
+// A machine whose libEGL.so.1 cannot be loaded (here: an empty file found first on the library
+// path): asking for EGL names the library and the packages to install.
+TEST(PixelgymCliTest, AnUnloadableLibEglNamesThePackagesToInstall) {
+  const std::filesystem::path folder =
+      std::filesystem::path(PIXELGYM_TEST_OUTPUT_DIR) / "cli" / "broken_egl";
+  std::filesystem::remove_all(folder);
+  std::filesystem::create_directories(folder);
+  std::ofstream(folder / "libEGL.so.1").flush();
+  const CliRun result = run("rollout CartPoleSwingup-v1 --episodes 1 --set render_backend=egl",
+                            "LD_LIBRARY_PATH=" + folder.string());
+  EXPECT_NE(result.exit_code, 0) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("cannot load libEGL.so.1"));
+  EXPECT_THAT(result.output, HasSubstr("install libegl1 and libegl-mesa0"));
+}
+
 TEST(PixelgymCliTest, InfoShowsRangesCamerasAndLimitsWithoutOpenGl) {
 #if defined(__SANITIZE_ADDRESS__)
   // info's renderer line tries EGL too, and Mesa's EGL leaks 6 KB when its display fails to open,
