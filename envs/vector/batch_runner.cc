@@ -64,7 +64,7 @@ void add_info(ValueDict& infos, const Info& info, int i, int n) {
 
 }  // namespace
 
-void check_reset_mask(const VectorEnv& envs, const Array& reset_mask) {
+void check_reset_mask(const VectorEnv& envs, const Array& reset_mask, bool failed) {
   const int n = envs.num_envs();
   if (reset_mask.dtype() != DType::kBool || reset_mask.shape() != Shape{n}) {
     throw std::invalid_argument(envs.name() + ": reset() reset_mask must be bool (" +
@@ -74,6 +74,10 @@ void check_reset_mask(const VectorEnv& envs, const Array& reset_mask) {
   if (std::none_of(mask, mask + n, [](bool b) { return b; })) {
     throw std::invalid_argument(envs.name() + ": reset() reset_mask must have a true entry, got " +
                                 reset_mask.to_string());
+  }
+  if (failed) {
+    throw ResetNeeded(envs.name() +
+                      ": reset() with a mask after a failed call; call reset() without a mask");
   }
 }
 
@@ -331,13 +335,7 @@ void BatchRunner::require_usable(const char* method) const {
 
 const VectorResetResult& BatchRunner::do_reset(std::optional<std::uint64_t> seed,
                                                const Options& options, const Array* reset_mask) {
-  if (reset_mask != nullptr) {
-    check_reset_mask(*this, *reset_mask);
-    if (failed_) {
-      throw ResetNeeded(name() +
-                        ": reset() with a mask after a failed call; call reset() without a mask");
-    }
-  }
+  if (reset_mask != nullptr) check_reset_mask(*this, *reset_mask, failed_);
   require_usable("reset()");
   seed_ = seed;
   options_ = &options;

@@ -34,8 +34,9 @@ struct BatchBuffers {
 };
 
 /// Throws std::invalid_argument naming `envs` unless `reset_mask` is a bool (num_envs,) array
-/// with a true entry (VectorEnv::reset's mask).
-void check_reset_mask(const VectorEnv& envs, const Array& reset_mask);
+/// with a true entry (VectorEnv::reset's mask), then ResetNeeded when `failed` (a failed call
+/// leaves only a full reset).
+void check_reset_mask(const VectorEnv& envs, const Array& reset_mask, bool failed);
 /// Throws std::invalid_argument naming `envs` and `method` unless `actions` are laid out as
 /// envs.action_space().
 void check_actions(const VectorEnv& envs, const Value& actions, const char* method);

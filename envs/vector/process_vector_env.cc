@@ -778,14 +778,16 @@ std::vector<std::string> ProcessVectorEnv::await(std::vector<std::uint8_t> pendi
   const auto any_died = [&] {
     return std::any_of(died.begin(), died.end(), [](auto d) { return d != 0; });
   };
-  // Reads one frame of worker w's: a reply is kept, a wakeup ignored; the end of the connection
-  // means the worker is gone.
+  // Reads one frame of worker w's: a reply is kept (and the worker is not watched again in this
+  // call: one that replies and then exits, as after a failed build, has answered), a wakeup
+  // ignored; the end of the connection means the worker is gone.
   const auto read_frame = [&](std::size_t w) {
     std::string frame;
     if (!receive_frame(workers_[w].fd, frame)) {
       died[w] = 1;
     } else if (!frame.empty()) {
       replies[w] = std::move(frame);
+      pending[w] = 0;
     }
   };
   std::vector<pollfd> fds;
@@ -832,7 +834,7 @@ std::vector<std::string> ProcessVectorEnv::await(std::vector<std::uint8_t> pendi
   }
   // Every worker is done: collect the replies still in their sockets.
   for (std::size_t w = 0; w < n && !any_died(); ++w) {
-    if (pending[w] == 0) continue;
+    if (pending[w] == 0 || !replies[w].empty()) continue;
     if (shared_->slots[w].sent.load(std::memory_order_relaxed) == 0) {
       replies[w] = std::string(1, static_cast<char>(Status::kOk));
       continue;
@@ -938,16 +940,24 @@ void ProcessVectorEnv::require_usable(const char* method) const {
   }
 }
 
+void ProcessVectorEnv::batch_infos(const std::vector<std::string>& replies, Info& infos) {
+  infos.clear();
+  try {
+    for (std::size_t w = 0; w < workers_.size(); ++w) {
+      if (replies[w].empty()) continue;
+      const Worker& worker = workers_[w];
+      merge_rows(infos, Reader(replies[w]).value().dict(), worker.first, worker.count, num_envs_);
+    }
+  } catch (const std::invalid_argument& e) {
+    failed_ = true;
+    throw std::invalid_argument(name() + ": " + e.what());
+  }
+}
+
 const VectorResetResult& ProcessVectorEnv::do_reset(std::optional<std::uint64_t> seed,
                                                     const Options& options,
                                                     const Array* reset_mask) {
-  if (reset_mask != nullptr) {
-    check_reset_mask(*this, *reset_mask);
-    if (failed_) {
-      throw ResetNeeded(name() +
-                        ": reset() with a mask after a failed call; call reset() without a mask");
-    }
-  }
+  if (reset_mask != nullptr) check_reset_mask(*this, *reset_mask, failed_);
   require_usable("reset()");
   std::vector<std::string> commands(workers_.size());
   for (std::size_t w = 0; w < workers_.size(); ++w) {
@@ -970,18 +980,7 @@ const VectorResetResult& ProcessVectorEnv::do_reset(std::optional<std::uint64_t>
     failed_ = false;
     has_reset_ = true;
   }
-  reset_result_.infos.clear();
-  try {
-    for (std::size_t w = 0; w < workers_.size(); ++w) {
-      if (replies[w].empty()) continue;
-      const Worker& worker = workers_[w];
-      merge_rows(reset_result_.infos, Reader(replies[w]).value().dict(), worker.first, worker.count,
-                 num_envs_);
-    }
-  } catch (const std::invalid_argument& e) {
-    failed_ = true;
-    throw std::invalid_argument(name() + ": " + e.what());
-  }
+  batch_infos(replies, reset_result_.infos);
   for (int i = 0; i < num_envs_; ++i) {
     if (reset_mask == nullptr || reset_mask->data<bool>()[i])
       ended_[static_cast<std::size_t>(i)] = 0;
@@ -999,18 +998,7 @@ const VectorStepResult& ProcessVectorEnv::do_step(const Value& actions) {
   const std::vector<std::string> commands(workers_.size(), Writer(Op::kStep).frame());
   std::vector<std::string> replies = call(commands, "step()");
   throw_first_error(replies, true);
-  step_result_.infos.clear();
-  try {
-    for (std::size_t w = 0; w < workers_.size(); ++w) {
-      if (replies[w].empty()) continue;
-      const Worker& worker = workers_[w];
-      merge_rows(step_result_.infos, Reader(replies[w]).value().dict(), worker.first, worker.count,
-                 num_envs_);
-    }
-  } catch (const std::invalid_argument& e) {
-    failed_ = true;
-    throw std::invalid_argument(name() + ": " + e.what());
-  }
+  batch_infos(replies, step_result_.infos);
   const bool* terminated = step_result_.terminated.data<bool>();
   const bool* truncated = step_result_.truncated.data<bool>();
   for (std::size_t i = 0; i < ended_.size(); ++i) {

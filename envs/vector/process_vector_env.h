@@ -111,6 +111,8 @@ class ProcessVectorEnv final : public VectorEnv {
   // Throws the lowest worker's error among `replies`; returns the successful replies' bodies.
   void throw_first_error(std::vector<std::string>& replies, bool poison);
   void require_usable(const char* method) const;
+  // Batches the replies' infos into `infos` (each worker's at its rows).
+  void batch_infos(const std::vector<std::string>& replies, Info& infos);
   void end_workers() noexcept;
 
   int num_envs_;
