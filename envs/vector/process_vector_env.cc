@@ -13,6 +13,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstring>
+#include <mutex>
 #include <new>
 #include <stdexcept>
 #include <thread>
@@ -360,6 +361,31 @@ void merge_rows(ValueDict& infos, const ValueDict& part, std::int64_t first, std
   }
 }
 
+// The parent's ends of every worker socket this process holds, of every ProcessVectorEnv: a
+// child closes them all at once, or it would keep another worker from seeing its parent close
+// (and that vector env's destructor would wait, then kill it).
+std::mutex& parent_fds_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+std::vector<int>& parent_fds() {
+  static std::vector<int> fds;
+  return fds;
+}
+void add_parent_fd(int fd) {
+  const std::lock_guard<std::mutex> lock(parent_fds_mutex());
+  parent_fds().push_back(fd);
+}
+void remove_parent_fd(int fd) {
+  const std::lock_guard<std::mutex> lock(parent_fds_mutex());
+  std::vector<int>& fds = parent_fds();
+  fds.erase(std::remove(fds.begin(), fds.end(), fd), fds.end());
+}
+std::vector<int> parent_fds_now() {
+  const std::lock_guard<std::mutex> lock(parent_fds_mutex());
+  return parent_fds();
+}
+
 std::string describe_exit(int status) {
   if (WIFSIGNALED(status)) {
     const int sig = WTERMSIG(status);
@@ -645,6 +671,8 @@ void ProcessVectorEnv::start_worker(int w, const WorkerFactory& make_worker_envs
     throw std::runtime_error(name() + ": cannot start worker " + std::to_string(w) +
                              ": socketpair: " + std::strerror(errno));
   }
+  // Taken before fork(): the child must not lock what another thread may hold at that moment.
+  const std::vector<int> inherited = parent_fds_now();
   const pid_t pid = ::fork();
   if (pid < 0) {
     const int error = errno;
@@ -657,28 +685,37 @@ void ProcessVectorEnv::start_worker(int w, const WorkerFactory& make_worker_envs
     ::close(ends[1]);
     worker.pid = pid;
     worker.fd = ends[0];
+    add_parent_fd(worker.fd);
     return;
   }
-
-  // The worker. It keeps only its own end of its socket: a worker that holds another's would
-  // keep the parent from seeing that one die.
-  ::close(ends[0]);
-  for (int v = 0; v < w; ++v) {
-    if (workers_[static_cast<std::size_t>(v)].fd >= 0)
-      ::close(workers_[static_cast<std::size_t>(v)].fd);
+  // The worker: whatever goes wrong, it must never return into a copy of the caller's program.
+  try {
+    serve_as_worker(w, ends, inherited, make_worker_envs);
+  } catch (...) {
   }
+  ::_exit(2);
+}
+
+void ProcessVectorEnv::serve_as_worker(int w, const int ends[2], const std::vector<int>& inherited,
+                                       const WorkerFactory& make_worker_envs) {
+  // It keeps only its own end of its socket: a worker that holds another's would keep the parent
+  // from seeing that one die.
+  ::close(ends[0]);
+  for (const int fd : inherited) ::close(fd);
   const int fd = ends[1];
   Shared& shared = *shared_;
-  // Sends `reply` unless it says only "done" (`content` false), then counts this worker done,
-  // waking the parent when it is the last one and the parent sleeps. False: the parent is gone.
+  // Answers a call: `reply` is sent unless it says only "done" (`content` false). False: the
+  // parent is gone. Counts this worker done first, waking the parent when it is the last one and
+  // the parent sleeps, and only then sends the reply: so any wakeup goes out while the parent still
+  // watches this worker's socket (it stops once it has read the reply), and a worker that dies
+  // after counting itself done is seen as the end of its socket where its reply should be.
   const auto answer = [&](const Writer& reply, bool content) {
-    if (content && !send_frame(fd, reply.frame())) return false;
     shared.slots[w].sent.store(content ? 1 : 0, std::memory_order_relaxed);
     if (shared.control->remaining.fetch_sub(1) == 1 &&
-        shared.control->parent_sleeping.load() != 0) {
-      return send_frame(fd, std::string());
+        shared.control->parent_sleeping.load() != 0 && !send_frame(fd, std::string())) {
+      return false;
     }
-    return true;
+    return !content || send_frame(fd, reply.frame());
   };
   {
     std::unique_ptr<Block> block;
@@ -710,7 +747,9 @@ void ProcessVectorEnv::start_worker(int w, const WorkerFactory& make_worker_envs
         }
         if (!readable && !ordered()) {
           slot.sleeping.store(1);
-          if (!ordered()) {
+          // seq_cst, as the parent's bump and its look at `sleeping`: one of the two sees the
+          // other.
+          if (slot.steps.load() == steps) {
             pollfd in{fd, POLLIN, 0};
             while (::poll(&in, 1, -1) < 0 && errno == EINTR) {
             }
@@ -787,7 +826,7 @@ std::vector<std::string> ProcessVectorEnv::await(std::vector<std::uint8_t> pendi
       died[w] = 1;
     } else if (!frame.empty()) {
       replies[w] = std::move(frame);
-      pending[w] = 0;
+      pending[w] = 0;  // it counted itself done before it sent its reply
     }
   };
   std::vector<pollfd> fds;
@@ -815,6 +854,7 @@ std::vector<std::string> ProcessVectorEnv::await(std::vector<std::uint8_t> pendi
     const int ready = ::poll(fds.data(), fds.size(), kPollMs);
     control.parent_sleeping.store(0);
     if (ready < 0 && errno != EINTR) {
+      dead_ = true;  // the workers may still be running this call
       throw std::runtime_error(name() + ": " + method + ": poll: " + std::strerror(errno));
     }
     for (std::size_t k = 0; k < fds.size(); ++k) {
@@ -893,7 +933,10 @@ void ProcessVectorEnv::throw_first_error(std::vector<std::string>& replies, bool
 void ProcessVectorEnv::end_workers() noexcept {
   // A worker whose socket closes destroys its envs and exits.
   for (Worker& worker : workers_) {
-    if (worker.fd >= 0) ::close(worker.fd);
+    if (worker.fd >= 0) {
+      remove_parent_fd(worker.fd);
+      ::close(worker.fd);
+    }
     if (worker.own) worker.reaped = true;
     worker.fd = -1;
   }

@@ -15,10 +15,14 @@
 
 namespace pixelgym::vector {
 
-/// A VectorEnv whose envs live in `num_workers()` child processes, each running a contiguous
-/// block of them (8 envs on 3 workers: envs 0-2, 3-5 and 6-7) in a loop. Why processes: each
-/// process has its own copy of everything the envs use, the rasterizer included, so the workers
-/// scale as independent processes do (a thread pool shares one Mesa: see docs/vector.md).
+/// A VectorEnv whose envs are stepped by `num_workers()` worker processes, each running a
+/// contiguous block of them (8 envs on 3 workers: envs 0-2, 3-5 and 6-7) in a loop. With
+/// `caller_steps_envs` (the default) worker 0 is the calling process, which steps its block while
+/// the child processes step theirs (as AsyncVectorEnv's calling thread runs thread 0's share);
+/// without it every worker is a child (an env that crashes cannot take the caller with it). Why
+/// processes: each has its own copy of everything the envs use, the rasterizer included, so the
+/// workers scale as independent processes do (a thread pool shares one Mesa: see
+/// docs/vector.md).
 ///
 /// Memory. The observation batch, the actions, the rewards and the flags are arrays in memory
 /// shared with the workers (mmap): each worker writes its envs' observations straight into their
@@ -26,11 +30,14 @@ namespace pixelgym::vector {
 /// varies in size (the batched infos, final_obs under kSameStep, errors, render() frames) comes
 /// back over a socket, only when there is some.
 ///
-/// Workers. They are made by fork() in the constructor, so whatever the process registered (a
+/// Workers. The children are made by fork() in the constructor, before the caller builds any env
+/// of its own, so whatever the process registered (a
 /// user's own tasks in a Registry) reaches them; each calls `make_worker_envs(w)` once and builds
 /// its envs with the factory it returns (so that what they share, such as rendering resources, is
-/// made in the worker). Make a ProcessVectorEnv before the process draws on a GPU: a GPU context
-/// does not survive fork(). A worker serves one vector env and ends with it.
+/// made in the worker). Make a ProcessVectorEnv before the process draws on a GPU (a GPU context
+/// does not survive fork()), and while no other thread is making envs (fork() copies only the
+/// calling thread: a lock another thread held stays taken in the child). A worker serves one
+/// vector env and ends with it.
 ///
 /// Results are byte-identical to SyncVectorEnv's for the same seeds and actions, whatever the
 /// number of workers, under every autoreset mode.
@@ -101,6 +108,10 @@ class ProcessVectorEnv final : public VectorEnv {
   // Builds worker w's envs (in the process that will run them).
   std::unique_ptr<Block> build_block(int w, const WorkerFactory& make_worker_envs);
   void start_worker(int w, const WorkerFactory& make_worker_envs);
+  // The child's side of start_worker: builds worker w's envs and serves calls until the parent
+  // closes its socket or sends kClose. `inherited`: the parent's sockets it must close.
+  void serve_as_worker(int w, const int ends[2], const std::vector<int>& inherited,
+                       const WorkerFactory& make_worker_envs);
   // Sends `command` to each worker for which it is not empty and returns each one's reply (empty
   // for those not called), in worker order; a dead worker throws (see Errors).
   std::vector<std::string> call(const std::vector<std::string>& commands, const char* method);

@@ -231,6 +231,23 @@ TEST_P(ProcessVectorEnvTest, DestroyingWithoutCloseEndsTheWorkers) {
   for (const int pid : pids) EXPECT_FALSE(alive(pid)) << pid;
 }
 
+// The children of a second vector env are forked while the first one's sockets are open: they
+// must not keep them, or the first one's workers would never see it go (its destructor would
+// wait, then kill them).
+TEST_P(ProcessVectorEnvTest, AnotherVectorEnvsChildrenDoNotKeepTheFirstsWorkersAlive) {
+  const UserRegistry registry;
+  auto first = make_process(registry, 2, 2);
+  const int first_child = dynamic_cast<const ProcessVectorEnv&>(*first).worker_pid(1);
+  const auto second = make_process(registry, 2, 2);
+  first->reset(0);
+  second->reset(0);
+  const auto start = std::chrono::steady_clock::now();
+  first.reset();  // without close(): its children see their sockets close
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(2));
+  EXPECT_FALSE(alive(first_child));
+  EXPECT_EQ(second->step(actions({0, 0})).rewards.data<double>()[1], 2.0);
+}
+
 TEST_P(ProcessVectorEnvTest, BadArgumentsAndAFailingFactory) {
   const UserRegistry registry;
   EXPECT_THROW(make_process(registry, 2, -1), std::invalid_argument);
