@@ -283,58 +283,43 @@ std::size_t layout_bytes(const Value& value) {
   return bytes;
 }
 
-// A Value of `like`'s structure, dtypes and shapes whose arrays are carved from `cursor`.
-Value place(const Value& like, std::byte*& cursor, const std::shared_ptr<void>& owner) {
-  if (like.is_array()) {
-    const Array& a = like.array();
-    Array placed = Array::from_external(cursor, a.dtype(), a.shape(), owner);
-    cursor += aligned(a.nbytes());
-    return placed;
-  }
-  if (like.is_dict()) {
+// A Value of `value`'s structure (Dicts and Tuples alike) whose arrays are `f(array)`, in order.
+template <typename F>
+Value map_arrays(const Value& value, const F& f) {
+  if (value.is_array()) return f(value.array());
+  if (value.is_dict()) {
     ValueDict dict;
-    for (std::size_t k = 0; k < like.dict().size(); ++k) {
-      dict.insert(like.dict().keys()[k], place(like.dict().values()[k], cursor, owner));
+    for (std::size_t k = 0; k < value.dict().size(); ++k) {
+      dict.insert(value.dict().keys()[k], map_arrays(value.dict().values()[k], f));
     }
     return dict;
   }
   std::vector<Value> items;
-  for (const Value& item : like.tuple().items()) items.push_back(place(item, cursor, owner));
+  for (const Value& item : value.tuple().items()) items.push_back(map_arrays(item, f));
   return ValueTuple(std::move(items));
+}
+
+// A Value of `like`'s structure, dtypes and shapes whose arrays are carved from `cursor`.
+Value place(const Value& like, std::byte*& cursor, const std::shared_ptr<void>& owner) {
+  return map_arrays(like, [&](const Array& a) {
+    Array placed = Array::from_external(cursor, a.dtype(), a.shape(), owner);
+    cursor += aligned(a.nbytes());
+    return placed;
+  });
 }
 
 // Rows [begin, end) of every array of a batch, as views.
 Value rows(const Value& batch, std::int64_t begin, std::int64_t end) {
-  if (batch.is_array()) return batch.array().slice(begin, end);
-  if (batch.is_dict()) {
-    ValueDict dict;
-    for (std::size_t k = 0; k < batch.dict().size(); ++k) {
-      dict.insert(batch.dict().keys()[k], rows(batch.dict().values()[k], begin, end));
-    }
-    return dict;
-  }
-  std::vector<Value> items;
-  for (const Value& item : batch.tuple().items()) items.push_back(rows(item, begin, end));
-  return ValueTuple(std::move(items));
+  return map_arrays(batch, [&](const Array& a) { return a.slice(begin, end); });
 }
 
 // A zero batch of `n` rows with the structure of `part` (whose arrays' leading axis is rows).
 Value grown(const Value& part, std::int64_t n) {
-  if (part.is_array()) {
-    Shape shape = part.array().shape();
+  return map_arrays(part, [&](const Array& a) {
+    Shape shape = a.shape();
     shape.at(0) = n;
-    return Array(part.array().dtype(), shape);
-  }
-  if (part.is_dict()) {
-    ValueDict dict;
-    for (std::size_t k = 0; k < part.dict().size(); ++k) {
-      dict.insert(part.dict().keys()[k], grown(part.dict().values()[k], n));
-    }
-    return dict;
-  }
-  std::vector<Value> items;
-  for (const Value& item : part.tuple().items()) items.push_back(grown(item, n));
-  return ValueTuple(std::move(items));
+    return Array(a.dtype(), shape);
+  });
 }
 
 // Adds a worker's batched infos (leading axis: its `count` envs) to `infos` (leading axis: all
