@@ -42,7 +42,9 @@ install(FILES ${PROJECT_BINARY_DIR}/pixelgymConfig.cmake
 
 # The Debian package (`make deb`, from a build configured with CMAKE_INSTALL_PREFIX=/usr):
 # dpkg-shlibdeps reads the installed programs and libraries and makes the package depend on the
-# Debian packages that hold the libraries they load (Bullet, Mesa's OSMesa, OpenCV, LibTorch ...).
+# Debian packages that hold the libraries they link (Bullet, OpenCV, LibTorch ...). The two GL
+# backends are loaded at run time, so they are named here: OSMesa (render_backend=auto tries it
+# first) as a dependency of a build with it, EGL as a recommendation.
 set(CPACK_GENERATOR DEB)
 set(CPACK_PACKAGE_NAME pixelgym)
 set(CPACK_PACKAGE_VENDOR pixelgym)
@@ -53,7 +55,9 @@ set(CPACK_DEBIAN_PACKAGE_SECTION science)
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
 # Headers include Eigen's; find_package(pixelgym) finds it and Threads.
 set(CPACK_DEBIAN_PACKAGE_DEPENDS "libeigen3-dev (>= 3.4), python3-numpy")
-# The EGL backend loads libEGL at run time (render_backend=egl; OSMesa draws without it).
+if(PIXELGYM_OSMESA)
+  string(APPEND CPACK_DEBIAN_PACKAGE_DEPENDS ", libosmesa6")
+endif()
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "libegl1, libegl-mesa0, libgl1-mesa-dri")
 set(CPACK_PACKAGING_INSTALL_PREFIX ${CMAKE_INSTALL_PREFIX})
 include(CPack)

@@ -43,28 +43,54 @@ void default_llvmpipe_threads() {
 #if PIXELGYM_HAS_OSMESA
 namespace {
 
-// Copy 0: the linked library.
-std::unique_ptr<GlLibrary> load_linked() {
+// Copy 0's file, by its soname (OSMesa's since Mesa 10). Loaded at run time rather than linked, so
+// a machine without it starts and draws with EGL, and asking for OSMesa says what to install.
+constexpr const char* kOSMesaLibrary = "libOSMesa.so.8";
+
+// Copy 0: libOSMesa loaded into the process's global scope, as a linked library would be. Its
+// entry points are looked up there (RTLD_DEFAULT), so a function the program itself defines
+// first (a test counting contexts) is the one called, as with a linked library. Throws
+// std::runtime_error naming the package when the library does not load.
+std::unique_ptr<GlLibrary> load_base(void*& handle) {
+  handle = ::dlopen(kOSMesaLibrary, RTLD_NOW | RTLD_GLOBAL);  // never closed, as private copies
+  if (handle == nullptr) {
+    const char* error = ::dlerror();
+    throw std::runtime_error(
+        std::string("Context: cannot load ") + kOSMesaLibrary + " (" +
+        (error != nullptr ? error : "dlopen failed") +
+        "); install libosmesa6 (Debian and Ubuntu package name; Mesa 25.1 and later no longer "
+        "ship OSMesa), or draw with EGL: render_backend=egl");
+  }
   auto library = std::make_unique<GlLibrary>();
-  library->create_context_attribs = &::OSMesaCreateContextAttribs;
-  library->make_current = &::OSMesaMakeCurrent;
-  library->get_current_context = &::OSMesaGetCurrentContext;
-  library->destroy_context = &::OSMesaDestroyContext;
-  const std::string missing = load_gl_functions(library->gl, &::OSMesaGetProcAddress);
+  std::string missing;
+  const auto symbol = [&](const char* name) {
+    void* address = ::dlsym(RTLD_DEFAULT, name);
+    if (address == nullptr && missing.empty()) missing = name;
+    return address;
+  };
+  library->create_context_attribs = reinterpret_cast<decltype(library->create_context_attribs)>(
+      symbol("OSMesaCreateContextAttribs"));
+  library->make_current =
+      reinterpret_cast<decltype(library->make_current)>(symbol("OSMesaMakeCurrent"));
+  library->get_current_context =
+      reinterpret_cast<decltype(library->get_current_context)>(symbol("OSMesaGetCurrentContext"));
+  library->destroy_context =
+      reinterpret_cast<decltype(library->destroy_context)>(symbol("OSMesaDestroyContext"));
+  auto* get_proc_address =
+      reinterpret_cast<OSMESAproc (*)(const char*)>(symbol("OSMesaGetProcAddress"));
+  if (missing.empty()) missing = load_gl_functions(library->gl, get_proc_address);
   if (!missing.empty()) {
-    throw std::runtime_error("Context: libOSMesa has no " + missing +
-                             " (OSMesaGetProcAddress returned null)");
+    throw std::runtime_error(std::string("Context: ") + kOSMesaLibrary + " has no " + missing);
   }
   return library;
 }
 
-// The file copy 0 was loaded from (OSMesaGetProcAddress: a function no test interposes).
-std::string linked_library_file() {
+// The file copy 0 was loaded from (found through its OSMesaGetProcAddress, which no test
+// interposes).
+std::string base_library_file(void* base_handle) {
   Dl_info info{};
-  if (::dladdr(reinterpret_cast<void*>(&::OSMesaGetProcAddress), &info) == 0 ||
-      info.dli_fname == nullptr) {
-    return "";
-  }
+  void* address = ::dlsym(base_handle, "OSMesaGetProcAddress");
+  if (address == nullptr || ::dladdr(address, &info) == 0 || info.dli_fname == nullptr) return "";
   return info.dli_fname;
 }
 
@@ -98,8 +124,8 @@ void tune_copy_malloc(void* handle) {
 }
 
 // A private copy, or null with `why` set; `handle` is set once the library is loaded.
-std::unique_ptr<GlLibrary> load_private(int copy, std::string& why, void*& handle) {
-  const std::string file = linked_library_file();
+std::unique_ptr<GlLibrary> load_private(int copy, const std::string& file, std::string& why,
+                                        void*& handle) {
   if (file.empty()) {
     why = "cannot find the file libOSMesa was loaded from (dladdr failed)";
     return nullptr;
@@ -144,7 +170,8 @@ struct Copies {
   std::mutex mutex;
   std::array<std::unique_ptr<GlLibrary>, kMostCopies> loaded;
   std::array<std::string, kMostCopies> why_not;
-  std::array<void*, kMostCopies> handles{};  // of the private copies loaded (dlmopen's)
+  // dlopen's of copy 0 (once loaded), dlmopen's of the private copies loaded.
+  std::array<void*, kMostCopies> handles{};
   bool fallback_reported = false;
 };
 
@@ -159,10 +186,12 @@ const GlLibrary& library(int copy) {
   Copies& all = copies();
   const std::lock_guard<std::mutex> lock(all.mutex);
   const auto index = static_cast<std::size_t>(copy);
-  if (all.loaded[0] == nullptr) all.loaded[0] = load_linked();
+  // A failure is not kept: a later context tries again (after libosmesa6 was installed, say).
+  if (all.loaded[0] == nullptr) all.loaded[0] = load_base(all.handles[0]);
   if (all.loaded[index] == nullptr && all.why_not[index].empty()) {
     std::string why;
-    all.loaded[index] = load_private(copy, why, all.handles[index]);
+    all.loaded[index] =
+        load_private(copy, base_library_file(all.handles[0]), why, all.handles[index]);
     if (all.loaded[index] == nullptr) {
       all.why_not[index] = why;
       if (!all.fallback_reported) {

@@ -13,8 +13,10 @@ namespace pixelgym::render {
 /// (dlmopen) is a separate copy, with its own screen and lock, and threads drawing with contexts
 /// of different copies run in parallel (figures: docs/design-notes.md, "Rendering").
 ///
-/// Copy 0 is the libOSMesa the process links. Copies 1, 2, ... are private copies of the same
-/// file, loaded when a context first asks for them and kept until the process ends. The copies run
+/// Copy 0 is libOSMesa.so.8 loaded into the process (dlopen, when the first OSMesa context is
+/// made; not linked, so a machine without it still runs EGL). Copies 1, 2, ... are private
+/// copies of the same file, loaded when a context first asks for them and kept until the process
+/// ends. The copies run
 /// the same code on the same machine, so a scene drawn with any copy gives the same bytes.
 ///
 /// A context is created in the copy its creator names (Context's `mesa_copy`, ContextGroup's; copy

@@ -80,7 +80,7 @@ struct ApiRollout {
 TEST(PixelgymCliTest, TheToolDoesNotLoadLibTorch) {
   const CliRun loaded = run("--version", "LD_TRACE_LOADED_OBJECTS=1");
   EXPECT_EQ(loaded.exit_code, 0) << loaded.output;
-  EXPECT_THAT(loaded.output, HasSubstr("libOSMesa"));
+  EXPECT_THAT(loaded.output, HasSubstr("libpixelgym"));
   std::vector<std::string> torch;
   std::istringstream lines(loaded.output);
   for (std::string line; std::getline(lines, line);) {
@@ -125,6 +125,27 @@ TEST(PixelgymCliTest, AnUnloadableLibEglNamesThePackagesToInstall) {
   EXPECT_NE(result.exit_code, 0) << result.output;
   EXPECT_THAT(result.output, HasSubstr("cannot load libEGL.so.1"));
   EXPECT_THAT(result.output, HasSubstr("install libegl1 and libegl-mesa0"));
+}
+
+// libOSMesa is loaded when an OSMesa context is first made, not linked: without it the tool starts,
+// and asking for OSMesa names the package.
+TEST(PixelgymCliTest, AnUnloadableLibOSMesaNamesThePackageToInstall) {
+  const std::filesystem::path folder =
+      std::filesystem::path(PIXELGYM_TEST_OUTPUT_DIR) / "cli" / "broken_osmesa";
+  std::filesystem::remove_all(folder);
+  std::filesystem::create_directories(folder);
+  std::ofstream(folder / "libOSMesa.so.8").flush();
+  const std::string without_osmesa = "LD_LIBRARY_PATH=" + folder.string();
+  EXPECT_EQ(run("list", without_osmesa).exit_code, 0);
+  const CliRun result =
+      run("rollout CartPoleSwingup-v1 --episodes 1 --set render_backend=osmesa", without_osmesa);
+  EXPECT_NE(result.exit_code, 0) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("cannot load libOSMesa.so.8"));
+  EXPECT_THAT(result.output, HasSubstr("install libosmesa6"));
+  // render_backend=auto draws with EGL instead.
+  const CliRun fallback = run(
+      "snapshot CartPoleSwingup-v1 --out " + fresh_output("without_osmesa.png"), without_osmesa);
+  EXPECT_EQ(fallback.exit_code, 0) << fallback.output;
 }
 
 TEST(PixelgymCliTest, InfoShowsRangesCamerasAndLimitsWithoutOpenGl) {
