@@ -47,6 +47,30 @@ namespace {
 // a machine without it starts and draws with EGL, and asking for OSMesa says what to install.
 constexpr const char* kOSMesaLibrary = "libOSMesa.so.8";
 
+// Fills `library`'s OSMesa entry points and GL table from `lookup` (name -> address, null when
+// missing). Returns the first name missing, or "".
+template <typename Lookup>
+std::string load_entry_points(GlLibrary& library, Lookup lookup) {
+  std::string missing;
+  const auto symbol = [&](const char* name) {
+    void* address = lookup(name);
+    if (address == nullptr && missing.empty()) missing = name;
+    return address;
+  };
+  library.create_context_attribs = reinterpret_cast<decltype(library.create_context_attribs)>(
+      symbol("OSMesaCreateContextAttribs"));
+  library.make_current =
+      reinterpret_cast<decltype(library.make_current)>(symbol("OSMesaMakeCurrent"));
+  library.get_current_context =
+      reinterpret_cast<decltype(library.get_current_context)>(symbol("OSMesaGetCurrentContext"));
+  library.destroy_context =
+      reinterpret_cast<decltype(library.destroy_context)>(symbol("OSMesaDestroyContext"));
+  auto* get_proc_address =
+      reinterpret_cast<OSMESAproc (*)(const char*)>(symbol("OSMesaGetProcAddress"));
+  if (!missing.empty()) return missing;
+  return load_gl_functions(library.gl, get_proc_address);
+}
+
 // Copy 0: libOSMesa loaded into the process's global scope, as a linked library would be. Its
 // entry points are looked up there (RTLD_DEFAULT), so a function the program itself defines
 // first (a test counting contexts) is the one called, as with a linked library. Throws
@@ -62,23 +86,8 @@ std::unique_ptr<GlLibrary> load_base(void*& handle) {
         "ship OSMesa), or draw with EGL: render_backend=egl");
   }
   auto library = std::make_unique<GlLibrary>();
-  std::string missing;
-  const auto symbol = [&](const char* name) {
-    void* address = ::dlsym(RTLD_DEFAULT, name);
-    if (address == nullptr && missing.empty()) missing = name;
-    return address;
-  };
-  library->create_context_attribs = reinterpret_cast<decltype(library->create_context_attribs)>(
-      symbol("OSMesaCreateContextAttribs"));
-  library->make_current =
-      reinterpret_cast<decltype(library->make_current)>(symbol("OSMesaMakeCurrent"));
-  library->get_current_context =
-      reinterpret_cast<decltype(library->get_current_context)>(symbol("OSMesaGetCurrentContext"));
-  library->destroy_context =
-      reinterpret_cast<decltype(library->destroy_context)>(symbol("OSMesaDestroyContext"));
-  auto* get_proc_address =
-      reinterpret_cast<OSMESAproc (*)(const char*)>(symbol("OSMesaGetProcAddress"));
-  if (missing.empty()) missing = load_gl_functions(library->gl, get_proc_address);
+  const std::string missing =
+      load_entry_points(*library, [](const char* name) { return ::dlsym(RTLD_DEFAULT, name); });
   if (!missing.empty()) {
     throw std::runtime_error(std::string("Context: ") + kOSMesaLibrary + " has no " + missing);
   }
@@ -140,25 +149,14 @@ std::unique_ptr<GlLibrary> load_private(int copy, const std::string& file, std::
   }
   auto library = std::make_unique<GlLibrary>();
   library->copy = copy;
-  const auto symbol = [&](const char* name) {
-    void* address = ::dlsym(handle, name);
-    if (address == nullptr) why = std::string(file) + " has no " + name;
-    return address;
-  };
-  library->create_context_attribs = reinterpret_cast<decltype(library->create_context_attribs)>(
-      symbol("OSMesaCreateContextAttribs"));
-  library->make_current =
-      reinterpret_cast<decltype(library->make_current)>(symbol("OSMesaMakeCurrent"));
-  library->get_current_context =
-      reinterpret_cast<decltype(library->get_current_context)>(symbol("OSMesaGetCurrentContext"));
-  library->destroy_context =
-      reinterpret_cast<decltype(library->destroy_context)>(symbol("OSMesaDestroyContext"));
-  library->init_thread = reinterpret_cast<void (*)()>(symbol("__ctype_init"));
+  library->init_thread = reinterpret_cast<void (*)()>(::dlsym(handle, "__ctype_init"));
+  if (library->init_thread == nullptr) {
+    why = file + " has no __ctype_init";
+    return nullptr;
+  }
   tune_copy_malloc(handle);
-  auto* get_proc_address =
-      reinterpret_cast<OSMESAproc (*)(const char*)>(symbol("OSMesaGetProcAddress"));
-  if (!why.empty()) return nullptr;
-  const std::string missing = load_gl_functions(library->gl, get_proc_address);
+  const std::string missing =
+      load_entry_points(*library, [handle](const char* name) { return ::dlsym(handle, name); });
   if (!missing.empty()) {
     why = file + " has no " + missing;
     return nullptr;
