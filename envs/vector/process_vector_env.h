@@ -141,7 +141,8 @@ class ProcessVectorEnv final : public VectorEnv {
   Value actions_;                    // in shared memory, laid out as action_space()
   std::vector<std::uint8_t> ended_;  // kDisabled: env i's episode ended at the last step
 
-  bool spin_ = false;  // workers <= cores: wait without sleeping first
+  bool spin_ = false;      // workers <= cores: wait without sleeping first
+  bool own_core_ = false;  // and a core for each process, the caller's included: pause, not yield
   bool has_reset_ = false;
   bool failed_ = false;
   bool dead_ = false;  // a worker died: only close() is left
