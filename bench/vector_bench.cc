@@ -175,10 +175,26 @@ int main(int argc, char** argv) {
     for (int n = 1; n <= max_envs; n *= 2) {
       std::vector<Config> configs;
       // The batched actions every configuration steps through (see the top of this file).
-      const SpacePtr batched_actions = vector::batch_space(pixelgym::make(id)->action_space(), n);
+      const SpacePtr batched_actions = vector::batch_space(*pixelgym::describe(id).action_space, n);
       auto pool = std::make_shared<std::vector<Value>>();
       Rng rng(0);
       for (int k = 0; k < kActionPool; ++k) pool->push_back(batched_actions->sample(rng));
+      vector::VectorOptions modes[] = {
+          {vector::VectorMode::kSync, 0, vector::AutoresetMode::kNextStep},
+          {vector::VectorMode::kAsync, 1, vector::AutoresetMode::kNextStep},
+          {vector::VectorMode::kAsync, 2, vector::AutoresetMode::kNextStep},
+          {vector::VectorMode::kProcess, 0, vector::AutoresetMode::kNextStep},
+          {vector::VectorMode::kProcess, 0, vector::AutoresetMode::kNextStep},
+      };
+      modes[3].num_workers = 1;
+      modes[4].num_workers = 2;
+      const int num_modes = cpu_time ? 1 : 5;
+      // The worker processes are forked first, from a process that has no env yet, as
+      // docs/vector.md advises (a child forked later carries a copy of everything made before).
+      std::shared_ptr<vector::VectorEnv> vector_envs[5];
+      for (int m = num_modes - 1; m >= 0; --m) {
+        vector_envs[m] = vector::make_vec(id, n, {}, {}, modes[m]);
+      }
       auto solo = std::make_shared<SoloEnvs>(id, *pool, n);
       configs.push_back({"single-env loop", 1, [solo, pool] { solo->step(); }, {}, {}});
       auto plain = std::make_shared<std::vector<LoopedEnv>>();
@@ -192,17 +208,8 @@ int main(int argc, char** argv) {
                          },
                          {},
                          {}});
-      vector::VectorOptions modes[] = {
-          {vector::VectorMode::kSync, 0, vector::AutoresetMode::kNextStep},
-          {vector::VectorMode::kAsync, 1, vector::AutoresetMode::kNextStep},
-          {vector::VectorMode::kAsync, 2, vector::AutoresetMode::kNextStep},
-          {vector::VectorMode::kProcess, 0, vector::AutoresetMode::kNextStep},
-          {vector::VectorMode::kProcess, 0, vector::AutoresetMode::kNextStep},
-      };
-      modes[3].num_workers = 1;
-      modes[4].num_workers = 2;
-      for (int m = 0; m < (cpu_time ? 1 : 5); ++m) {
-        std::shared_ptr<vector::VectorEnv> env = vector::make_vec(id, n, {}, {}, modes[m]);
+      for (int m = 0; m < num_modes; ++m) {
+        std::shared_ptr<vector::VectorEnv> env = vector_envs[m];
         env->reset(0);
         auto next = std::make_shared<std::size_t>(0);
         configs.push_back({names[m + 1],
