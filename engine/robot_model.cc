@@ -60,6 +60,8 @@ struct XmlFacts {
   std::string xml;  // with <capsule> rewritten as <cylinder>
   // (link, "visual"/"collision", index within that link) of each element that was a capsule.
   std::set<std::tuple<std::string, std::string, int>> capsules;
+  // Joint name -> <dynamics stiffness>, which urdfdom does not read.
+  std::map<std::string, double> stiffness;
 };
 
 std::string read_file(const std::string& path) {
@@ -211,7 +213,7 @@ void check_joint_numbers(const TiXmlElement* joint, const std::string& name,
   check_magnitudes(limit, "effort", kMaxEffort, "N m or N", path, where);
   check_magnitudes(limit, "velocity", kMaxSpeed, "rad/s or m/s", path, where);
   const TiXmlElement* dynamics = joint->FirstChildElement("dynamics");
-  for (const char* coefficient : {"damping", "friction"}) {
+  for (const char* coefficient : {"damping", "friction", "stiffness"}) {
     check_numbers(dynamics, coefficient, 1, false, path, where);
     check_magnitudes(dynamics, coefficient, kMaxDamping, "N m s/rad, N s/m, N m or N", path, where);
   }
@@ -273,6 +275,22 @@ XmlFacts inspect_xml(const std::string& path) {
     const std::string type = joint->Attribute("type") != nullptr ? joint->Attribute("type") : "";
     if (name.empty()) fail(path, "a <joint> has no name");
     check_joint_numbers(joint, name, path);
+    if (TiXmlElement* dynamics = joint->FirstChildElement("dynamics")) {
+      double stiffness = 0.0;
+      if (dynamics->QueryDoubleAttribute("stiffness", &stiffness) == TIXML_SUCCESS) {
+        // urdfdom refuses a <dynamics> with neither damping nor friction.
+        dynamics->RemoveAttribute("stiffness");
+        if (dynamics->Attribute("damping") == nullptr &&
+            dynamics->Attribute("friction") == nullptr) {
+          dynamics->SetAttribute("damping", "0");
+        }
+        if (stiffness < 0) {
+          fail(path, "joint \"" + name + "\" has a negative stiffness (" +
+                         std::to_string(stiffness) + " N m/rad or N/m; a spring needs >= 0)");
+        }
+        facts.stiffness[name] = stiffness;
+      }
+    }
     if (type == "planar" || type == "floating") {
       fail(path, "joint \"" + name + "\" has type " + type +
                      ", which pixelgym does not support inside a robot (supported: revolute, "
@@ -655,6 +673,9 @@ std::shared_ptr<const RobotModel> parse_urdf(const std::string& path, MeshCache&
     if (source.dynamics) {
       joint.damping = source.dynamics->damping;
       joint.friction = source.dynamics->friction;
+    }
+    if (const auto spring = facts.stiffness.find(source.name); spring != facts.stiffness.end()) {
+      joint.stiffness = spring->second;
     }
     links[static_cast<std::size_t>(joint.child_link)].parent_joint =
         static_cast<int>(joints.size());

@@ -128,6 +128,10 @@ struct JointModel {
   double damping = 0.0;
   /// Dry friction (N m or N) from <dynamics>; 0 when the URDF sets none.
   double friction = 0.0;
+  /// A spring towards position 0 (N m / rad or N / m) from <dynamics stiffness="...">, an
+  /// attribute pixelgym adds to URDF (for models such as dm_control's, whose joints have springs;
+  /// other URDF readers ignore it); 0 when the URDF sets none.
+  double stiffness = 0.0;
 
   /// True for every type but kFixed: the joint is one of the robot's degrees of freedom.
   bool movable() const { return type != JointType::kFixed; }

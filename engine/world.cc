@@ -355,6 +355,7 @@ struct World::Impl {
       const JointModel& joint = joints[static_cast<std::size_t>(dof.joint)];
       const double velocity = body.getJointVel(dof.bullet_link);
       double torque = -joint.damping * velocity;
+      if (joint.stiffness != 0.0) torque -= joint.stiffness * body.getJointPos(dof.bullet_link);
       btMultiBodyJointMotor& motor = *robot.motors[d];
       if (dof.mode == ControlMode::kTorque) {
         double command = dof.command;
@@ -411,6 +412,36 @@ struct World::Impl {
                                             std::int64_t step) {
     throw NonFiniteState("World: robot \"" + robot.model->name() + "\" has a non-finite state (" +
                          where + ") after step " + std::to_string(step));
+  }
+
+  // World position of link `link`'s centre of mass (the Bullet link frame's origin).
+  Eigen::Vector3d com_position(const Robot& robot, int link) const {
+    return from_bt(link == 0 ? robot.body->getBaseWorldTransform().getOrigin()
+                             : robot.body->getLink(link - 1).m_cachedWorldTransform.getOrigin());
+  }
+
+  // World velocity of the point of link `link` that is at `point` (world coordinates) now.
+  Eigen::Vector3d point_velocity(const Robot& robot, int link, const Eigen::Vector3d& point) const {
+    const btMultiBody& body = *robot.body;
+    if (link == 0) {
+      const Eigen::Vector3d com = from_bt(body.getBaseWorldTransform().getOrigin());
+      return from_bt(body.getBaseVel()) + from_bt(body.getBaseOmega()).cross(point - com);
+    }
+    // v = J u along each world axis, with J the contact Jacobian of the point.
+    const int n = body.getNumDofs() + 6;
+    scratch_jacobian.resize(n);
+    const btScalar* u = body.getVelocityVector();
+    Eigen::Vector3d velocity;
+    for (int axis = 0; axis < 3; ++axis) {
+      btVector3 direction(0, 0, 0);
+      direction[axis] = 1;
+      body.fillContactJacobianMultiDof(link - 1, to_bt(point), direction, &scratch_jacobian[0],
+                                       scratch_r, scratch_v, scratch_m);
+      double v = 0;
+      for (int k = 0; k < n; ++k) v += scratch_jacobian[k] * u[k];
+      velocity[axis] = v;
+    }
+    return velocity;
   }
 
   Eigen::Isometry3d link_pose(const Robot& robot, int link) const {
@@ -748,30 +779,33 @@ Eigen::Vector3d World::link_linear_velocity(RobotId robot, int link) const {
   check_robot(robot, "link_linear_velocity");
   const Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot.index)];
   check_link("link_linear_velocity", *r.model, link);
-  const Eigen::Isometry3d X_world_link = impl_->link_pose(r, link);
-  if (link == 0) {
-    const Eigen::Vector3d com = from_bt(r.body->getBaseWorldTransform().getOrigin());
-    return from_bt(r.body->getBaseVel()) +
-           from_bt(r.body->getBaseOmega()).cross(X_world_link.translation() - com);
+  return impl_->point_velocity(r, link, impl_->link_pose(r, link).translation());
+}
+
+Eigen::Vector3d World::center_of_mass(RobotId robot) const {
+  check_robot(robot, "center_of_mass");
+  const Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot.index)];
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double mass = 0.0;
+  for (int link = 0; link <= r.body->getNumLinks(); ++link) {
+    const double m = link == 0 ? r.body->getBaseMass() : r.body->getLinkMass(link - 1);
+    sum += m * impl_->com_position(r, link);
+    mass += m;
   }
-  // v = J u along each world axis, with J the contact Jacobian of the link's origin.
-  const btMultiBody& body = *r.body;
-  const int n = body.getNumDofs() + 6;
-  btAlignedObjectArray<btScalar>& jacobian = impl_->scratch_jacobian;
-  jacobian.resize(n);
-  const btScalar* u = body.getVelocityVector();
-  Eigen::Vector3d velocity;
-  for (int axis = 0; axis < 3; ++axis) {
-    btVector3 direction(0, 0, 0);
-    direction[axis] = 1;
-    body.fillContactJacobianMultiDof(link - 1, to_bt(X_world_link.translation()), direction,
-                                     &jacobian[0], impl_->scratch_r, impl_->scratch_v,
-                                     impl_->scratch_m);
-    double v = 0;
-    for (int k = 0; k < n; ++k) v += jacobian[k] * u[k];
-    velocity[axis] = v;
+  return mass > 0 ? Eigen::Vector3d(sum / mass) : impl_->link_pose(r, 0).translation();
+}
+
+Eigen::Vector3d World::center_of_mass_velocity(RobotId robot) const {
+  check_robot(robot, "center_of_mass_velocity");
+  const Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot.index)];
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double mass = 0.0;
+  for (int link = 0; link <= r.body->getNumLinks(); ++link) {
+    const double m = link == 0 ? r.body->getBaseMass() : r.body->getLinkMass(link - 1);
+    if (m > 0) sum += m * impl_->point_velocity(r, link, impl_->com_position(r, link));
+    mass += m;
   }
-  return velocity;
+  return mass > 0 ? Eigen::Vector3d(sum / mass) : Eigen::Vector3d::Zero();
 }
 
 Eigen::Isometry3d World::base_pose(RobotId robot) const {

@@ -226,6 +226,12 @@ class World {
   Eigen::Isometry3d link_pose(RobotId robot, int link) const;
   /// World linear velocity of the origin of link `link`'s URDF frame, in m/s.
   Eigen::Vector3d link_linear_velocity(RobotId robot, int link) const;
+  /// World position of the robot's centre of mass (every link's mass, the root's included; for a
+  /// fixed base of zero mass, the links that move), m. Allocates nothing.
+  Eigen::Vector3d center_of_mass(RobotId robot) const;
+  /// World velocity of the robot's centre of mass, m/s (dm_control's subtreelinvel of the root):
+  /// the mass-weighted mean of the links' centre-of-mass velocities. Allocates nothing once warm.
+  Eigen::Vector3d center_of_mass_velocity(RobotId robot) const;
   /// World pose of the root link's URDF frame: link_pose(robot, 0).
   Eigen::Isometry3d base_pose(RobotId robot) const;
   /// Moves a floating-base robot's root link frame to `X_world_base` and stops its base. Throws

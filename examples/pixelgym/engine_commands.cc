@@ -72,6 +72,7 @@ int run_inspect(const std::string& path, bool floating_base) {
         std::cout << "   no limits";
       }
       std::cout << "   effort " << joint.effort_limit << "   damping " << joint.damping;
+      if (joint.stiffness != 0.0) std::cout << "   stiffness " << joint.stiffness;
     }
     std::cout << "\n";
   }

@@ -56,7 +56,8 @@ INSTANTIATE_TEST_SUITE_P(
         AssetCase{"pendulum/pendulum.urdf", 2, 1}, AssetCase{"acrobot/acrobot.urdf", 3, 2},
         AssetCase{"reacher/reacher.urdf", 4, 2}, AssetCase{"reacher/reacher_v1.urdf", 4, 2},
         AssetCase{"arm/arm.urdf", 10, 7}, AssetCase{"objects/table.urdf", 1, 0},
-        AssetCase{"objects/cube.urdf", 1, 0}, AssetCase{"objects/target.urdf", 1, 0}),
+        AssetCase{"objects/cube.urdf", 1, 0}, AssetCase{"objects/target.urdf", 1, 0},
+        AssetCase{"cheetah/cheetah.urdf", 10, 9}),
     [](const ::testing::TestParamInfo<AssetCase>& param_info) {
       std::string name = std::filesystem::path(param_info.param.file).stem().string();
       return name;
@@ -68,7 +69,7 @@ TEST(RobotModelTest, EveryUrdfUnderAssetsIsCovered) {
            std::string(PIXELGYM_SOURCE_DIR) + "/assets")) {
     if (entry.path().extension() == ".urdf") ++count;
   }
-  EXPECT_EQ(count, 10) << "a new asset needs a line in AssetTest";
+  EXPECT_EQ(count, 11) << "a new asset needs a line in AssetTest";
 }
 
 TEST(RobotModelTest, ArmIsMadeOfMeshesWithLimitsAndInertias) {
@@ -286,6 +287,41 @@ TEST(RobotModelTest, OnlyRegularFilesOfBoundedSizeAreRead) {
                                  ": is 32.0 MiB (33554433 bytes); a URDF file may be at "
                                  "most 32 MiB (33554432 bytes)");
   std::filesystem::remove_all(folder);
+}
+
+TEST(RobotModelTest, StiffnessIsReadFromDynamicsAndANegativeOneIsRefused) {
+  const auto urdf = [](const std::string& dynamics) {
+    const std::string inertial =
+        "<inertial><mass value=\"1\"/><inertia ixx=\"0.01\" iyy=\"0.01\" izz=\"0.01\" "
+        "ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>";
+    return "<robot name=\"r\"><link name=\"a\">" + inertial + "</link><link name=\"b\">" +
+           inertial +
+           "</link><joint name=\"j\" type=\"revolute\"><parent link=\"a\"/><child "
+           "link=\"b\"/><axis xyz=\"0 1 0\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" "
+           "velocity=\"1\"/>" +
+           dynamics + "</joint></robot>";
+  };
+  MeshCache meshes;
+  const auto joint = [&](const std::string& name, const std::string& dynamics) {
+    return parse_urdf(write_temporary(name, urdf(dynamics)), meshes)->joints()[0];
+  };
+  EXPECT_EQ(joint("no_dynamics.urdf", "").stiffness, 0.0);
+  EXPECT_EQ(joint("damping_only.urdf", "<dynamics damping=\"2\"/>").stiffness, 0.0);
+  const JointModel spring = joint("spring.urdf", "<dynamics damping=\"2\" stiffness=\"240\"/>");
+  EXPECT_EQ(spring.stiffness, 240.0);
+  EXPECT_EQ(spring.damping, 2.0);
+  try {
+    joint("negative_spring.urdf", "<dynamics stiffness=\"-5\"/>");
+    ADD_FAILURE() << "a negative stiffness was accepted";
+  } catch (const UrdfError& error) {
+    EXPECT_THAT(error.what(), ::testing::HasSubstr("joint \"j\" has a negative stiffness"));
+  }
+  try {
+    joint("nan_spring.urdf", "<dynamics stiffness=\"nan\"/>");
+    ADD_FAILURE() << "a stiffness of nan was accepted";
+  } catch (const UrdfError& error) {
+    EXPECT_THAT(error.what(), ::testing::HasSubstr("stiffness"));
+  }
 }
 
 TEST(RobotModelTest, HugeFiniteLimitsAndOriginsAreRefusedNamingTheRange) {

@@ -187,6 +187,52 @@ TEST(WorldPhysicsTest, JointDampingDecaysVelocityExponentially) {
   EXPECT_NEAR(world.joint_velocities(wheel)[0] / (2.0 * std::exp(-1.0)), 1.0, 0.01);
 }
 
+TEST(WorldPhysicsTest, JointStiffnessIsASpringTowardsZero) {
+  // tests/data/urdf_good/spring_slider.urdf: 2 kg on a spring of 8 pi^2 N/m, a period of 1 s.
+  ModelCache cache;
+  const auto model = good_urdf(cache, "spring_slider.urdf");
+  EXPECT_DOUBLE_EQ(model->joints()[0].stiffness, 8 * M_PI * M_PI);
+  World world;
+  const RobotId slider = world.add_robot(model);
+  world.set_joint_state(slider, Eigen::VectorXd::Constant(1, 0.1), Eigen::VectorXd::Zero(1));
+  world.step(120);  // half a period: at the other end
+  EXPECT_NEAR(world.joint_position(slider, 0), -0.1, 0.002);
+  world.step(60);  // three quarters: through 0 at the top speed, 2 pi A / T
+  EXPECT_NEAR(world.joint_position(slider, 0), 0.0, 0.002);
+  EXPECT_NEAR(world.joint_velocity(slider, 0), 2 * M_PI * 0.1, 0.01);
+  world.step(60);
+  EXPECT_NEAR(world.joint_position(slider, 0), 0.1, 0.002);
+}
+
+TEST(WorldPhysicsTest, CenterOfMassAndItsVelocityWeighEveryLink) {
+  ModelCache cache;
+  World world;
+  // The pendulum: hinge about y at (0, 0, 1.2), 1.1 kg with its centre of mass d below the
+  // hinge; its mount has no mass. Turned by q and spinning at w, the centre of mass is at
+  // (-d sin q, 0, 1.2 - d cos q) and moves at w d (-cos q, 0, sin q).
+  const auto model = cache.load_urdf(asset_path("pendulum/pendulum.urdf"));
+  const double d = pendulum_properties(*model).com_distance;
+  const RobotId pendulum = world.add_robot(model);
+  // The slider: 2 kg 0.5 m above x, moving at its joint velocity. (Both are added first: adding a
+  // robot rebuilds the world.)
+  const RobotId slider = world.add_robot(good_urdf(cache, "slider.urdf"));
+  const double q = 0.3;
+  const double w = 2.0;
+  world.set_joint_state(pendulum, Eigen::VectorXd::Constant(1, q), Eigen::VectorXd::Constant(1, w));
+  const Eigen::Vector3d com = world.center_of_mass(pendulum);
+  const Eigen::Vector3d velocity = world.center_of_mass_velocity(pendulum);
+  EXPECT_NEAR((com - Eigen::Vector3d(-d * std::sin(q), 0, 1.2 - d * std::cos(q))).norm(), 0, 1e-9)
+      << com.transpose();
+  EXPECT_NEAR((velocity - w * d * Eigen::Vector3d(-std::cos(q), 0, std::sin(q))).norm(), 0, 1e-9)
+      << velocity.transpose();
+  world.set_joint_state(slider, Eigen::VectorXd::Constant(1, 0.2),
+                        Eigen::VectorXd::Constant(1, -0.7));
+  EXPECT_NEAR((world.center_of_mass(slider) - Eigen::Vector3d(0.2, 0, 0.5)).norm(), 0, 1e-12);
+  EXPECT_NEAR((world.center_of_mass_velocity(slider) - Eigen::Vector3d(-0.7, 0, 0)).norm(), 0,
+              1e-12);
+  EXPECT_NEAR((world.center_of_mass_velocity(pendulum) - velocity).norm(), 0, 1e-12);
+}
+
 TEST(WorldPhysicsTest, JointFrictionStopsTheJointAndHoldsIt) {
   ModelCache cache;
   World world;

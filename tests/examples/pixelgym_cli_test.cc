@@ -713,11 +713,12 @@ TEST(PixelgymCliTest, BadWrapSpecIsAUsageErrorNamingWrapperArgumentAndExpectatio
 
 // --- inspect ---
 
-const std::vector<std::string> kAssetUrdfs = {"acrobot/acrobot.urdf",   "arm/arm.urdf",
-                                              "cartpole/cartpole.urdf", "cartpole/cartpole_v1.urdf",
-                                              "objects/cube.urdf",      "objects/table.urdf",
-                                              "objects/target.urdf",    "pendulum/pendulum.urdf",
-                                              "reacher/reacher.urdf",   "reacher/reacher_v1.urdf"};
+const std::vector<std::string> kAssetUrdfs = {"acrobot/acrobot.urdf",      "arm/arm.urdf",
+                                              "cheetah/cheetah.urdf",      "cartpole/cartpole.urdf",
+                                              "cartpole/cartpole_v1.urdf", "objects/cube.urdf",
+                                              "objects/table.urdf",        "objects/target.urdf",
+                                              "pendulum/pendulum.urdf",    "reacher/reacher.urdf",
+                                              "reacher/reacher_v1.urdf"};
 
 TEST(PixelgymCliTest, InspectWorksOnEveryAsset) {
   std::set<std::string> found;
@@ -736,6 +737,10 @@ TEST(PixelgymCliTest, InspectWorksOnEveryAsset) {
   EXPECT_THAT(arm.output, HasSubstr("link3.obj   1152 triangles"));
   EXPECT_THAT(arm.output, HasSubstr("limits [-2.090, 2.090] rad"));
   EXPECT_THAT(arm.output, HasSubstr("total mass 23.200 kg"));
+  // dm_control's cheetah: 14 kg and its joint springs (<dynamics stiffness>).
+  const CliRun cheetah = run("inspect " + asset("cheetah/cheetah.urdf"));
+  EXPECT_THAT(cheetah.output, HasSubstr("total mass 14.002 kg"));
+  EXPECT_THAT(cheetah.output, HasSubstr("damping 6.000   stiffness 240.000"));
 }
 
 TEST(PixelgymCliTest, InspectCountsAFloatingBasesSixDegreesAndSaysOneInTheSingular) {
