@@ -13,6 +13,12 @@ at height 0.7 m, level, the legs as drawn.
 
 Joint springs (dm_control's stiffness) are written as <dynamics stiffness="..."/>, which
 pixelgym's URDF reader takes as a spring towards position 0 (other URDF readers ignore it).
+dm_control's leg joints have an armature of 0.1 kg m^2 (a motor's rotor inertia, added to the
+joint's inertia), which Bullet's multibodies lack; it is added to each leg link's moment of
+inertia about y instead. That gives each joint the same inertia against its own torque (the
+armature is 60-90% of it for the shins and feet), but the added inertia also turns with the
+links above: the whole cheetah pitching with its joints still carries 0.6 kg m^2 more than in
+dm_control (docs/tasks.md compares the two).
 Standard library only; running it again gives an identical file.
 """
 import math
@@ -51,6 +57,9 @@ LEGS = [
     ("fshin", "fthigh", (-0.14, -0.24), (-70.0, 50.0), 120.0, 3.0, 60.0),
     ("ffoot", "fshin", (0.13, -0.18), (-28.0, 28.0), 60.0, 1.5, 30.0),
 ]
+
+# dm_control's armature of every leg joint, kg m^2 (see the docstring).
+ARMATURE = 0.1
 
 # The two links between the fixed base and the torso that carry the sliders. They need some
 # mass for the simulator; 1 g each is 0.007% of the cheetah.
@@ -153,6 +162,8 @@ def main():
     for body in bodies:
         capsules = [c for c in CAPSULES if c[1] == body]
         mass, com, inertia = link_inertial(capsules, scale)
+        if body != "torso":
+            inertia[1][1] += ARMATURE
         total_mass += mass
         out.append("  <link name=\"%s\">\n" % body)
         out.append(inertial_xml(mass, com, inertia))

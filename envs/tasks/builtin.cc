@@ -6,6 +6,7 @@
 #include "pixelgym/envs/tasks/arm_push.h"
 #include "pixelgym/envs/tasks/arm_reach.h"
 #include "pixelgym/envs/tasks/cartpole.h"
+#include "pixelgym/envs/tasks/cheetah.h"
 #include "pixelgym/envs/tasks/grid_world.h"
 #include "pixelgym/envs/tasks/pendulum.h"
 #include "pixelgym/envs/tasks/reacher.h"
@@ -24,6 +25,7 @@ void register_builtin_envs(Registry& registry) {
   registry.register_env(ArmReachTask::spec_v0());
   registry.register_env(ArmPushTask::spec_v0());
   registry.register_env(UrdfReachTask::spec_v0());
+  registry.register_env(CheetahTask::spec_v0());
 }
 
 // The process-wide registry and its free functions (declared in envs/registry.h and

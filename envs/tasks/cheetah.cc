@@ -1,0 +1,119 @@
+#include "pixelgym/envs/tasks/cheetah.h"
+
+#include <cmath>
+#include <limits>
+
+#include "pixelgym/engine/robot_model.h"
+#include "pixelgym/envs/spaces/box.h"
+#include "pixelgym/envs/tasks/pixel_env.h"
+#include "pixelgym/envs/tasks/reward.h"
+
+namespace pixelgym {
+
+namespace {
+
+// The cheetah's degrees of freedom: rootx, rootz, rooty, then the legs (the URDF's joint order,
+// dm_control's qpos order).
+constexpr int kDofs = 9;
+constexpr int kFirstLeg = 3;
+
+// Where each camera is relative to the centre of mass (dm_control's trackcom: the camera's
+// offset from the centre of mass in the model's drawn pose, where the torso is at (0, 0, 0.7)
+// and the centre of mass at (0.0378, 0, 0.551)), and where it looks.
+struct TrackingCamera {
+  Eigen::Vector3f offset;
+  Eigen::Vector3f forward;
+  Eigen::Vector3f up;
+};
+// side: pos (0, -3, 0) in the torso, looking along +y with z up.
+const TrackingCamera kSide{{-0.0378F, -3.0F, 0.149F}, {0.0F, 1.0F, 0.0F}, {0.0F, 0.0F, 1.0F}};
+// back: pos (-1.8, -1.3, 0.8) in the torso, xyaxes (0.45, -0.9, 0), (0.3, 0.15, 0.94).
+const TrackingCamera kBack{
+    {-1.8378F, -1.3F, 0.949F}, {0.842F, 0.421F, -0.336F}, {0.301F, 0.150F, 0.942F}};
+
+}  // namespace
+
+SpacePtr CheetahTask::action_space() const {
+  return std::make_shared<spaces::Box>(-1.0, 1.0, Shape{6});
+}
+
+engine::WorldConfig CheetahTask::world_config() const {
+  engine::WorldConfig config;
+  // 4 physics steps per control step: the joint springs and damping act explicitly, and on the
+  // feet (60 and 120 N m/rad on a joint inertia of about 0.1 kg m^2) need steps this short.
+  config.timestep_s = 0.0025;
+  // Bullet multiplies the two sides' friction; the links have 0.8, so the ground's 1.25 gives
+  // dm_control's 1.0 (MuJoCo takes the larger of the ground's 1 and the cheetah's 0.4).
+  config.ground_friction = 1.25;
+  return config;
+}
+
+void CheetahTask::build(engine::World& world) {
+  const auto model =
+      engine::default_model_cache().load_urdf(engine::asset_path("cheetah/cheetah.urdf"));
+  engine::RobotOptions options;
+  options.self_collision = true;  // as dm_control's cheetah: a foot can hit the torso
+  robot_ = world.add_robot(model, options);
+  const auto& joints = model->joints();
+  for (int leg = 0; leg < 6; ++leg) {
+    gears_[leg] =
+        joints[static_cast<std::size_t>(model->movable_joints()[kFirstLeg + leg])].effort_limit;
+  }
+}
+
+render::Camera CheetahTask::camera(const std::string& name, const engine::World& world) const {
+  const TrackingCamera& tracking = name == "back" ? kBack : kSide;
+  const Eigen::Vector3f eye = world.center_of_mass(robot_).cast<float>() + tracking.offset;
+  render::Camera camera = render::Camera::look_at(eye, eye + tracking.forward, tracking.up);
+  camera.fov_y_deg = 45.0F;
+  return camera;
+}
+
+void CheetahTask::initialize_episode(engine::World& world, Rng& rng) {
+  const engine::RobotModel& model = world.robot_model(robot_);
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(kDofs);
+  for (int dof = kFirstLeg; dof < kDofs; ++dof) {
+    const engine::JointModel& joint =
+        model.joints()[static_cast<std::size_t>(model.movable_joints()[dof])];
+    q[dof] = rng.uniform(joint.lower, joint.upper);
+  }
+  world.set_joint_state(robot_, q, Eigen::VectorXd::Zero(kDofs));
+  const int substeps =
+      static_cast<int>(std::lround(control_timestep_s() / world.config().timestep_s));
+  world.step(kSettleSteps * substeps);
+}
+
+void CheetahTask::before_step(const Value& action, engine::World& world) {
+  const Array& a = action.array();
+  Eigen::Matrix<double, kDofs, 1> torques = Eigen::Matrix<double, kDofs, 1>::Zero();
+  for (int leg = 0; leg < 6; ++leg) {
+    torques[kFirstLeg + leg] = gears_[leg] * a.element_as_double(leg);
+  }
+  world.set_joint_commands(robot_, torques);
+}
+
+double CheetahTask::speed(const engine::World& world) const {
+  return world.center_of_mass_velocity(robot_).x();
+}
+
+void CheetahTask::observe(const engine::World& world, StateSlots& state) const {
+  Eigen::Matrix<double, kDofs, 1> q;
+  Eigen::Matrix<double, kDofs, 1> qd;
+  world.joint_positions(robot_, q);
+  world.joint_velocities(robot_, qd);
+  state.set("joint_pos", q.tail<kDofs - 1>());
+  state.set("joint_vel", qd);
+}
+
+double CheetahTask::reward(const engine::World& world) const {
+  return reward::tolerance(speed(world), kRunSpeed, std::numeric_limits<double>::infinity(),
+                           kRunSpeed, reward::Sigmoid::kLinear, 0.0);
+}
+
+EnvSpec CheetahTask::spec_v0() {
+  return pixel_task_spec("CheetahRun-v0",
+                         "dm_control's planar cheetah runs forward; six leg torques in [-1, 1]",
+                         [](const Params&) { return std::make_unique<CheetahTask>(); });
+}
+
+}  // namespace pixelgym
