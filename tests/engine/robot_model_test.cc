@@ -57,7 +57,7 @@ INSTANTIATE_TEST_SUITE_P(
         AssetCase{"reacher/reacher.urdf", 4, 2}, AssetCase{"reacher/reacher_v1.urdf", 4, 2},
         AssetCase{"arm/arm.urdf", 10, 7}, AssetCase{"objects/table.urdf", 1, 0},
         AssetCase{"objects/cube.urdf", 1, 0}, AssetCase{"objects/target.urdf", 1, 0},
-        AssetCase{"cheetah/cheetah.urdf", 10, 9}),
+        AssetCase{"cheetah/cheetah.urdf", 10, 9}, AssetCase{"walker/walker.urdf", 10, 9}),
     [](const ::testing::TestParamInfo<AssetCase>& param_info) {
       std::string name = std::filesystem::path(param_info.param.file).stem().string();
       return name;
@@ -69,7 +69,7 @@ TEST(RobotModelTest, EveryUrdfUnderAssetsIsCovered) {
            std::string(PIXELGYM_SOURCE_DIR) + "/assets")) {
     if (entry.path().extension() == ".urdf") ++count;
   }
-  EXPECT_EQ(count, 11) << "a new asset needs a line in AssetTest";
+  EXPECT_EQ(count, 12) << "a new asset needs a line in AssetTest";
 }
 
 TEST(RobotModelTest, ArmIsMadeOfMeshesWithLimitsAndInertias) {

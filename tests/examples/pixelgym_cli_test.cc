@@ -718,7 +718,7 @@ const std::vector<std::string> kAssetUrdfs = {"acrobot/acrobot.urdf",      "arm/
                                               "cartpole/cartpole_v1.urdf", "objects/cube.urdf",
                                               "objects/table.urdf",        "objects/target.urdf",
                                               "pendulum/pendulum.urdf",    "reacher/reacher.urdf",
-                                              "reacher/reacher_v1.urdf"};
+                                              "reacher/reacher_v1.urdf",   "walker/walker.urdf"};
 
 TEST(PixelgymCliTest, InspectWorksOnEveryAsset) {
   std::set<std::string> found;

@@ -1,0 +1,135 @@
+"""Shared by the generators of dm_control's planar models (make_cheetah.py, make_walker.py):
+capsule masses and inertias, and the URDF text of links and joints. Standard library only."""
+import math
+
+DENSITY = 1000.0  # MuJoCo's default, kg/m^3
+
+
+class Capsule:
+    """A capsule in its link's frame: centre (x, z), turned about +y by `tilt` degrees from
+    +z (dm_control's euler "0 tilt 0"), radius and half-length of the cylinder, m."""
+
+    def __init__(self, centre, tilt, radius, half_length):
+        self.centre, self.tilt, self.radius, self.half = centre, tilt, radius, half_length
+
+    def volume(self):
+        r = self.radius
+        return math.pi * r**2 * 2 * self.half + 4.0 / 3.0 * math.pi * r**3
+
+    def moments(self, mass):
+        """(about its axis, about a perpendicular axis through its centre), kg m^2."""
+        r, length = self.radius, 2 * self.half
+        cylinder = math.pi * r**2 * length
+        sphere = 4.0 / 3.0 * math.pi * r**3
+        m_cyl = mass * cylinder / (cylinder + sphere)
+        m_hemi = mass * sphere / (cylinder + sphere) / 2
+        axial = m_cyl * r**2 / 2 + 2 * m_hemi * 2 * r**2 / 5
+        perpendicular = m_cyl * (r**2 / 4 + length**2 / 12) + 2 * m_hemi * (
+            2 * r**2 / 5 + length**2 / 4 + 3 * length * r / 8)
+        return axial, perpendicular
+
+
+def rotation_y(degrees):
+    a = math.radians(degrees)
+    c, s = math.cos(a), math.sin(a)
+    return [[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]]
+
+
+def link_inertial(capsules, scale=1.0, armature=0.0):
+    """Mass, centre of mass (3) and inertia (3x3 about it, link axes) of a link's capsules at
+    DENSITY times `scale`; `armature` is added to the moment about y (see the generators)."""
+    parts = []
+    for capsule in capsules:
+        mass = DENSITY * capsule.volume() * scale
+        axial, perp = capsule.moments(mass)
+        r = rotation_y(capsule.tilt)
+        local = [[perp, 0, 0], [0, perp, 0], [0, 0, axial]]  # the capsule's axis is local z
+        inertia = [[sum(r[i][k] * local[k][l] * r[j][l] for k in range(3) for l in range(3))
+                    for j in range(3)] for i in range(3)]
+        parts.append((mass, (capsule.centre[0], 0.0, capsule.centre[1]), inertia))
+    total = sum(p[0] for p in parts)
+    com = tuple(sum(p[0] * p[1][i] for p in parts) / total for i in range(3))
+    inertia = [[0.0] * 3 for _ in range(3)]
+    for mass, centre, own in parts:
+        d = [centre[i] - com[i] for i in range(3)]
+        d2 = sum(v * v for v in d)
+        for i in range(3):
+            for j in range(3):
+                inertia[i][j] += own[i][j] + mass * ((d2 if i == j else 0.0) - d[i] * d[j])
+    inertia[1][1] += armature
+    return total, com, inertia
+
+
+def fmt(value):
+    text = "%.6g" % value
+    return "0" if text in ("-0", "0") else text
+
+
+def inertial_xml(mass, com, inertia):
+    return ("    <inertial>\n"
+            "      <origin xyz=\"%s %s %s\"/>\n"
+            "      <mass value=\"%s\"/>\n"
+            "      <inertia ixx=\"%s\" ixy=\"%s\" ixz=\"%s\" iyy=\"%s\" iyz=\"%s\" izz=\"%s\"/>\n"
+            "    </inertial>\n") % (fmt(com[0]), fmt(com[1]), fmt(com[2]), fmt(mass),
+                                    fmt(inertia[0][0]), fmt(inertia[0][1]), fmt(inertia[0][2]),
+                                    fmt(inertia[1][1]), fmt(inertia[1][2]), fmt(inertia[2][2]))
+
+
+def link_xml(name, capsules, mass, com, inertia, material="self"):
+    """A link with its inertial, and each capsule as a visual and a collision."""
+    out = ["  <link name=\"%s\">\n" % name, inertial_xml(mass, com, inertia)]
+    for kind in ("visual", "collision"):
+        for c in capsules:
+            out.append("    <%s>\n"
+                       "      <origin xyz=\"%s 0 %s\" rpy=\"0 %s 0\"/>\n"
+                       "      <geometry><capsule radius=\"%s\" length=\"%s\"/></geometry>\n"
+                       "%s"
+                       "    </%s>\n" % (kind, fmt(c.centre[0]), fmt(c.centre[1]),
+                                       fmt(math.radians(c.tilt)), fmt(c.radius),
+                                       fmt(2 * c.half),
+                                       "      <material name=\"%s\"/>\n" % material
+                                       if kind == "visual" else "", kind))
+    out.append("  </link>\n")
+    return "".join(out)
+
+
+def slider_links(names, mass=0.001, inertia=1e-6):
+    """The links between a fixed base and the body that carry the root sliders. They need some
+    mass for the simulator; 1 g each."""
+    out = []
+    for name in names:
+        out.append("  <link name=\"%s\">\n" % name)
+        out.append(inertial_xml(mass, (0, 0, 0), [[inertia, 0, 0], [0, inertia, 0],
+                                                  [0, 0, inertia]]))
+        out.append("  </link>\n")
+    return "".join(out)
+
+
+def root_joint_xml(name, kind, parent, child, axis, origin=(0.0, 0.0, 0.0)):
+    """An unlimited root joint: a slider ("prismatic", limits of 1000 m) or a hinge
+    ("continuous")."""
+    limit = ("<limit lower=\"-1000\" upper=\"1000\" effort=\"0\" velocity=\"100\"/>"
+             if kind == "prismatic" else "<limit effort=\"0\" velocity=\"100\"/>")
+    return ("  <joint name=\"%s\" type=\"%s\">\n"
+            "    <parent link=\"%s\"/><child link=\"%s\"/>\n"
+            "    <origin xyz=\"%s %s %s\"/><axis xyz=\"%s %s %s\"/>\n"
+            "    %s\n"
+            "  </joint>\n") % (name, kind, parent, child, fmt(origin[0]), fmt(origin[1]),
+                               fmt(origin[2]), fmt(axis[0]), fmt(axis[1]), fmt(axis[2]), limit)
+
+
+def hinge_xml(name, parent, child, origin, axis, limits_deg, gear, damping, stiffness=0.0):
+    """A limited hinge with a motor of `gear` N m (the URDF's effort), damping and, when not 0,
+    a spring (pixelgym's <dynamics stiffness>)."""
+    dynamics = "damping=\"%s\"" % fmt(damping)
+    if stiffness:
+        dynamics += " stiffness=\"%s\"" % fmt(stiffness)
+    return ("  <joint name=\"%s\" type=\"revolute\">\n"
+            "    <parent link=\"%s\"/><child link=\"%s\"/>\n"
+            "    <origin xyz=\"%s %s %s\"/><axis xyz=\"%s %s %s\"/>\n"
+            "    <limit lower=\"%s\" upper=\"%s\" effort=\"%s\" velocity=\"100\"/>\n"
+            "    <dynamics %s/>\n"
+            "  </joint>\n") % (name, parent, child, fmt(origin[0]), fmt(origin[1]),
+                               fmt(origin[2]), fmt(axis[0]), fmt(axis[1]), fmt(axis[2]),
+                               fmt(math.radians(limits_deg[0])),
+                               fmt(math.radians(limits_deg[1])), fmt(gear), dynamics)
