@@ -11,6 +11,7 @@
 #include "pixelgym/envs/tasks/pendulum.h"
 #include "pixelgym/envs/tasks/reacher.h"
 #include "pixelgym/envs/tasks/urdf_reach.h"
+#include "pixelgym/envs/tasks/walker.h"
 #include "pixelgym/envs/vector/make_vec.h"
 
 namespace pixelgym {
@@ -26,6 +27,7 @@ void register_builtin_envs(Registry& registry) {
   registry.register_env(ArmPushTask::spec_v0());
   registry.register_env(UrdfReachTask::spec_v0());
   registry.register_env(CheetahTask::spec_v0());
+  for (EnvSpec& spec : WalkerTask::specs()) registry.register_env(std::move(spec));
 }
 
 // The process-wide registry and its free functions (declared in envs/registry.h and
