@@ -7,6 +7,7 @@
 #include "pixelgym/envs/spaces/box.h"
 #include "pixelgym/envs/tasks/pixel_env.h"
 #include "pixelgym/envs/tasks/reward.h"
+#include "pixelgym/envs/tasks/tracking_camera.h"
 
 namespace pixelgym {
 
@@ -20,11 +21,6 @@ constexpr int kFirstLeg = 3;
 // Where each camera is relative to the centre of mass (dm_control's trackcom: the camera's
 // offset from the centre of mass in the model's drawn pose, where the torso is at (0, 0, 0.7)
 // and the centre of mass at (0.0378, 0, 0.551)), and where it looks.
-struct TrackingCamera {
-  Eigen::Vector3f offset;
-  Eigen::Vector3f forward;
-  Eigen::Vector3f up;
-};
 // side: pos (0, -3, 0) in the torso, looking along +y with z up.
 const TrackingCamera kSide{{-0.0378F, -3.0F, 0.149F}, {0.0F, 1.0F, 0.0F}, {0.0F, 0.0F, 1.0F}};
 // back: pos (-1.8, -1.3, 0.8) in the torso, xyaxes (0.45, -0.9, 0), (0.3, 0.15, 0.94).
@@ -62,11 +58,7 @@ void CheetahTask::build(engine::World& world) {
 }
 
 render::Camera CheetahTask::camera(const std::string& name, const engine::World& world) const {
-  const TrackingCamera& tracking = name == "back" ? kBack : kSide;
-  const Eigen::Vector3f eye = world.center_of_mass(robot_).cast<float>() + tracking.offset;
-  render::Camera camera = render::Camera::look_at(eye, eye + tracking.forward, tracking.up);
-  camera.fov_y_deg = 45.0F;
-  return camera;
+  return (name == "back" ? kBack : kSide).at(world, robot_);
 }
 
 void CheetahTask::initialize_episode(engine::World& world, Rng& rng) {

@@ -9,6 +9,7 @@
 #include "pixelgym/envs/tasks/angles.h"
 #include "pixelgym/envs/tasks/pixel_env.h"
 #include "pixelgym/envs/tasks/reward.h"
+#include "pixelgym/envs/tasks/tracking_camera.h"
 
 namespace pixelgym {
 
@@ -25,11 +26,6 @@ constexpr const char* kBodies[7] = {"torso",      "right_thigh", "right_leg", "r
 // Where each camera is relative to the centre of mass (dm_control's trackcom: the camera's
 // offset from the centre of mass in the model's drawn pose, torso at (0, 0, 1.3), centre of mass
 // at (0.0088, 0, 0.7723)), and where it looks.
-struct TrackingCamera {
-  Eigen::Vector3f offset;
-  Eigen::Vector3f forward;
-  Eigen::Vector3f up;
-};
 // side: pos (0, -2, 0.7) in the torso, euler (60, 0, 0): looking along +y, 30 degrees down.
 const TrackingCamera kSide{{-0.0088F, -2.0F, 1.2277F}, {0.0F, 0.866F, -0.5F}, {0.0F, 0.5F, 0.866F}};
 // back: pos (-2, 0, 0.5) in the torso, xyaxes (0, -1, 0), (1, 0, 3).
@@ -77,11 +73,7 @@ void WalkerTask::build(engine::World& world) {
 }
 
 render::Camera WalkerTask::camera(const std::string& name, const engine::World& world) const {
-  const TrackingCamera& tracking = name == "back" ? kBack : kSide;
-  const Eigen::Vector3f eye = world.center_of_mass(robot_).cast<float>() + tracking.offset;
-  render::Camera camera = render::Camera::look_at(eye, eye + tracking.forward, tracking.up);
-  camera.fov_y_deg = 45.0F;
-  return camera;
+  return (name == "back" ? kBack : kSide).at(world, robot_);
 }
 
 void WalkerTask::initialize_episode(engine::World& world, Rng& rng) {
