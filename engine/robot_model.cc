@@ -450,6 +450,15 @@ int RobotModel::joint_index(const std::string& name) const {
   throw std::out_of_range("robot \"" + name_ + "\" has no joint \"" + name + "\"");
 }
 
+int RobotModel::dof_index(const std::string& name) const {
+  const int joint = joint_index(name);
+  for (std::size_t d = 0; d < movable_joints_.size(); ++d) {
+    if (movable_joints_[d] == joint) return static_cast<int>(d);
+  }
+  throw std::out_of_range("robot \"" + name_ + "\": joint \"" + name +
+                          "\" is fixed, not a degree of freedom");
+}
+
 double RobotModel::total_mass_kg() const {
   double total = 0.0;
   for (const LinkModel& link : links_) total += link.inertial.mass_kg;

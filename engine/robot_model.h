@@ -161,6 +161,10 @@ class RobotModel {
   int link_index(const std::string& name) const;
   /// The index into joints() of the joint named `name`. Throws std::out_of_range as link_index.
   int joint_index(const std::string& name) const;
+  /// The index into movable_joints() (the degree of freedom, as World numbers them) of the joint
+  /// named `name`. Throws std::out_of_range naming the robot and the name when there is no such
+  /// joint or it is fixed.
+  int dof_index(const std::string& name) const;
   /// The sum of every link's mass, in kg.
   double total_mass_kg() const;
 

@@ -342,6 +342,27 @@ struct World::Impl {
     names[body.rigid.get()] = options.name;
   }
 
+  // The points of the dispatcher's manifolds: those with a normal impulse in the last step or
+  // overlapping, or (touching_only) just those overlapping or touching.
+  std::vector<Contact> manifold_contacts(double timestep_s, bool touching_only) const {
+    std::vector<Contact> result;
+    for (int m = 0; m < dispatcher->getNumManifolds(); ++m) {
+      const btPersistentManifold& manifold = *dispatcher->getManifoldByIndexInternal(m);
+      for (int p = 0; p < manifold.getNumContacts(); ++p) {
+        const btManifoldPoint& point = manifold.getContactPoint(p);
+        if (point.getDistance() > 0 && (touching_only || point.getAppliedImpulse() <= 0)) continue;
+        Contact contact;
+        contact.a = names.at(manifold.getBody0());
+        contact.b = names.at(manifold.getBody1());
+        contact.position_world_m = from_bt(point.getPositionWorldOnB());
+        contact.normal_world = from_bt(point.m_normalWorldOnB);
+        contact.normal_force_n = touching_only ? 0.0 : point.getAppliedImpulse() / timestep_s;
+        result.push_back(contact);
+      }
+    }
+    return result;
+  }
+
   void update_kinematics(Robot& robot) {
     robot.body->forwardKinematics(scratch_rotations, scratch_origins);
     robot.body->updateCollisionObjectWorldTransforms(scratch_rotations, scratch_origins);
@@ -874,23 +895,39 @@ int World::segmentation_id(BodyId body) const {
 }
 
 std::vector<Contact> World::contacts() const {
-  std::vector<Contact> result;
+  return impl_->manifold_contacts(config_.timestep_s, /*touching_only=*/false);
+}
+
+void World::link_contacts(RobotId robot, int link, std::vector<LinkContact>& out) const {
+  check_robot(robot, "link_contacts");
+  const Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot.index)];
+  if (link < 0 || static_cast<std::size_t>(link) >= r.model->links().size()) {
+    throw std::out_of_range("World::link_contacts: robot \"" + r.model->name() + "\" has " +
+                            std::to_string(r.model->links().size()) + " links, got link " +
+                            std::to_string(link));
+  }
+  const auto is_link = [&](const btCollisionObject* object) {
+    const btMultiBodyLinkCollider* collider = btMultiBodyLinkCollider::upcast(object);
+    return collider != nullptr && collider->m_multiBody == r.body.get() &&
+           collider->m_link == link - 1;  // Bullet numbers the links after the base from 0
+  };
+  out.clear();
   btCollisionDispatcher& dispatcher = *impl_->dispatcher;
   for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {
     const btPersistentManifold& manifold = *dispatcher.getManifoldByIndexInternal(m);
+    if (!is_link(manifold.getBody0()) && !is_link(manifold.getBody1())) continue;
     for (int p = 0; p < manifold.getNumContacts(); ++p) {
       const btManifoldPoint& point = manifold.getContactPoint(p);
       if (point.getDistance() > 0 && point.getAppliedImpulse() <= 0) continue;
-      Contact contact;
-      contact.a = impl_->names.at(manifold.getBody0());
-      contact.b = impl_->names.at(manifold.getBody1());
-      contact.position_world_m = from_bt(point.getPositionWorldOnB());
-      contact.normal_world = from_bt(point.m_normalWorldOnB);
-      contact.normal_force_n = point.getAppliedImpulse() / config_.timestep_s;
-      result.push_back(contact);
+      out.push_back(
+          {from_bt(point.getPositionWorldOnB()), point.getAppliedImpulse() / config_.timestep_s});
     }
   }
-  return result;
+}
+
+std::vector<Contact> World::detect_contacts() {
+  impl_->dynamics->performDiscreteCollisionDetection();
+  return impl_->manifold_contacts(config_.timestep_s, /*touching_only=*/true);
 }
 
 void World::visual_poses(std::vector<Eigen::Isometry3d>& poses) const {

@@ -83,6 +83,14 @@ struct Contact {
   double normal_force_n = 0.0;
 };
 
+/// Where one contact touches a robot's link, and how hard: what World::link_contacts lists.
+struct LinkContact {
+  /// The contact point on the second body's surface, in world coordinates, m (as Contact's).
+  Eigen::Vector3d position_world_m = Eigen::Vector3d::Zero();
+  /// The normal impulse of the last step divided by the timestep, N.
+  double normal_force_n = 0.0;
+};
+
 /// Thrown by World::step when the simulation went non-finite (a robot's base or joint, or a
 /// body), naming what and the simulation step.
 class NonFiniteState : public std::runtime_error {
@@ -258,6 +266,14 @@ class World {
   /// Contact points of the last step (with positive normal force or penetration). Allocates the
   /// returned vector.
   std::vector<Contact> contacts() const;
+  /// The contacts of the last step that touch link `link` (an index into the model's links())
+  /// of `robot`, those contacts() lists, written into `out` (cleared first): no allocation once
+  /// `out` has room, for sensors read at every step.
+  void link_contacts(RobotId robot, int link, std::vector<LinkContact>& out) const;
+  /// Runs collision detection on the current state, without stepping, and returns the points
+  /// where two things touch or overlap (normal_force_n 0): for an episode start that must be
+  /// free of contacts, as dm_control's finger and ball-in-cup ask after setting joints.
+  std::vector<Contact> detect_contacts();
   /// Every visual element of every robot and body, in a fixed order.
   const std::vector<VisualShape>& visual_shapes() const { return visual_shapes_; }
   /// Writes the current world pose of each visual shape, in visual_shapes() order, into `poses`

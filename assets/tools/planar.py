@@ -1,5 +1,6 @@
-"""Shared by the generators of dm_control's planar models (make_cheetah.py, make_walker.py):
-capsule masses and inertias, and the URDF text of links and joints. Standard library only."""
+"""Shared by the generators of dm_control's planar models (make_cheetah.py, make_walker.py,
+make_finger.py): capsule and cylinder masses and inertias, and the URDF text of links and
+joints. Standard library only."""
 import math
 
 DENSITY = 1000.0  # MuJoCo's default, kg/m^3
@@ -7,14 +8,26 @@ DENSITY = 1000.0  # MuJoCo's default, kg/m^3
 
 class Capsule:
     """A capsule in its link's frame: centre (x, z), turned about +y by `tilt` degrees from
-    +z (dm_control's euler "0 tilt 0"), radius and half-length of the cylinder, m."""
+    +z (dm_control's euler "0 tilt 0"), radius and half-length of the cylinder, m. `material`
+    (None: the link's) colours it; `collides` False makes it drawn only (dm_control's
+    contype="0" conaffinity="0")."""
 
-    def __init__(self, centre, tilt, radius, half_length):
+    def __init__(self, centre, tilt, radius, half_length, material=None, collides=True):
         self.centre, self.tilt, self.radius, self.half = centre, tilt, radius, half_length
+        self.material, self.collides = material, collides
+
+    def rpy(self):
+        return (0.0, math.radians(self.tilt), 0.0)
+
+    def geometry_xml(self):
+        return "<capsule radius=\"%s\" length=\"%s\"/>" % (fmt(self.radius), fmt(2 * self.half))
 
     def volume(self):
         r = self.radius
         return math.pi * r**2 * 2 * self.half + 4.0 / 3.0 * math.pi * r**3
+
+    def rotation(self):
+        return rotation_y(self.tilt)
 
     def moments(self, mass):
         """(about its axis, about a perpendicular axis through its centre), kg m^2."""
@@ -27,6 +40,30 @@ class Capsule:
         perpendicular = m_cyl * (r**2 / 4 + length**2 / 12) + 2 * m_hemi * (
             2 * r**2 / 5 + length**2 / 4 + 3 * length * r / 8)
         return axial, perpendicular
+
+
+class CylinderY(Capsule):
+    """A cylinder along y in its link's frame (dm_control's fromto "0 -h 0 0 h 0"): centre
+    (x, z), radius and half-length, m."""
+
+    def __init__(self, centre, radius, half_length, material=None, collides=True):
+        super().__init__(centre, 0.0, radius, half_length, material, collides)
+
+    def rpy(self):
+        return (math.pi / 2, 0.0, 0.0)  # turns the URDF cylinder's z axis onto -y
+
+    def geometry_xml(self):
+        return "<cylinder radius=\"%s\" length=\"%s\"/>" % (fmt(self.radius), fmt(2 * self.half))
+
+    def volume(self):
+        return math.pi * self.radius**2 * 2 * self.half
+
+    def rotation(self):
+        return [[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]]
+
+    def moments(self, mass):
+        r, length = self.radius, 2 * self.half
+        return mass * r**2 / 2, mass * (r**2 / 4 + length**2 / 12)
 
 
 def rotation_y(degrees):
@@ -42,7 +79,7 @@ def link_inertial(capsules, scale=1.0, armature=0.0):
     for capsule in capsules:
         mass = DENSITY * capsule.volume() * scale
         axial, perp = capsule.moments(mass)
-        r = rotation_y(capsule.tilt)
+        r = capsule.rotation()
         local = [[perp, 0, 0], [0, perp, 0], [0, 0, axial]]  # the capsule's axis is local z
         inertia = [[sum(r[i][k] * local[k][l] * r[j][l] for k in range(3) for l in range(3))
                     for j in range(3)] for i in range(3)]
@@ -76,18 +113,21 @@ def inertial_xml(mass, com, inertia):
 
 
 def link_xml(name, capsules, mass, com, inertia, material="self"):
-    """A link with its inertial, and each capsule as a visual and a collision."""
+    """A link with its inertial, each shape as a visual and each that collides as a
+    collision."""
     out = ["  <link name=\"%s\">\n" % name, inertial_xml(mass, com, inertia)]
     for kind in ("visual", "collision"):
         for c in capsules:
+            if kind == "collision" and not c.collides:
+                continue
+            rpy = c.rpy()
             out.append("    <%s>\n"
-                       "      <origin xyz=\"%s 0 %s\" rpy=\"0 %s 0\"/>\n"
-                       "      <geometry><capsule radius=\"%s\" length=\"%s\"/></geometry>\n"
+                       "      <origin xyz=\"%s 0 %s\" rpy=\"%s %s %s\"/>\n"
+                       "      <geometry>%s</geometry>\n"
                        "%s"
-                       "    </%s>\n" % (kind, fmt(c.centre[0]), fmt(c.centre[1]),
-                                       fmt(math.radians(c.tilt)), fmt(c.radius),
-                                       fmt(2 * c.half),
-                                       "      <material name=\"%s\"/>\n" % material
+                       "    </%s>\n" % (kind, fmt(c.centre[0]), fmt(c.centre[1]), fmt(rpy[0]),
+                                       fmt(rpy[1]), fmt(rpy[2]), c.geometry_xml(),
+                                       "      <material name=\"%s\"/>\n" % (c.material or material)
                                        if kind == "visual" else "", kind))
     out.append("  </link>\n")
     return "".join(out)
@@ -118,18 +158,28 @@ def root_joint_xml(name, kind, parent, child, axis, origin=(0.0, 0.0, 0.0)):
                                fmt(origin[2]), fmt(axis[0]), fmt(axis[1]), fmt(axis[2]), limit)
 
 
-def hinge_xml(name, parent, child, origin, axis, limits_deg, gear, damping, stiffness=0.0):
-    """A limited hinge with a motor of `gear` N m (the URDF's effort), damping and, when not 0,
-    a spring (pixelgym's <dynamics stiffness>)."""
+def hinge_xml(name, parent, child, origin, axis, limits_deg, gear, damping, stiffness=0.0,
+              friction=0.0, rpy=(0.0, 0.0, 0.0)):
+    """A hinge with a motor of `gear` N m (the URDF's effort; 0: none), damping and, when not 0,
+    dry friction and a spring (pixelgym's <dynamics stiffness>). `limits_deg` None makes it
+    unlimited ("continuous"); `rpy` turns the joint frame in the parent's."""
     dynamics = "damping=\"%s\"" % fmt(damping)
+    if friction:
+        dynamics += " friction=\"%s\"" % fmt(friction)
     if stiffness:
         dynamics += " stiffness=\"%s\"" % fmt(stiffness)
-    return ("  <joint name=\"%s\" type=\"revolute\">\n"
+    if limits_deg is None:
+        kind, limit = "continuous", "<limit effort=\"%s\" velocity=\"100\"/>" % fmt(gear)
+    else:
+        kind = "revolute"
+        limit = "<limit lower=\"%s\" upper=\"%s\" effort=\"%s\" velocity=\"100\"/>" % (
+            fmt(math.radians(limits_deg[0])), fmt(math.radians(limits_deg[1])), fmt(gear))
+    turn = "" if not any(rpy) else " rpy=\"%s %s %s\"" % (fmt(rpy[0]), fmt(rpy[1]), fmt(rpy[2]))
+    return ("  <joint name=\"%s\" type=\"%s\">\n"
             "    <parent link=\"%s\"/><child link=\"%s\"/>\n"
-            "    <origin xyz=\"%s %s %s\"/><axis xyz=\"%s %s %s\"/>\n"
-            "    <limit lower=\"%s\" upper=\"%s\" effort=\"%s\" velocity=\"100\"/>\n"
+            "    <origin xyz=\"%s %s %s\"%s/><axis xyz=\"%s %s %s\"/>\n"
+            "    %s\n"
             "    <dynamics %s/>\n"
-            "  </joint>\n") % (name, parent, child, fmt(origin[0]), fmt(origin[1]),
-                               fmt(origin[2]), fmt(axis[0]), fmt(axis[1]), fmt(axis[2]),
-                               fmt(math.radians(limits_deg[0])),
-                               fmt(math.radians(limits_deg[1])), fmt(gear), dynamics)
+            "  </joint>\n") % (name, kind, parent, child, fmt(origin[0]), fmt(origin[1]),
+                               fmt(origin[2]), turn, fmt(axis[0]), fmt(axis[1]), fmt(axis[2]),
+                               limit, dynamics)

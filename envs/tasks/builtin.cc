@@ -7,6 +7,7 @@
 #include "pixelgym/envs/tasks/arm_reach.h"
 #include "pixelgym/envs/tasks/cartpole.h"
 #include "pixelgym/envs/tasks/cheetah.h"
+#include "pixelgym/envs/tasks/finger.h"
 #include "pixelgym/envs/tasks/grid_world.h"
 #include "pixelgym/envs/tasks/pendulum.h"
 #include "pixelgym/envs/tasks/reacher.h"
@@ -28,6 +29,7 @@ void register_builtin_envs(Registry& registry) {
   registry.register_env(UrdfReachTask::spec_v0());
   registry.register_env(CheetahTask::spec_v0());
   for (EnvSpec& spec : WalkerTask::specs()) registry.register_env(std::move(spec));
+  registry.register_env(FingerTask::spec_v0());
 }
 
 // The process-wide registry and its free functions (declared in envs/registry.h and

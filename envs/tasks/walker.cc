@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <limits>
-#include <stdexcept>
 
 #include "pixelgym/engine/robot_model.h"
 #include "pixelgym/envs/spaces/box.h"
@@ -52,17 +51,7 @@ void WalkerTask::build(engine::World& world) {
       engine::default_model_cache().load_urdf(engine::asset_path("walker/walker.urdf"));
   robot_ = world.add_robot(model);  // no self-collision, as dm_control's walker
   const auto& movable = model->movable_joints();
-  for (int i = 0; i < kDofs; ++i) {
-    dof_[static_cast<std::size_t>(i)] = -1;
-    for (std::size_t d = 0; d < movable.size(); ++d) {
-      if (model->joints()[static_cast<std::size_t>(movable[d])].name == kJoints[i]) {
-        dof_[static_cast<std::size_t>(i)] = static_cast<int>(d);
-      }
-    }
-    if (dof_[static_cast<std::size_t>(i)] < 0) {
-      throw std::runtime_error(std::string("WalkerTask: walker.urdf has no joint ") + kJoints[i]);
-    }
-  }
+  for (int i = 0; i < kDofs; ++i) dof_[static_cast<std::size_t>(i)] = model->dof_index(kJoints[i]);
   for (int b = 0; b < 7; ++b) link_[static_cast<std::size_t>(b)] = model->link_index(kBodies[b]);
   for (int leg = 0; leg < 6; ++leg) {
     gears_[leg] = model

@@ -16,6 +16,7 @@ namespace pixelgym::engine {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 std::string data(const std::string& name) {
   return std::string(PIXELGYM_SOURCE_DIR) + "/tests/data/urdf/" + name;
@@ -57,7 +58,8 @@ INSTANTIATE_TEST_SUITE_P(
         AssetCase{"reacher/reacher.urdf", 4, 2}, AssetCase{"reacher/reacher_v1.urdf", 4, 2},
         AssetCase{"arm/arm.urdf", 10, 7}, AssetCase{"objects/table.urdf", 1, 0},
         AssetCase{"objects/cube.urdf", 1, 0}, AssetCase{"objects/target.urdf", 1, 0},
-        AssetCase{"cheetah/cheetah.urdf", 10, 9}, AssetCase{"walker/walker.urdf", 10, 9}),
+        AssetCase{"cheetah/cheetah.urdf", 10, 9}, AssetCase{"walker/walker.urdf", 10, 9},
+        AssetCase{"finger/finger.urdf", 4, 3}),
     [](const ::testing::TestParamInfo<AssetCase>& param_info) {
       std::string name = std::filesystem::path(param_info.param.file).stem().string();
       return name;
@@ -69,7 +71,7 @@ TEST(RobotModelTest, EveryUrdfUnderAssetsIsCovered) {
            std::string(PIXELGYM_SOURCE_DIR) + "/assets")) {
     if (entry.path().extension() == ".urdf") ++count;
   }
-  EXPECT_EQ(count, 12) << "a new asset needs a line in AssetTest";
+  EXPECT_EQ(count, 13) << "a new asset needs a line in AssetTest";
 }
 
 TEST(RobotModelTest, ArmIsMadeOfMeshesWithLimitsAndInertias) {
@@ -112,6 +114,31 @@ TEST(RobotModelTest, CapsulesMaterialsAndJointDetails) {
   EXPECT_EQ(hinge.type, JointType::kContinuous);
   EXPECT_FALSE(hinge.has_limits);
   EXPECT_EQ(hinge.axis, Eigen::Vector3d(0, 1, 0));
+}
+
+TEST(RobotModelTest, DofIndexNumbersMovableJointsAsTheWorldDoes) {
+  MeshCache meshes;
+  // The finger's two chains hang from one base: urdfdom's tree order is not the file's.
+  const auto finger = parse_urdf(asset_path("finger/finger.urdf"), meshes);
+  for (const char* name : {"proximal", "distal", "hinge"}) {
+    const int dof = finger->dof_index(name);
+    ASSERT_GE(dof, 0);
+    EXPECT_EQ(finger
+                  ->joints()[static_cast<std::size_t>(
+                      finger->movable_joints()[static_cast<std::size_t>(dof)])]
+                  .name,
+              name);
+  }
+  const auto arm = parse_urdf(asset_path("arm/arm.urdf"), meshes);
+  std::string fixed;
+  for (const JointModel& joint : arm->joints()) {
+    if (joint.type == JointType::kFixed) fixed = joint.name;
+  }
+  ASSERT_FALSE(fixed.empty());
+  EXPECT_THAT([&] { arm->dof_index(fixed); },
+              ThrowsMessage<std::out_of_range>(HasSubstr("is fixed, not a degree of freedom")));
+  EXPECT_THAT([&] { arm->dof_index("no_such_joint"); },
+              ThrowsMessage<std::out_of_range>(HasSubstr("has no joint \"no_such_joint\"")));
 }
 
 struct BadCase {

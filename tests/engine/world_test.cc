@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <map>
 #include <thread>
@@ -384,6 +385,78 @@ TEST(WorldTest, MarkerHasNoCollision) {
     EXPECT_NE(contact.a, "marker");
     EXPECT_NE(contact.b, "marker");
   }
+}
+
+TEST(WorldTest, DetectContactsSeesOverlapsWithoutAStep) {
+  ModelCache cache;
+  World world;
+  BodyOptions ball;
+  ball.name = "ball";
+  ball.geometry.type = GeometryType::kSphere;
+  ball.geometry.radius_m = 0.1;
+  ball.X_world_body.translation() = Eigen::Vector3d(0, 0, 0.5);
+  const BodyId b = world.add_body(ball);
+  // The finger's two chains, one robot: the tip reaches into the spinner when both point at each
+  // other, and does not when the finger hangs down.
+  RobotOptions self;
+  self.self_collision = true;
+  const RobotId finger = world.add_robot(cache.load_urdf(asset_path("finger/finger.urdf")), self);
+  const RobotModel& model = world.robot_model(finger);
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(3);
+  q[model.dof_index("proximal")] = -M_PI / 2;
+  world.set_joint_state(finger, q, Eigen::VectorXd::Zero(3));
+  EXPECT_TRUE(world.detect_contacts().empty());
+
+  Eigen::Isometry3d low = Eigen::Isometry3d::Identity();
+  low.translation() = Eigen::Vector3d(0, 0, 0.05);  // 5 cm into the ground
+  world.set_body_pose(b, low);
+  q[model.dof_index("proximal")] = 0.0;
+  q[model.dof_index("hinge")] = M_PI / 2;
+  world.set_joint_state(finger, q, Eigen::VectorXd::Zero(3));
+  std::map<std::string, int> pairs;
+  for (const Contact& contact : world.detect_contacts()) {
+    pairs[std::min(contact.a, contact.b) + " " + std::max(contact.a, contact.b)]++;
+    EXPECT_EQ(contact.normal_force_n, 0.0);
+  }
+  EXPECT_EQ(pairs.count("ball ground"), 1U);
+  EXPECT_EQ(pairs.count("finger/distal finger/spinner"), 1U);
+  EXPECT_EQ(pairs.size(), 2U);
+  EXPECT_EQ(world.step_count(), 0);  // nothing moved
+  EXPECT_EQ(world.body_pose(b).translation().z(), 0.05);
+}
+
+TEST(WorldTest, LinkContactsListWhatTouchesOneLinkWithItsForce) {
+  ModelCache cache;
+  WorldConfig config;
+  config.gravity_m_s2 = Eigen::Vector3d::Zero();
+  config.timestep_s = 0.001;
+  World world(config);
+  RobotOptions self;
+  self.self_collision = true;
+  const RobotId finger = world.add_robot(cache.load_urdf(asset_path("finger/finger.urdf")), self);
+  const RobotModel& model = world.robot_model(finger);
+  // The finger points at the spinner, which is turned flat so that it cannot slip past, and
+  // the proximal joint pushes the fingertip into its left end.
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(3);
+  q[model.dof_index("proximal")] = 0.3;
+  q[model.dof_index("hinge")] = M_PI / 2;
+  world.set_joint_state(finger, q, Eigen::VectorXd::Zero(3));
+  Eigen::VectorXd torque = Eigen::VectorXd::Zero(3);
+  torque[model.dof_index("proximal")] = -5.0;
+  std::vector<LinkContact> touching;
+  double force = 0.0;
+  for (int t = 0; t < 300 && force == 0.0; ++t) {
+    world.set_joint_commands(finger, torque);
+    world.step();
+    world.link_contacts(finger, model.link_index("distal"), touching);
+    for (const LinkContact& contact : touching) force += contact.normal_force_n;
+  }
+  EXPECT_GT(force, 0.0) << "the fingertip never pressed on the spinner";
+  std::vector<LinkContact> proximal(4);
+  world.link_contacts(finger, model.link_index("proximal"), proximal);
+  EXPECT_TRUE(proximal.empty());  // cleared: the proximal link touches nothing
+  EXPECT_THAT([&] { world.link_contacts(finger, 7, proximal); },
+              ::testing::ThrowsMessage<std::out_of_range>(HasSubstr("has 4 links, got link 7")));
 }
 
 TEST(WorldTest, StaticMeshBodiesCollideAsTriangles) {
