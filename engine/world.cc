@@ -14,6 +14,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <unordered_map>
+#include <utility>
 
 namespace pixelgym::engine {
 namespace {
@@ -342,6 +343,48 @@ struct World::Impl {
     names[body.rigid.get()] = options.name;
   }
 
+  // A string's two ends in world coordinates.
+  std::pair<Eigen::Vector3d, Eigen::Vector3d> string_ends(const StringOptions& string) const {
+    const Robot& a = robots[static_cast<std::size_t>(string.robot_a.index)];
+    const Robot& b = robots[static_cast<std::size_t>(string.robot_b.index)];
+    return {link_pose(a, string.link_a) * string.point_a,
+            link_pose(b, string.link_b) * string.point_b};
+  }
+
+  // Adds `force` (world) at `point` (world) of model link `link` to its Bullet link, as a force
+  // at the centre of mass and the torque about it.
+  void add_force_at(Robot& robot, int link, const Eigen::Vector3d& point,
+                    const Eigen::Vector3d& force) {
+    const Eigen::Vector3d torque = (point - com_position(robot, link)).cross(force);
+    if (link == 0) {
+      robot.body->addBaseForce(to_bt(force));
+      robot.body->addBaseTorque(to_bt(torque));
+    } else {
+      robot.body->addLinkForce(link - 1, to_bt(force));
+      robot.body->addLinkTorque(link - 1, to_bt(torque));
+    }
+  }
+
+  // Each taut string's pull, for the coming physics step.
+  void apply_strings() {
+    for (const StringOptions& string : strings) {
+      const auto [end_a, end_b] = string_ends(string);
+      const Eigen::Vector3d span = end_b - end_a;
+      const double length = span.norm();
+      if (length <= string.max_length_m) continue;
+      const Eigen::Vector3d along = span / length;
+      Robot& a = robots[static_cast<std::size_t>(string.robot_a.index)];
+      Robot& b = robots[static_cast<std::size_t>(string.robot_b.index)];
+      const double lengthening =
+          (point_velocity(b, string.link_b, end_b) - point_velocity(a, string.link_a, end_a))
+              .dot(along);
+      const double pull = std::max(0.0, string.stiffness_n_m * (length - string.max_length_m) +
+                                            string.damping_n_s_m * lengthening);
+      add_force_at(a, string.link_a, end_a, pull * along);
+      add_force_at(b, string.link_b, end_b, -pull * along);
+    }
+  }
+
   // The points of the dispatcher's manifolds: those with a normal impulse in the last step or
   // overlapping, or (touching_only) just those overlapping or touching.
   std::vector<Contact> manifold_contacts(double timestep_s, bool touching_only) const {
@@ -478,6 +521,7 @@ struct World::Impl {
   std::vector<Robot> robots;
   std::vector<Body> bodies;
   std::vector<VisualRef> visual_refs;
+  std::vector<StringOptions> strings;
 
   std::unique_ptr<btDefaultCollisionConfiguration> collision_config;
   std::unique_ptr<btCollisionDispatcher> dispatcher;
@@ -595,6 +639,7 @@ void World::step(int steps) {
     throw std::invalid_argument("World::step: steps must be >= 0, got " + std::to_string(steps));
   for (int s = 0; s < steps; ++s) {
     for (Impl::Robot& robot : impl_->robots) impl_->apply_controls(robot);
+    impl_->apply_strings();
     impl_->dynamics->stepSimulation(config_.timestep_s, 0, config_.timestep_s);
     ++step_count_;
     for (Impl::Robot& robot : impl_->robots) impl_->update_kinematics(robot);
@@ -892,6 +937,45 @@ void World::set_body_pose(BodyId body, const Eigen::Isometry3d& X_world_body) {
 int World::segmentation_id(BodyId body) const {
   check_body(body, "segmentation_id");
   return impl_->bodies[static_cast<std::size_t>(body.index)].segmentation_id;
+}
+
+int World::add_string(const StringOptions& options) {
+  const auto check_end = [&](RobotId robot, int link, const Eigen::Vector3d& point) {
+    check_robot(robot, "add_string");
+    const RobotModel& model = *impl_->robots[static_cast<std::size_t>(robot.index)].model;
+    if (link < 0 || static_cast<std::size_t>(link) >= model.links().size()) {
+      throw std::out_of_range("World::add_string: robot \"" + model.name() + "\" has " +
+                              std::to_string(model.links().size()) + " links, got link " +
+                              std::to_string(link));
+    }
+    if (!point.allFinite()) {
+      throw std::invalid_argument("World::add_string: a non-finite point on robot \"" +
+                                  model.name() + "\"");
+    }
+  };
+  check_end(options.robot_a, options.link_a, options.point_a);
+  check_end(options.robot_b, options.link_b, options.point_b);
+  const auto positive = [](double v) { return v > 0 && std::isfinite(v); };
+  if (!positive(options.max_length_m) || !positive(options.stiffness_n_m) ||
+      !(options.damping_n_s_m >= 0 && std::isfinite(options.damping_n_s_m))) {
+    std::ostringstream message;
+    message << "World::add_string: max_length_m and stiffness_n_m must be > 0 and "
+               "damping_n_s_m >= 0, all finite; got max_length_m "
+            << options.max_length_m << ", stiffness_n_m " << options.stiffness_n_m
+            << ", damping_n_s_m " << options.damping_n_s_m;
+    throw std::invalid_argument(message.str());
+  }
+  impl_->strings.push_back(options);
+  return static_cast<int>(impl_->strings.size()) - 1;
+}
+
+double World::string_length(int string) const {
+  if (string < 0 || static_cast<std::size_t>(string) >= impl_->strings.size()) {
+    throw std::out_of_range("World::string_length: no string " + std::to_string(string) +
+                            " (there are " + std::to_string(impl_->strings.size()) + ")");
+  }
+  const auto [end_a, end_b] = impl_->string_ends(impl_->strings[static_cast<std::size_t>(string)]);
+  return (end_b - end_a).norm();
 }
 
 std::vector<Contact> World::contacts() const {

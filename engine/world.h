@@ -121,6 +121,25 @@ struct BodyId {
 inline bool operator==(BodyId a, BodyId b) { return a.index == b.index; }
 inline bool operator!=(BodyId a, BodyId b) { return a.index != b.index; }
 
+/// A massless string between a point of one robot link and a point of another (dm_control's
+/// spatial tendon with only a length limit, as ball-in-cup's). Slack while the points are at
+/// most `max_length_m` apart; past that it pulls them together along the line between them with a
+/// spring and a damper (pull only, never push), every physics step.
+struct StringOptions {
+  RobotId robot_a;
+  /// An index into robot_a's model links(), and the point in that link's frame, m.
+  int link_a = 0;
+  Eigen::Vector3d point_a = Eigen::Vector3d::Zero();
+  RobotId robot_b;
+  int link_b = 0;
+  Eigen::Vector3d point_b = Eigen::Vector3d::Zero();
+  /// The length at which it goes taut, m (> 0).
+  double max_length_m = 1.0;
+  /// Its pull per metre past max_length_m, N/m (> 0), and per m/s of lengthening, N s/m (>= 0).
+  double stiffness_n_m = 1000.0;
+  double damping_n_s_m = 0.0;
+};
+
 /// Something the renderer draws. Its pose comes from `visual_poses()`, in the same order.
 struct VisualShape {
   /// The shape; `visual_poses()` gives its world pose.
@@ -169,6 +188,12 @@ class World {
   /// Adds a free body. A static mesh body collides as its triangles, a moving one as its convex
   /// hull. Throws std::invalid_argument for a negative mass or a mesh geometry without a mesh.
   BodyId add_body(BodyOptions options);
+  /// Adds a string (StringOptions) and returns its index, from 0 in the order added. Throws
+  /// std::out_of_range for a robot or link that does not exist, std::invalid_argument for a
+  /// length or stiffness that is not positive and finite or a negative damping.
+  int add_string(const StringOptions& options);
+  /// String `string`'s length now (the distance between its points), m.
+  double string_length(int string) const;
 
   /// Advances `steps` physics steps of config().timestep_s with the current controls. Throws
   /// std::invalid_argument for steps < 0, and NonFiniteState after the step that left a state

@@ -5,6 +5,7 @@
 #include "pixelgym/envs/tasks/acrobot.h"
 #include "pixelgym/envs/tasks/arm_push.h"
 #include "pixelgym/envs/tasks/arm_reach.h"
+#include "pixelgym/envs/tasks/ball_in_cup.h"
 #include "pixelgym/envs/tasks/cartpole.h"
 #include "pixelgym/envs/tasks/cheetah.h"
 #include "pixelgym/envs/tasks/finger.h"
@@ -30,6 +31,7 @@ void register_builtin_envs(Registry& registry) {
   registry.register_env(CheetahTask::spec_v0());
   for (EnvSpec& spec : WalkerTask::specs()) registry.register_env(std::move(spec));
   registry.register_env(FingerTask::spec_v0());
+  registry.register_env(BallInCupTask::spec_v0());
 }
 
 // The process-wide registry and its free functions (declared in envs/registry.h and

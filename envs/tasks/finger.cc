@@ -9,6 +9,7 @@
 #include "pixelgym/envs/spaces/box.h"
 #include "pixelgym/envs/tasks/angles.h"
 #include "pixelgym/envs/tasks/pixel_env.h"
+#include "pixelgym/envs/tasks/tracking_camera.h"
 
 namespace pixelgym {
 
@@ -17,15 +18,6 @@ namespace {
 constexpr int kDofs = 3;
 // dm_control's _set_random_joint_angles gives up after this many draws that touch.
 constexpr int kMaxStartAttempts = 1000;
-
-// dm_control's fixed cameras, 45 degree field of view. cam0: pos (0, -1, 0.8), xyaxes (1, 0, 0),
-// (0, 1, 2); cam1: pos (0, -1, 0.4), xyaxes (1, 0, 0), (0, 0, 1).
-render::Camera fixed_camera(const Eigen::Vector3f& eye, const Eigen::Vector3f& forward,
-                            const Eigen::Vector3f& up) {
-  render::Camera camera = render::Camera::look_at(eye, eye + forward, up);
-  camera.fov_y_deg = 45.0F;
-  return camera;
-}
 
 // The touch sensors: ellipsoids in the distal link's frame (dm_control's touchtop and
 // touchbottom sites: size 0.025, 0.03, 0.025 at x = +-0.01, z = -0.17).
@@ -80,11 +72,7 @@ void FingerTask::build(engine::World& world) {
 }
 
 render::Camera FingerTask::camera(const std::string& name, const engine::World& /*world*/) const {
-  if (name == "cam1") {
-    return fixed_camera({0.0F, -1.0F, 0.4F}, Eigen::Vector3f::UnitY(), Eigen::Vector3f::UnitZ());
-  }
-  const float s = 1.0F / std::sqrt(5.0F);
-  return fixed_camera({0.0F, -1.0F, 0.8F}, {0.0F, 2.0F * s, -s}, {0.0F, s, 2.0F * s});
+  return finger_and_cup_camera(name);
 }
 
 void FingerTask::initialize_episode(engine::World& world, Rng& rng) {

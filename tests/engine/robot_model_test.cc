@@ -59,7 +59,7 @@ INSTANTIATE_TEST_SUITE_P(
         AssetCase{"arm/arm.urdf", 10, 7}, AssetCase{"objects/table.urdf", 1, 0},
         AssetCase{"objects/cube.urdf", 1, 0}, AssetCase{"objects/target.urdf", 1, 0},
         AssetCase{"cheetah/cheetah.urdf", 10, 9}, AssetCase{"walker/walker.urdf", 10, 9},
-        AssetCase{"finger/finger.urdf", 4, 3}),
+        AssetCase{"finger/finger.urdf", 4, 3}, AssetCase{"ball_in_cup/ball_in_cup.urdf", 5, 4}),
     [](const ::testing::TestParamInfo<AssetCase>& param_info) {
       std::string name = std::filesystem::path(param_info.param.file).stem().string();
       return name;
@@ -71,7 +71,7 @@ TEST(RobotModelTest, EveryUrdfUnderAssetsIsCovered) {
            std::string(PIXELGYM_SOURCE_DIR) + "/assets")) {
     if (entry.path().extension() == ".urdf") ++count;
   }
-  EXPECT_EQ(count, 13) << "a new asset needs a line in AssetTest";
+  EXPECT_EQ(count, 14) << "a new asset needs a line in AssetTest";
 }
 
 TEST(RobotModelTest, ArmIsMadeOfMeshesWithLimitsAndInertias) {

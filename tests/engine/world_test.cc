@@ -459,6 +459,53 @@ TEST(WorldTest, LinkContactsListWhatTouchesOneLinkWithItsForce) {
               ::testing::ThrowsMessage<std::out_of_range>(HasSubstr("has 4 links, got link 7")));
 }
 
+TEST(WorldTest, AStringIsSlackUpToItsLengthAndPullsPastIt) {
+  ModelCache cache;
+  World world;  // gravity on
+  const RobotId cup_and_ball =
+      world.add_robot(cache.load_urdf(asset_path("ball_in_cup/ball_in_cup.urdf")), RobotOptions{});
+  const RobotModel& model = world.robot_model(cup_and_ball);
+  StringOptions options;
+  options.robot_a = cup_and_ball;
+  options.link_a = model.link_index("ball");
+  options.robot_b = cup_and_ball;
+  options.link_b = model.link_index("cup");
+  options.point_b = Eigen::Vector3d(0, 0, -0.108);
+  options.max_length_m = 0.3;
+  options.stiffness_n_m = 500.0;
+  options.damping_n_s_m = 2.0;
+  const int string = world.add_string(options);
+  // The ball starts 0.1 m below the cup's bottom: slack, so it falls freely for 0.1 s.
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(4);
+  q[model.dof_index("ball_z")] = 0.6 - 0.108 - 0.1 - 0.2;
+  world.set_joint_state(cup_and_ball, q, Eigen::VectorXd::Zero(4));
+  EXPECT_NEAR(world.string_length(string), 0.1, 1e-9);
+  const int steps = static_cast<int>(std::lround(0.1 / world.config().timestep_s));
+  world.step(steps);
+  EXPECT_NEAR(world.joint_velocity(cup_and_ball, model.dof_index("ball_z")),
+              -9.81 * steps * world.config().timestep_s, 1e-6);
+  // Held up by the string, it comes to hang 0.3 m under the cup's bottom, plus the stretch of
+  // its weight (0.0654 kg x 9.81 / 500 N/m = 1.3 mm).
+  world.step(2400);
+  EXPECT_NEAR(world.string_length(string), 0.3 + 0.0654 * 9.81 / 500.0, 2e-4);
+  EXPECT_NEAR(world.joint_velocity(cup_and_ball, model.dof_index("ball_z")), 0.0, 1e-3);
+
+  StringOptions bad = options;
+  bad.max_length_m = 0.0;
+  EXPECT_THAT([&] { world.add_string(bad); },
+              ::testing::ThrowsMessage<std::invalid_argument>(HasSubstr("got max_length_m 0")));
+  bad = options;
+  bad.damping_n_s_m = -1.0;
+  EXPECT_THAT([&] { world.add_string(bad); },
+              ::testing::ThrowsMessage<std::invalid_argument>(HasSubstr("damping_n_s_m -1")));
+  bad = options;
+  bad.link_b = 9;
+  EXPECT_THAT([&] { world.add_string(bad); },
+              ::testing::ThrowsMessage<std::out_of_range>(HasSubstr("has 5 links, got link 9")));
+  EXPECT_THAT([&] { world.string_length(1); },
+              ::testing::ThrowsMessage<std::out_of_range>(HasSubstr("no string 1 (there are 1)")));
+}
+
 TEST(WorldTest, StaticMeshBodiesCollideAsTriangles) {
   // A ball dropped into the pedestal's open top ring lands on its cap, 0.16 m up: the triangles,
   // not a bounding box, hold it.

@@ -714,11 +714,11 @@ TEST(PixelgymCliTest, BadWrapSpecIsAUsageErrorNamingWrapperArgumentAndExpectatio
 // --- inspect ---
 
 const std::vector<std::string> kAssetUrdfs = {
-    "acrobot/acrobot.urdf",   "arm/arm.urdf",         "cheetah/cheetah.urdf",
-    "cartpole/cartpole.urdf", "finger/finger.urdf",   "cartpole/cartpole_v1.urdf",
-    "objects/cube.urdf",      "objects/table.urdf",   "objects/target.urdf",
-    "pendulum/pendulum.urdf", "reacher/reacher.urdf", "reacher/reacher_v1.urdf",
-    "walker/walker.urdf"};
+    "acrobot/acrobot.urdf",         "arm/arm.urdf",           "cheetah/cheetah.urdf",
+    "ball_in_cup/ball_in_cup.urdf", "cartpole/cartpole.urdf", "finger/finger.urdf",
+    "cartpole/cartpole_v1.urdf",    "objects/cube.urdf",      "objects/table.urdf",
+    "objects/target.urdf",          "pendulum/pendulum.urdf", "reacher/reacher.urdf",
+    "reacher/reacher_v1.urdf",      "walker/walker.urdf"};
 
 TEST(PixelgymCliTest, InspectWorksOnEveryAsset) {
   std::set<std::string> found;
