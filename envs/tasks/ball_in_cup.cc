@@ -18,10 +18,12 @@ constexpr const char* kJoints[kDofs] = {"cup_x", "cup_z", "ball_x", "ball_z"};
 // dm_control's initialize_episode draws until nothing touches; it never needs many draws.
 constexpr int kMaxStartAttempts = 1000;
 
-// The string's spring and damper: MuJoCo's default constraint softness (solref 0.02 s, damping
-// ratio 1; solimp's impedance 0.95) pulls a violation r back as r'' = -(b r' + k r) with
-// b = 2 / (0.95 x 0.02 s) = 105 /s and k = 0.95 / (0.95^2 x 0.02^2 s^2) = 2632 /s^2, on the
-// reduced mass of ball and cup, 0.0327 kg: 86 N/m and 3.4 N s/m.
+// The string's spring and damper: MuJoCo's reference dynamics for a violated limit (solref 0.02 s,
+// damping ratio 1; impedance 0.95) are r'' = -(b r' + k r) with b = 2 / (0.95 x 0.02 s) = 105 /s
+// and k = 0.95 / (0.95^2 x 0.02^2 s^2) = 2632 /s^2; on the reduced mass of ball and cup, 0.0327
+// kg: 86 N/m and 3.4 N s/m. This leaves out the impedance's cancellation of 95% of the
+// acceleration that lengthens the string, so the string is softer than dm_control's (7.5 mm of
+// stretch under the hanging ball against under a millimetre): docs/tasks.md.
 constexpr double kStringStiffness = 86.0;
 constexpr double kStringDamping = 3.4;
 

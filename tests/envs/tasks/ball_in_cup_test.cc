@@ -186,8 +186,8 @@ TEST(BallInCupTest, TheStringHoldsTheBallThreeTenthsOfAMetreFromTheCupsBottom) {
   const Value obs = env->step(action(0, 0)).obs;
   EXPECT_NEAR(state(obs, "joint_pos", 1), -0.064, 0.003);
   EXPECT_NEAR(state(obs, "joint_pos", 2), state(obs, "joint_pos", 0), 0.01);  // right under it
-  // Shaken as hard as the motors go, it stretches a little, as MuJoCo's soft limit does (0.335 m
-  // at most here), and never runs away.
+  // Shaken as hard as the motors go, it stretches (0.335 m at most here: more than dm_control's
+  // nearly rigid limit would, see docs/tasks.md) and never runs away.
   env->reset(2);
   Rng rng(2);
   double longest = 0.0;

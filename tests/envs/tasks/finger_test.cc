@@ -160,10 +160,16 @@ TEST(FingerTest, WithoutGravityOrTorqueNothingMoves) {
   for (int j = 0; j < 2; ++j) {
     EXPECT_NEAR(state(obs, "joint_pos", j), state(start, "joint_pos", j), 1e-6);
   }
-  // A torque turns the proximal joint, and it goes the way of dm_control's: about -y, so that
-  // positive angles lift a finger pointing at the spinner.
-  obs = env->step(action(1, 0)).obs;
-  EXPECT_GT(state(obs, "joint_vel", 0), 0.1);
+  // A torque turns the proximal joint about -y, as dm_control's: a positive angle turns the
+  // finger from +x towards +z, so the distal joint (0.18 m out) moves along (-sin q, cos q).
+  const double q = state(obs, "joint_pos", 0);
+  const engine::World& world = world_of(*env);
+  const int distal = world.robot_model(engine::RobotId{0}).link_index("distal");
+  const Eigen::Vector3d before = world.link_pose(engine::RobotId{0}, distal).translation();
+  env->step(action(1, 0));
+  const Eigen::Vector3d moved = world.link_pose(engine::RobotId{0}, distal).translation() - before;
+  EXPECT_GT(-std::sin(q) * moved.x() + std::cos(q) * moved.z(), 1e-4);
+  EXPECT_NEAR(moved.y(), 0.0, 1e-12);  // in the x-z plane
 }
 
 TEST(FingerTest, TouchSensesTheFingertipPressingOnTheSpinner) {
