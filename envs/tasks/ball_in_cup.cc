@@ -18,14 +18,14 @@ constexpr const char* kJoints[kDofs] = {"cup_x", "cup_z", "ball_x", "ball_z"};
 // dm_control's initialize_episode draws until nothing touches; it never needs many draws.
 constexpr int kMaxStartAttempts = 1000;
 
-// The string's spring and damper: MuJoCo's reference dynamics for a violated limit (solref 0.02 s,
-// damping ratio 1; impedance 0.95) are r'' = -(b r' + k r) with b = 2 / (0.95 x 0.02 s) = 105 /s
-// and k = 0.95 / (0.95^2 x 0.02^2 s^2) = 2632 /s^2; on the reduced mass of ball and cup, 0.0327
-// kg: 86 N/m and 3.4 N s/m. This leaves out the impedance's cancellation of 95% of the
-// acceleration that lengthens the string, so the string is softer than dm_control's (7.5 mm of
-// stretch under the hanging ball against under a millimetre): docs/tasks.md.
-constexpr double kStringStiffness = 86.0;
-constexpr double kStringDamping = 3.4;
+// The string's spring and damper, stiff enough to stand in for MuJoCo's nearly rigid limit
+// (solref 0.02 s, damping ratio 1, impedance 0.95: it cancels 95% of the acceleration that would
+// lengthen the string at once, so the hanging ball stretches it by 0.2-0.4 mm): 1,635 N/m gives
+// 0.4 mm under the ball's weight. The damper is critical for the pair's reduced mass, 0.0327 kg
+// (2 sqrt(1635 x 0.0327) = 14.6 N s/m). Applied explicitly: the spring turns 224 rad/s x 2 ms =
+// 0.45 rad a physics step, well inside the step's stability.
+constexpr double kStringStiffness = 1635.0;
+constexpr double kStringDamping = 14.6;
 
 }  // namespace
 

@@ -19,8 +19,8 @@ namespace pixelgym {
 /// - State: joint_pos (4: cup x, cup z, ball x, ball z; the cup from (0, 0.6), the ball from
 ///   (0, 0.2), m), joint_vel (4). dm_control's position and velocity.
 /// - The string: World::add_string, slack up to 0.3 m from the ball's centre to the cup's bottom
-///   (0.108 m below its rim), past that a pull-only spring-damper (86 N/m, 3.4 N s/m), softer
-///   than dm_control's nearly rigid limit (docs/tasks.md).
+///   (0.108 m below its rim), past that a pull-only spring-damper (1,635 N/m, 14.6 N s/m) that
+///   stretches by millimetres, as dm_control's nearly rigid limit (docs/tasks.md).
 /// - Episodes: the ball starts at x uniform in [-0.2, 0.2] m and 0.4 to 0.7 m up (drawn again
 ///   until it touches nothing), the cup at (0, 0.6), all at rest. 1000 control steps of 0.02 s;
 ///   no termination.
