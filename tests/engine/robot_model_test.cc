@@ -129,6 +129,22 @@ TEST(RobotModelTest, DofIndexNumbersMovableJointsAsTheWorldDoes) {
                   .name,
               name);
   }
+  // A fixed joint before the movable one, so that the joint's index is not its degree of
+  // freedom's.
+  const auto mounted_path =
+      std::filesystem::temp_directory_path() / "pixelgym_robot_model_mounted.urdf";
+  std::ofstream(mounted_path)
+      << "<robot name=\"mounted\"><link name=\"base\"/><link name=\"mount\"/>"
+         "<link name=\"bar\"><inertial><mass value=\"1\"/>"
+         "<inertia ixx=\"1\" iyy=\"1\" izz=\"1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial></link>"
+         "<joint name=\"mount_joint\" type=\"fixed\"><parent link=\"base\"/>"
+         "<child link=\"mount\"/></joint>"
+         "<joint name=\"hinge\" type=\"continuous\"><parent link=\"mount\"/>"
+         "<child link=\"bar\"/><axis xyz=\"0 1 0\"/></joint></robot>";
+  const auto mounted = parse_urdf(mounted_path.string(), meshes);
+  ASSERT_EQ(mounted->joint_index("hinge"), 1);
+  EXPECT_EQ(mounted->dof_index("hinge"), 0);
+
   const auto arm = parse_urdf(asset_path("arm/arm.urdf"), meshes);
   std::string fixed;
   for (const JointModel& joint : arm->joints()) {
