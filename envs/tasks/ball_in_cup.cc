@@ -7,6 +7,7 @@
 #include "pixelgym/engine/robot_model.h"
 #include "pixelgym/envs/spaces/box.h"
 #include "pixelgym/envs/tasks/pixel_env.h"
+#include "pixelgym/envs/tasks/start_state.h"
 #include "pixelgym/envs/tasks/tracking_camera.h"
 
 namespace pixelgym {
@@ -15,8 +16,6 @@ namespace {
 
 constexpr int kDofs = 4;
 constexpr const char* kJoints[kDofs] = {"cup_x", "cup_z", "ball_x", "ball_z"};
-// dm_control's initialize_episode draws until nothing touches; it never needs many draws.
-constexpr int kMaxStartAttempts = 1000;
 
 // The string's spring and damper, stiff enough to stand in for MuJoCo's nearly rigid limit
 // (solref 0.02 s, damping ratio 1, impedance 0.95: it cancels 95% of the acceleration that would
@@ -68,14 +67,10 @@ render::Camera BallInCupTask::camera(const std::string& name,
 
 void BallInCupTask::initialize_episode(engine::World& world, Rng& rng) {
   Eigen::VectorXd q = Eigen::VectorXd::Zero(kDofs);
-  for (int attempt = 0; attempt < kMaxStartAttempts; ++attempt) {
-    q[dof_[2]] = rng.uniform(-0.2, 0.2);
-    q[dof_[3]] = rng.uniform(0.2, 0.5);
-    world.set_joint_state(robot_, q, Eigen::VectorXd::Zero(kDofs));
-    if (world.detect_contacts().empty()) return;
-  }
-  throw std::runtime_error("BallInCupTask: no start without contacts in " +
-                           std::to_string(kMaxStartAttempts) + " draws");
+  draw_start_without_contacts(world, robot_, q, "BallInCupTask", [&](Eigen::VectorXd& start) {
+    start[dof_[2]] = rng.uniform(-0.2, 0.2);
+    start[dof_[3]] = rng.uniform(0.2, 0.5);
+  });
 }
 
 void BallInCupTask::before_step(const Value& action, engine::World& world) {

@@ -9,6 +9,7 @@
 #include "pixelgym/envs/spaces/box.h"
 #include "pixelgym/envs/tasks/angles.h"
 #include "pixelgym/envs/tasks/pixel_env.h"
+#include "pixelgym/envs/tasks/start_state.h"
 #include "pixelgym/envs/tasks/tracking_camera.h"
 
 namespace pixelgym {
@@ -16,8 +17,6 @@ namespace pixelgym {
 namespace {
 
 constexpr int kDofs = 3;
-// dm_control's _set_random_joint_angles gives up after this many draws that touch.
-constexpr int kMaxStartAttempts = 1000;
 
 // The touch sensors: ellipsoids in the distal link's frame (dm_control's touchtop and
 // touchbottom sites: size 0.025, 0.03, 0.025 at x = +-0.01, z = -0.17).
@@ -82,15 +81,11 @@ void FingerTask::initialize_episode(engine::World& world, Rng& rng) {
         .joints()[static_cast<std::size_t>(model.movable_joints()[static_cast<std::size_t>(dof)])];
   };
   Eigen::VectorXd q = Eigen::VectorXd::Zero(kDofs);
-  for (int attempt = 0; attempt < kMaxStartAttempts; ++attempt) {
-    q[proximal_] = rng.uniform(range(proximal_).lower, range(proximal_).upper);
-    q[distal_] = rng.uniform(range(distal_).lower, range(distal_).upper);
-    q[hinge_] = rng.uniform(-kPi, kPi);
-    world.set_joint_state(robot_, q, Eigen::VectorXd::Zero(kDofs));
-    if (world.detect_contacts().empty()) return;
-  }
-  throw std::runtime_error("FingerTask: no start without contacts in " +
-                           std::to_string(kMaxStartAttempts) + " draws");
+  draw_start_without_contacts(world, robot_, q, "FingerTask", [&](Eigen::VectorXd& start) {
+    start[proximal_] = rng.uniform(range(proximal_).lower, range(proximal_).upper);
+    start[distal_] = rng.uniform(range(distal_).lower, range(distal_).upper);
+    start[hinge_] = rng.uniform(-kPi, kPi);
+  });
 }
 
 void FingerTask::before_step(const Value& action, engine::World& world) {

@@ -1,5 +1,5 @@
-// pixelgym train, eval and compare: their command lines (train_commands.h), and compare, which
-// draws finished runs' curves; train and eval run in pixelgym-train (trainer.cc).
+// pixelgym train, eval, export and compare: their command lines (train_commands.h), and compare,
+// which draws finished runs' curves; train, eval and export run in pixelgym-train (trainer.cc).
 #include "examples/pixelgym/train_commands.h"
 
 #include <unistd.h>
@@ -205,6 +205,19 @@ void declare_eval(CLI::App& eval, EvalArguments& args) {
                 "Sample actions from the policy instead of taking its mean / most likely one");
 }
 
+// --- export ---
+
+void declare_export(CLI::App& command, ExportArguments& args) {
+  command.description(
+      "Write a trained policy (a run folder's latest checkpoint, or a checkpoint file) as a "
+      "policy file that runs without LibTorch: JSON with the env id and kwargs, the observation "
+      "keys it reads and its layers' weights (pixelgym::testing::MlpPolicy loads and runs it). "
+      "For policies that are an MLP over vector observations: a drq run trained from state "
+      "(--set obs_mode=state)");
+  command.add_option("run", args.run, "Run folder or checkpoint file (.pgck)")->required();
+  command.add_option("--out", args.out, "The policy file to write (JSON)")->required();
+}
+
 // --- compare ---
 
 struct CompareArguments {
@@ -340,17 +353,20 @@ Trainer exec_trainer(char** argv) {
     std::cout.flush();
     std::cerr.flush();
     ::execv(program.c_str(), argv);
-    throw std::runtime_error("cannot start " + program.string() + ": " + std::strerror(errno) +
-                             " (pixelgym runs train and eval in pixelgym-train, the program "
-                             "beside it that links LibTorch)");
+    throw std::runtime_error(
+        "cannot start " + program.string() + ": " + std::strerror(errno) +
+        " (pixelgym runs train, eval and export in pixelgym-train, the program "
+        "beside it that links LibTorch)");
   };
   return {[replace_this_process](const TrainArguments&) { return replace_this_process(); },
-          [replace_this_process](const EvalArguments&) { return replace_this_process(); }};
+          [replace_this_process](const EvalArguments&) { return replace_this_process(); },
+          [replace_this_process](const ExportArguments&) { return replace_this_process(); }};
 }
 
 std::vector<Command> add_train_commands(CLI::App& app, const Trainer& trainer) {
   return {add_command(app, "train", declare_train, trainer.train),
           add_command(app, "eval", declare_eval, trainer.eval),
+          add_command(app, "export", declare_export, trainer.export_policy),
           add_command(app, "compare", declare_compare, run_compare)};
 }
 

@@ -1,6 +1,6 @@
-// pixelgym train and eval: their command lines, and what runs them. LibTorch is loaded only by
-// pixelgym-train, the program that runs them (trainer.cc); pixelgym parses their command lines and
-// then replaces itself by it, so that its other subcommands start without LibTorch (0.9 s of
+// pixelgym train, eval and export: their command lines, and what runs them. LibTorch is loaded only
+// by pixelgym-train, the program that runs them (trainer.cc); pixelgym parses their command lines
+// and then replaces itself by it, so that its other subcommands start without LibTorch (0.9 s of
 // every start otherwise).
 #pragma once
 
@@ -54,10 +54,18 @@ struct EvalArguments {
   bool stochastic = false;
 };
 
-/// What runs train and eval once their command lines parsed (each returns the exit code).
+/// `pixelgym export`'s command line.
+struct ExportArguments {
+  std::string run;
+  std::string out;
+};
+
+/// What runs train, eval and export once their command lines parsed (each returns the exit
+/// code).
 struct Trainer {
   std::function<int(const TrainArguments&)> train;
   std::function<int(const EvalArguments&)> eval;
+  std::function<int(const ExportArguments&)> export_policy;
 };
 
 /// pixelgym-train's: trains and evaluates in this process, with LibTorch (trainer.cc).
@@ -68,7 +76,7 @@ Trainer in_process_trainer();
 /// the program and the OS's reason when it cannot be started.
 Trainer exec_trainer(char** argv);
 
-/// Adds train, eval and compare to `app`; train and eval run through `trainer`.
+/// Adds train, eval, export and compare to `app`; train, eval and export run through `trainer`.
 std::vector<Command> add_train_commands(CLI::App& app, const Trainer& trainer);
 
 }  // namespace pixelgym::cli

@@ -21,6 +21,7 @@
 #include "examples/trainer/drq/drq_algorithm.h"
 #include "examples/trainer/drqv2/drqv2_algorithm.h"
 #include "examples/trainer/ppo/ppo_algorithm.h"
+#include "pixelgym/trainer/atomic_file.h"
 #include "pixelgym/trainer/evaluation.h"
 #include "pixelgym/trainer/process_tuning.h"
 #include "pixelgym/trainer/recipes.h"
@@ -402,8 +403,45 @@ int run_eval(const EvalArguments& args) {
   return 0;
 }
 
+int run_export(const ExportArguments& args) {
+  const fs::path out(args.out);
+  const fs::path folder = out.parent_path().empty() ? fs::path(".") : out.parent_path();
+  if (!fs::is_directory(folder)) {
+    throw UsageError("export --out: expected a file in an existing folder, got \"" + args.out +
+                     "\" (" + folder.string() + " is not a folder)");
+  }
+  trainer::CheckpointPolicy policy =
+      trainer::load_checkpoint_policy(kAlgorithms, args.run, "export", std::cerr);
+  const trainer::RunSettings& settings = policy.settings;
+  nlohmann::json file;
+  try {
+    file = policy.actor->mlp_policy();
+  } catch (const std::invalid_argument& error) {
+    throw std::runtime_error("export: " + policy.checkpoint.string() + " (" + settings.algorithm +
+                             " on " + settings.env_id + "): " + error.what());
+  }
+  if (!settings.wraps.empty()) {
+    throw std::runtime_error("export: " + policy.checkpoint.string() +
+                             ": expected a run on the bare env (a policy file names the env by its "
+                             "id and kwargs), got one wrapped in --wrap " +
+                             settings.wraps.front());
+  }
+  file["env_id"] = settings.env_id;
+  file["env_kwargs"] = trainer::settings_to_json(settings).at("env_kwargs");
+  file["source"] = {{"checkpoint", policy.checkpoint.filename().string()},
+                    {"algorithm", settings.algorithm},
+                    {"env_steps", policy.env_steps},
+                    {"seed", settings.seed()}};
+  const std::string text = file.dump(1) + "\n";
+  trainer::write_file_atomically(out, {text}, "export");
+  std::cout << "wrote " << out.string() << " (" << settings.env_id << ", "
+            << file.at("layers").size() << " layers, from " << policy.checkpoint.string() << " at "
+            << policy.env_steps << " env steps)\n";
+  return 0;
+}
+
 }  // namespace
 
-Trainer in_process_trainer() { return {run_train, run_eval}; }
+Trainer in_process_trainer() { return {run_train, run_eval, run_export}; }
 
 }  // namespace pixelgym::cli

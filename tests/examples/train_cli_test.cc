@@ -24,10 +24,13 @@
 #include <vector>
 
 #include "examples/trainer/drqv2/drqv2.h"
+#include "pixelgym/envs/registry.h"
+#include "pixelgym/testing/mlp_policy.h"
 #include "pixelgym/trainer/checkpoint_file.h"
 #include "pixelgym/trainer/progress_csv.h"
 #include "pixelgym/trainer/recipes.h"
 #include "pixelgym/trainer/training_run.h"
+#include "tests/envs/tasks/scripted.h"
 #include "tests/examples/cli_run.h"
 
 namespace pixelgym::testing {
@@ -848,6 +851,72 @@ TEST(TrainCliTest, DrqResumesAsIfItHadNotStopped) {
     }
     EXPECT_EQ(json::parse(a.at("meta")).at("drq"), json::parse(b.at("meta")).at("drq"));
   }
+}
+
+// `pixelgym export` writes a drq policy trained from state as a policy file, and MlpPolicy runs it
+// as the run's policy: the same returns as `pixelgym eval` (deterministic actions) episode by
+// episode. A policy that reads pixels, a PPO run and a missing run are refused by name, and no
+// file is written for them.
+TEST(TrainCliTest, ExportWritesAPolicyFileThatActsAsTheRunsPolicy) {
+  const fs::path folder = fresh_folder("export");
+  const fs::path run = folder / "state";
+  std::ofstream(folder / "drq.json") << R"({"seed_env_steps": 24, "iteration_env_steps": 16,
+      "batch_size": 8, "hidden_dim": 16, "replay_capacity": 400})";
+  const CliRun trained = run_cli(
+      "train CartPoleSwingup-v1 --algo drq --set obs_mode=state --set action_repeat=2 "
+      "--set max_episode_steps=40 --threads 1 --config " +
+      (folder / "drq.json").string() + " --steps 160 --eval-episodes 1 --quiet --out " +
+      run.string());
+  ASSERT_EQ(trained.exit_code, 0) << trained.output;
+  const fs::path file = folder / "swingup.policy.json";
+  const CliRun exported = run_cli("export " + run.string() + " --out " + file.string());
+  ASSERT_EQ(exported.exit_code, 0) << exported.output;
+  EXPECT_NE(exported.output.find("wrote " + file.string() + " (CartPoleSwingup-v1, 3 layers"),
+            std::string::npos)
+      << exported.output;
+  const MlpPolicy policy = MlpPolicy::load(file.string());
+  EXPECT_EQ(policy.env_id(), "CartPoleSwingup-v1");
+  EXPECT_EQ(policy.action_size(), 1);
+  const CliRun evaluated = run_cli("eval " + run.string() + " --episodes 3 --seed 7");
+  ASSERT_EQ(evaluated.exit_code, 0) << evaluated.output;
+  std::unique_ptr<Env> env = make(policy.env_id(), policy.env_kwargs());
+  for (int e = 0; e < 3; ++e) {
+    const std::string line = "episode " + std::to_string(e) + ": return=";
+    const std::size_t at = evaluated.output.find(line);
+    ASSERT_NE(at, std::string::npos) << evaluated.output;
+    const double expected = std::stod(evaluated.output.substr(at + line.size()));
+    const double got = episode_return(*env, 7 + static_cast<std::uint64_t>(e),
+                                      [&](const Value& obs) { return Value(policy.act(obs)); });
+    // float32 in torch, double sums here: the actions agree to about 1e-6.
+    EXPECT_NEAR(got, expected, 1e-3 + 1e-4 * std::abs(expected)) << "episode " << e;
+  }
+
+  const auto refused = [&](const std::string& source, const std::string& expected) {
+    const fs::path out = folder / "refused.json";
+    const CliRun result = run_cli("export " + source + " --out " + out.string());
+    EXPECT_NE(result.exit_code, 0) << source;
+    EXPECT_NE(result.output.find(expected), std::string::npos) << result.output;
+    EXPECT_FALSE(fs::exists(out)) << source;
+  };
+  const fs::path pixels = folder / "pixels";
+  ASSERT_EQ(run_cli("train CartPoleSwingup-v1 --algo drq --set obs_mode=pixels --set width=32 "
+                    "--set height=32 --set max_episode_steps=24 --wrap frame_stack=3 --threads 1 "
+                    "--config " +
+                    (folder / "drq.json").string() +
+                    " --steps 32 --eval-episodes 1 --quiet --out " + pixels.string())
+                .exit_code,
+            0);
+  refused(pixels.string(),
+          "(drq on CartPoleSwingup-v1): expected a policy that reads vectors "
+          "only, got one that reads the image \"pixels\"");
+  const fs::path ppo = folder / "ppo";
+  ASSERT_EQ(run_cli(train_arguments(folder, "--steps 32 --out " + ppo.string())).exit_code, 0);
+  refused(ppo.string(),
+          "(ppo on CartPoleBalance-v0): expected a policy that is an MLP over "
+          "vector observations");
+  refused((folder / "nothing").string(),
+          "export: " + (folder / "nothing").string() + " does not exist");
+  fs::remove_all(folder);
 }
 
 // --config takes a recipe's name, a file or inline JSON, and --set-algo one setting over it, each

@@ -124,6 +124,8 @@ class Agent : public trainer::OffPolicyAgent {
   /// The mean when `deterministic` or `generator` is null, else a sample.
   torch::Tensor act(const trainer::ObservationTensors& obs, bool deterministic,
                     at::Generator* generator) override;
+  /// From vectors alone, `actor`: its first half is the Gaussian's mean.
+  torch::nn::Sequential policy_mlp() const override { return input().has_image ? nullptr : actor; }
 
   torch::nn::Sequential actor_head{nullptr}, critic_head{nullptr}, target_head{nullptr};
   torch::nn::Sequential actor{nullptr}, q1{nullptr}, q2{nullptr}, target_q1{nullptr},

@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,15 @@ class Actor {
   /// `observations` (the vector env's observation batch): the policy's most likely action when
   /// `deterministic`, else one sampled from it. Computes no gradients.
   virtual ActCounts act(const Value& observations, bool deterministic, Value& actions) = 0;
+  /// The policy as a policy file's JSON (pixelgym/testing/mlp_policy.h) without "env_id",
+  /// "env_kwargs" and "source", which the caller adds: for a policy that is an MLP over the
+  /// observation's float keys, its deterministic action. Throws std::invalid_argument saying why
+  /// this policy is not one (by default: none is).
+  virtual nlohmann::json mlp_policy() const {
+    throw std::invalid_argument(
+        "expected a policy that is an MLP over vector observations (a drq run trained from "
+        "state, --set obs_mode=state), got one of another kind");
+  }
 };
 
 /// What one Algorithm::iterate did.

@@ -85,9 +85,10 @@ std::unique_ptr<vector::SyncVectorEnv> evaluation_env(const RunSettings& setting
 
 // The checkpoint `run_or_checkpoint` names (see evaluate_checkpoint) and the folder of its run.
 std::pair<LoadedCheckpoint, fs::path> find_checkpoint(const fs::path& run_or_checkpoint,
+                                                      const std::string& command,
                                                       std::ostream& errors) {
   if (!fs::exists(run_or_checkpoint)) {
-    throw std::runtime_error("eval: " + run_or_checkpoint.string() +
+    throw std::runtime_error(command + ": " + run_or_checkpoint.string() +
                              " does not exist; expected a run folder (`pixelgym train --out`'s) "
                              "or a checkpoint file (ckpt-*.pgck)");
   }
@@ -101,15 +102,15 @@ std::pair<LoadedCheckpoint, fs::path> find_checkpoint(const fs::path& run_or_che
   }
   CheckpointSearch search = find_latest_checkpoint(run_or_checkpoint);
   for (const auto& skipped : search.skipped) {
-    errors << "eval: skipping " << skipped.path.string() << ": " << skipped.reason << "\n";
+    errors << command << ": skipping " << skipped.path.string() << ": " << skipped.reason << "\n";
   }
   if (!search.latest && search.skipped.empty() && !fs::exists(run_or_checkpoint / "config.json")) {
-    throw std::runtime_error("eval: " + run_or_checkpoint.string() +
+    throw std::runtime_error(command + ": " + run_or_checkpoint.string() +
                              " is not a run folder (no checkpoint ckpt-*.pgck, config.json or "
                              "summary.json in it)");
   }
   if (!search.latest) {
-    throw std::runtime_error("eval: no valid checkpoint in " + run_or_checkpoint.string());
+    throw std::runtime_error(command + ": no valid checkpoint in " + run_or_checkpoint.string());
   }
   return {std::move(*search.latest), run_or_checkpoint};
 }
@@ -119,7 +120,7 @@ std::pair<LoadedCheckpoint, fs::path> find_checkpoint(const fs::path& run_or_che
 // The run's settings and its algorithm.
 std::pair<RunSettings, const AlgorithmFactory*> checkpoint_settings(
     const LoadedCheckpoint& checkpoint, const fs::path& folder,
-    const AlgorithmFactories& algorithms) {
+    const AlgorithmFactories& algorithms, const std::string& command) {
   const auto read = [&](const json& config, const fs::path& where) {
     const AlgorithmFactory& algorithm = algorithm_of(config, where, algorithms);
     return std::make_pair(settings_from_json(config, where, algorithm), &algorithm);
@@ -128,12 +129,26 @@ std::pair<RunSettings, const AlgorithmFactory*> checkpoint_settings(
     return read(json::parse(embedded->second), checkpoint.path);
   }
   if (!fs::exists(folder / "config.json")) {
-    throw std::runtime_error("eval: " + checkpoint.path.string() +
+    throw std::runtime_error(command + ": " + checkpoint.path.string() +
                              " does not carry its run's settings, and there is no config.json "
                              "in " +
                              folder.string() + " (the run folder it belongs to)");
   }
-  return read(read_run_config(folder / "config.json", "eval"), folder / "config.json");
+  return read(read_run_config(folder / "config.json", command), folder / "config.json");
+}
+
+// The policy of `checkpoint`, loaded by `algorithm` for an env built as the run's, computing
+// with the run's torch threads.
+std::unique_ptr<Actor> load_run_actor(const AlgorithmFactory& algorithm,
+                                      const RunSettings& settings,
+                                      const LoadedCheckpoint& checkpoint) {
+  algorithm.set_threads(settings.torch_threads);
+  // The spaces come from one env built as the run's.
+  std::unique_ptr<Env> probe = make_run_env(settings);
+  std::unique_ptr<Actor> actor = algorithm.load_actor(
+      probe->observation_space(), probe->action_space(), settings.algorithm_config, checkpoint);
+  probe->close();
+  return actor;
 }
 
 }  // namespace
@@ -292,8 +307,8 @@ CheckpointEvaluation evaluate_checkpoint(const AlgorithmFactories& algorithms,
                                          const fs::path& run_or_checkpoint,
                                          const CheckpointEvaluationRequest& given,
                                          std::ostream& errors) {
-  const auto [checkpoint, folder] = find_checkpoint(run_or_checkpoint, errors);
-  auto [settings, found] = checkpoint_settings(checkpoint, folder, algorithms);
+  const auto [checkpoint, folder] = find_checkpoint(run_or_checkpoint, "eval", errors);
+  auto [settings, found] = checkpoint_settings(checkpoint, folder, algorithms, "eval");
   const AlgorithmFactory& algorithm = *found;
   CheckpointEvaluation result{checkpoint.path, std::move(settings), {}, {}, {}};
   // The run's final evaluation: summary.json's when it is of this checkpoint (the same env
@@ -317,14 +332,22 @@ CheckpointEvaluation evaluate_checkpoint(const AlgorithmFactories& algorithms,
   if (given.seed) request.seed = *given.seed;
   request.stochastic = given.stochastic;
   request.video = given.video;
-  algorithm.set_threads(result.settings.torch_threads);
-  // The spaces come from one env built as the run's.
-  std::unique_ptr<Env> probe = make_run_env(result.settings);
-  const std::unique_ptr<Actor> actor =
-      algorithm.load_actor(probe->observation_space(), probe->action_space(),
-                           result.settings.algorithm_config, checkpoint);
-  probe->close();
+  const std::unique_ptr<Actor> actor = load_run_actor(algorithm, result.settings, checkpoint);
   result.evaluation = evaluate(*actor, result.settings, request);
+  return result;
+}
+
+CheckpointPolicy load_checkpoint_policy(const AlgorithmFactories& algorithms,
+                                        const fs::path& run_or_checkpoint,
+                                        const std::string& command, std::ostream& errors) {
+  const auto [checkpoint, folder] = find_checkpoint(run_or_checkpoint, command, errors);
+  auto [settings, algorithm] = checkpoint_settings(checkpoint, folder, algorithms, command);
+  CheckpointPolicy result{checkpoint.path, std::move(settings), 0, nullptr};
+  if (const auto meta = checkpoint.blobs.find("meta"); meta != checkpoint.blobs.end()) {
+    result.env_steps =
+        json::parse(meta->second, nullptr, false).value("env_steps", std::int64_t{0});
+  }
+  result.actor = load_run_actor(*algorithm, result.settings, checkpoint);
   return result;
 }
 

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <ostream>
@@ -129,5 +130,19 @@ CheckpointEvaluation evaluate_checkpoint(const AlgorithmFactories& algorithms,
                                          const std::filesystem::path& run_or_checkpoint,
                                          const CheckpointEvaluationRequest& request,
                                          std::ostream& errors);
+
+/// The policy of a checkpoint, found as evaluate_checkpoint finds it, and its run's settings.
+struct CheckpointPolicy {
+  std::filesystem::path checkpoint;  // the file loaded
+  RunSettings settings;
+  std::int64_t env_steps = 0;  // the checkpoint's (0 when it does not say)
+  std::unique_ptr<Actor> actor;
+};
+
+/// Loads the policy of `run_or_checkpoint` (a run folder or a checkpoint file) as
+/// evaluate_checkpoint does, for `command` ("export"), which its errors and skip lines name.
+CheckpointPolicy load_checkpoint_policy(const AlgorithmFactories& algorithms,
+                                        const std::filesystem::path& run_or_checkpoint,
+                                        const std::string& command, std::ostream& errors);
 
 }  // namespace pixelgym::trainer

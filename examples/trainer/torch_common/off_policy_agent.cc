@@ -8,6 +8,7 @@
 
 #include "examples/trainer/torch_common/off_policy_networks.h"
 #include "examples/trainer/torch_common/random_shift.h"
+#include "pixelgym/testing/mlp_policy.h"
 
 namespace pixelgym::trainer {
 
@@ -135,6 +136,55 @@ ActCounts OffPolicyActor::act(const Value& observations, bool deterministic, Val
   write_env_actions(*agent_, unit, actions);
   // The tanh policies' actions lie within the bounds: none is clipped.
   return {0, unit.numel()};
+}
+
+nlohmann::json OffPolicyActor::mlp_policy() const {
+  const InputLayout& input = agent_->input();
+  if (input.has_image) {
+    throw std::invalid_argument(
+        "expected a policy that reads vectors only, got one that reads "
+        "the image \"" +
+        input.image_key + "\" (train from state, --set obs_mode=state, to export it)");
+  }
+  const torch::nn::Sequential mlp = agent_->policy_mlp();
+  if (!mlp) {
+    throw std::invalid_argument(
+        "expected a policy that is an MLP over the vectors, got one "
+        "built otherwise");
+  }
+  const auto base64 = [](const torch::Tensor& values) {
+    const torch::Tensor floats = values.detach().to(torch::kFloat32).contiguous();
+    std::vector<std::uint8_t> bytes(static_cast<std::size_t>(floats.numel()) * 4);
+    // Little-endian, as every machine this builds for stores float32.
+    std::memcpy(bytes.data(), floats.data_ptr<float>(), bytes.size());
+    return testing::encode_base64(bytes);
+  };
+  nlohmann::json policy;
+  policy["format"] = "pixelgym mlp policy";
+  policy["version"] = 1;
+  policy["inputs"] = nlohmann::json::array();
+  for (std::size_t k = 0; k < input.vector_keys.size(); ++k) {
+    policy["inputs"].push_back({{"key", input.vector_keys[k]}, {"size", input.vector_sizes[k]}});
+  }
+  nlohmann::json layers = nlohmann::json::array();
+  for (const auto& child : mlp->children()) {
+    if (const auto* linear = child->as<torch::nn::Linear>()) {
+      layers.push_back({{"inputs", linear->weight.size(1)},
+                        {"outputs", linear->weight.size(0)},
+                        {"activation", "none"},
+                        {"weight", base64(linear->weight)},
+                        {"bias", base64(linear->bias)}});
+    } else if (child->as<torch::nn::ReLU>() != nullptr && !layers.empty()) {
+      layers.back()["activation"] = "relu";
+    } else {
+      throw std::invalid_argument("expected an MLP of Linear and ReLU layers, got a " +
+                                  child->name());
+    }
+  }
+  policy["layers"] = std::move(layers);
+  policy["action"] = {
+      {"size", input.action_size}, {"low", input.action_low}, {"high", input.action_high}};
+  return policy;
 }
 
 }  // namespace pixelgym::trainer

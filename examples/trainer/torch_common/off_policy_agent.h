@@ -60,6 +60,11 @@ class OffPolicyAgent : public torch::nn::Module {
   virtual torch::Tensor act(const ObservationTensors& obs, bool deterministic,
                             at::Generator* generator) = 0;
 
+  /// The MLP from the concatenated vector keys to the actor's outputs, whose first action_size
+  /// are the pre-tanh mean of its action (the deterministic action is their tanh), when the
+  /// policy is one; null otherwise (by default).
+  virtual torch::nn::Sequential policy_mlp() const { return nullptr; }
+
   const InputLayout& input() const { return input_; }
   /// Whether the encoder runs under bfloat16 autocast.
   bool autocast() const { return autocast_; }
@@ -111,6 +116,9 @@ class OffPolicyActor final : public Actor {
   /// Throws std::invalid_argument for a null agent.
   OffPolicyActor(std::shared_ptr<OffPolicyAgent> agent, std::uint64_t seed);
   ActCounts act(const Value& observations, bool deterministic, Value& actions) override;
+  /// The agent's policy_mlp() with its input keys and action bounds; throws
+  /// std::invalid_argument when it reads images or has no such MLP.
+  nlohmann::json mlp_policy() const override;
 
  private:
   std::shared_ptr<OffPolicyAgent> agent_;

@@ -11,6 +11,7 @@
 #include "pixelgym/engine/world.h"
 #include "pixelgym/envs/registry.h"
 #include "pixelgym/envs/tasks/pixel_env.h"
+#include "pixelgym/testing/mlp_policy.h"
 #include "tests/envs/tasks/scripted.h"
 
 namespace pixelgym {
@@ -52,6 +53,31 @@ TEST_P(WalkerTest, TheRewardIsDmControlsStandTimesMove) {
       ASSERT_FLOAT_EQ(state(step.obs, "height", 0), task.torso_height(world));
     }
   }
+}
+
+// Policies trained from state (drq, action repeat 2, seed 0, 100k env steps = 200k control
+// steps), exported from the runs' last checkpoints; the commands are in controllers/README.md.
+TEST_P(WalkerTest, ATrainedPolicyScoresFarAboveRandomActions) {
+  const bool walk = std::string(GetParam()) == "WalkerWalk-v0";
+  const testing::MlpPolicy policy =
+      testing::MlpPolicy::load(std::string(PIXELGYM_SOURCE_DIR) + "/tests/envs/tasks/controllers/" +
+                               (walk ? "walker_walk" : "walker_stand") + ".policy.json");
+  ASSERT_EQ(policy.env_id(), GetParam());
+  std::unique_ptr<Env> env = make(policy.env_id(), policy.env_kwargs());
+  double trained = 0.0;
+  double random = 0.0;
+  // Seeds the policy was neither trained nor evaluated on (its run's were 0, 1, ... and 1000000
+  // on); 1000 control steps each.
+  for (std::uint64_t seed = 2; seed < 5; ++seed) {
+    trained += testing::episode_return(*env, seed,
+                                       [&](const Value& obs) { return Value(policy.act(obs)); }) /
+               3.0;
+    random += testing::episode_return(*env, seed, testing::random_policy(*env, seed)) / 3.0;
+  }
+  std::cout << GetParam() << " mean return over seeds 2-4: trained " << trained << ", random "
+            << random << "\n";
+  EXPECT_GE(trained, walk ? 900.0 : 950.0);
+  EXPECT_LE(random, walk ? 60.0 : 250.0);
 }
 
 INSTANTIATE_TEST_SUITE_P(
