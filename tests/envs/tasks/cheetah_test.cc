@@ -11,8 +11,8 @@
 #include "pixelgym/engine/world.h"
 #include "pixelgym/envs/registry.h"
 #include "pixelgym/envs/tasks/pixel_env.h"
-#include "pixelgym/testing/mlp_policy.h"
 #include "tests/envs/tasks/scripted.h"
+#include "tests/envs/tasks/trained_policy.h"
 
 namespace pixelgym {
 namespace {
@@ -68,23 +68,10 @@ TEST(CheetahTest, AGaitRunsFarAboveRandomActions) {
 // A policy trained from state (drq, action repeat 4, seed 0, 100k env steps = 400k control
 // steps), exported from its run's last checkpoint; the command is in controllers/README.md.
 TEST(CheetahTest, ATrainedPolicyRunsFarAboveRandomActions) {
-  const testing::MlpPolicy policy = testing::MlpPolicy::load(
-      std::string(PIXELGYM_SOURCE_DIR) + "/tests/envs/tasks/controllers/cheetah_run.policy.json");
-  ASSERT_EQ(policy.env_id(), "CheetahRun-v0");
-  std::unique_ptr<Env> env = make(policy.env_id(), policy.env_kwargs());
-  double trained = 0.0;
-  double random = 0.0;
-  // Seeds the policy was neither trained nor evaluated on.
-  for (std::uint64_t seed = 2; seed < 5; ++seed) {
-    trained += testing::episode_return(*env, seed,
-                                       [&](const Value& obs) { return Value(policy.act(obs)); }) /
-               3.0;
-    random += testing::episode_return(*env, seed, testing::random_policy(*env, seed)) / 3.0;
-  }
-  std::cout << "CheetahRun-v0 mean return over seeds 2-4: trained " << trained << ", random "
-            << random << "\n";
-  EXPECT_GE(trained, 550.0);  // a mean speed of 5.5 m/s
-  EXPECT_LE(random, 30.0);
+  const testing::TrainedAndRandom played = testing::play_trained_policy("cheetah_run.policy.json");
+  ASSERT_EQ(played.env_id, "CheetahRun-v0");
+  EXPECT_GE(played.trained, 550.0);  // a mean speed of 5.5 m/s
+  EXPECT_LE(played.random, 30.0);
 }
 
 TEST(CheetahTest, TheRewardIsTheCentreOfMassSpeedOverTenClipped) {

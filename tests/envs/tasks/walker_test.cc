@@ -11,8 +11,8 @@
 #include "pixelgym/engine/world.h"
 #include "pixelgym/envs/registry.h"
 #include "pixelgym/envs/tasks/pixel_env.h"
-#include "pixelgym/testing/mlp_policy.h"
 #include "tests/envs/tasks/scripted.h"
+#include "tests/envs/tasks/trained_policy.h"
 
 namespace pixelgym {
 namespace {
@@ -59,25 +59,11 @@ TEST_P(WalkerTest, TheRewardIsDmControlsStandTimesMove) {
 // steps), exported from the runs' last checkpoints; the commands are in controllers/README.md.
 TEST_P(WalkerTest, ATrainedPolicyScoresFarAboveRandomActions) {
   const bool walk = std::string(GetParam()) == "WalkerWalk-v0";
-  const testing::MlpPolicy policy =
-      testing::MlpPolicy::load(std::string(PIXELGYM_SOURCE_DIR) + "/tests/envs/tasks/controllers/" +
-                               (walk ? "walker_walk" : "walker_stand") + ".policy.json");
-  ASSERT_EQ(policy.env_id(), GetParam());
-  std::unique_ptr<Env> env = make(policy.env_id(), policy.env_kwargs());
-  double trained = 0.0;
-  double random = 0.0;
-  // Seeds the policy was neither trained nor evaluated on (its run's were 0, 1, ... and 1000000
-  // on); 1000 control steps each.
-  for (std::uint64_t seed = 2; seed < 5; ++seed) {
-    trained += testing::episode_return(*env, seed,
-                                       [&](const Value& obs) { return Value(policy.act(obs)); }) /
-               3.0;
-    random += testing::episode_return(*env, seed, testing::random_policy(*env, seed)) / 3.0;
-  }
-  std::cout << GetParam() << " mean return over seeds 2-4: trained " << trained << ", random "
-            << random << "\n";
-  EXPECT_GE(trained, walk ? 900.0 : 950.0);
-  EXPECT_LE(random, walk ? 60.0 : 250.0);
+  const testing::TrainedAndRandom played =
+      testing::play_trained_policy(walk ? "walker_walk.policy.json" : "walker_stand.policy.json");
+  ASSERT_EQ(played.env_id, GetParam());
+  EXPECT_GE(played.trained, walk ? 900.0 : 950.0);
+  EXPECT_LE(played.random, walk ? 60.0 : 250.0);
 }
 
 INSTANTIATE_TEST_SUITE_P(
