@@ -5,7 +5,9 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <stdexcept>
 
 namespace pixelgym::testing {
@@ -18,7 +20,11 @@ constexpr char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwx
 // The member `name` of `object`, which must be of `type` ("string", "number", ...).
 const json& member(const json& object, const std::string& name, json::value_t type,
                    const std::string& where, const std::string& what) {
-  if (!object.is_object() || !object.contains(name)) {
+  if (!object.is_object()) {
+    throw std::runtime_error(where + ": expected an object with \"" + name + "\", got " +
+                             object.dump().substr(0, 60));
+  }
+  if (!object.contains(name)) {
     throw std::runtime_error(where + ": expected a member \"" + name + "\" (" + what +
                              "), got none");
   }
@@ -32,15 +38,23 @@ const json& member(const json& object, const std::string& name, json::value_t ty
   return value;
 }
 
+// The largest size a file may give (a layer's inputs or outputs, an input's size): far above
+// any policy's, and small enough that no product or sum of sizes overflows.
+constexpr std::int64_t kMaxSize = std::int64_t{1} << 24;
+
 std::int64_t positive(const json& object, const std::string& name, const std::string& where) {
-  const std::int64_t value =
-      member(object, name, json::value_t::number_integer, where, "a positive integer")
-          .get<std::int64_t>();
-  if (value <= 0) {
-    throw std::runtime_error(where + ": expected \"" + name + "\" to be a positive integer, got " +
-                             std::to_string(value));
+  const json& value =
+      member(object, name, json::value_t::number_integer, where, "a positive integer");
+  const bool in_range =
+      value.is_number_unsigned()
+          ? value.get<std::uint64_t>() >= 1 &&
+                value.get<std::uint64_t>() <= static_cast<std::uint64_t>(kMaxSize)
+          : value.get<std::int64_t>() >= 1 && value.get<std::int64_t>() <= kMaxSize;
+  if (!in_range) {
+    throw std::runtime_error(where + ": expected \"" + name + "\" to be an integer from 1 to " +
+                             std::to_string(kMaxSize) + ", got " + value.dump());
   }
-  return value;
+  return value.get<std::int64_t>();
 }
 
 // The float32 values of a base64 member, `count` of them.
@@ -55,7 +69,7 @@ std::vector<float> floats(const json& object, const std::string& name, std::int6
   } catch (const std::invalid_argument& error) {
     throw std::runtime_error(where + ": \"" + name + "\": " + error.what());
   }
-  if (bytes.size() != static_cast<std::size_t>(count) * 4) {
+  if (bytes.size() % 4 != 0 || bytes.size() / 4 != static_cast<std::size_t>(count)) {
     throw std::runtime_error(where + ": expected \"" + name + "\" to hold " +
                              std::to_string(count) + " float32 values (" +
                              std::to_string(count * 4) + " bytes), got " +
@@ -84,7 +98,16 @@ std::vector<float> bounds(const json& action, const std::string& name, std::int6
     throw std::runtime_error(where + ": expected \"" + name + "\" to hold " + std::to_string(size) +
                              " numbers (the action's size), got " + values.dump().substr(0, 60));
   }
-  return values.get<std::vector<float>>();
+  std::vector<float> result;
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const double value = values[i].get<double>();
+    if (!(std::abs(value) <= std::numeric_limits<float>::max())) {  // NaN too
+      throw std::runtime_error(where + ": expected \"" + name + "\" value " + std::to_string(i) +
+                               " to be a finite float32, got " + values[i].dump());
+    }
+    result.push_back(static_cast<float>(value));
+  }
+  return result;
 }
 
 Param param_of(const json& value, const std::string& name, const std::string& where) {
@@ -136,7 +159,7 @@ std::vector<std::uint8_t> decode_base64(const std::string& text) {
         continue;
       }
       const int v = value[static_cast<unsigned char>(c)];
-      if (v < 0 || padding > 0) {
+      if (v < 0) {
         throw std::invalid_argument("expected base64, got '" + std::string(1, c) +
                                     "' at character " + std::to_string(i + j));
       }
@@ -150,12 +173,22 @@ std::vector<std::uint8_t> decode_base64(const std::string& text) {
 }
 
 MlpPolicy MlpPolicy::load(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw std::runtime_error("MLP policy " + path + ": cannot be opened for reading");
+  std::stringstream text;
+  text << file.rdbuf();
+  return parse(text.str(), path);
+}
+
+MlpPolicy MlpPolicy::parse(const std::string& text, const std::string& path) {
   const std::string where = "MLP policy " + path;
-  std::ifstream file(path);
-  if (!file) throw std::runtime_error(where + ": cannot be opened for reading");
-  const json root = json::parse(file, nullptr, /*allow_exceptions=*/false);
-  if (root.is_discarded())
-    throw std::runtime_error(where + ": expected JSON, got text that is not");
+  json root;
+  try {
+    root = json::parse(text);
+  } catch (const json::exception& error) {
+    throw std::runtime_error(where + ": expected JSON, got text that is not (" + error.what() +
+                             ")");
+  }
   const std::string format =
       member(root, "format", json::value_t::string, where, "\"pixelgym mlp policy\"")
           .get<std::string>();
@@ -177,12 +210,23 @@ MlpPolicy MlpPolicy::load(const std::string& path) {
     policy.env_kwargs_.emplace(name, param_of(value, name, where));
   }
   std::int64_t width = 0;
-  for (const json& input :
-       member(root, "inputs", json::value_t::array, where, "an array of {key, size}")) {
-    Input in{member(input, "key", json::value_t::string, where + ": inputs", "an observation key")
+  const json& inputs =
+      member(root, "inputs", json::value_t::array, where, "an array of {key, size}");
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const std::string at = where + ": input " + std::to_string(i);
+    Input in{member(inputs[i], "key", json::value_t::string, at, "an observation key")
                  .get<std::string>(),
-             positive(input, "size", where + ": inputs")};
+             positive(inputs[i], "size", at)};
+    for (const Input& earlier : policy.inputs_) {
+      if (earlier.key == in.key) {
+        throw std::runtime_error(at + ": expected each key once, got \"" + in.key + "\" again");
+      }
+    }
     width += in.size;
+    if (width > kMaxSize) {
+      throw std::runtime_error(at + ": expected the inputs' sizes to add up to at most " +
+                               std::to_string(kMaxSize) + ", got more");
+    }
     policy.inputs_.push_back(std::move(in));
   }
   if (policy.inputs_.empty()) throw std::runtime_error(where + ": expected inputs, got none");
@@ -221,6 +265,13 @@ MlpPolicy MlpPolicy::load(const std::string& path) {
   }
   policy.low_ = bounds(action, "low", policy.action_size_, where + ": action");
   policy.high_ = bounds(action, "high", policy.action_size_, where + ": action");
+  for (std::size_t a = 0; a < policy.low_.size(); ++a) {
+    if (!(policy.low_[a] <= policy.high_[a])) {
+      throw std::runtime_error(
+          where + ": action: expected \"low\" <= \"high\", got " + std::to_string(policy.low_[a]) +
+          " > " + std::to_string(policy.high_[a]) + " at element " + std::to_string(a));
+    }
+  }
   return policy;
 }
 
@@ -236,7 +287,12 @@ Array MlpPolicy::act(const Value& observation) const {
       throw std::invalid_argument("MLP policy " + path_ + ": expected the observation key \"" +
                                   input.key + "\", which it does not have");
     }
-    const Array& array = observation.dict().at(input.key).array();
+    const Value& value = observation.dict().at(input.key);
+    if (!value.is_array()) {
+      throw std::invalid_argument("MLP policy " + path_ + ": expected \"" + input.key +
+                                  "\" to be an array, got another kind of value");
+    }
+    const Array& array = value.array();
     if (!is_floating(array.dtype()) || array.size() != input.size) {
       throw std::invalid_argument("MLP policy " + path_ + ": expected \"" + input.key + "\" of " +
                                   std::to_string(input.size) + " floating elements, got " +

@@ -37,8 +37,11 @@ class MlpPolicy {
  public:
   /// Reads a policy file. Throws std::runtime_error "MLP policy PATH: ..." naming what was
   /// expected and what the file has (not JSON, another format or version, a missing member,
-  /// layers whose sizes do not chain, weights of the wrong length).
+  /// a key given twice, layers whose sizes do not chain, weights of the wrong length, a size over
+  /// 2^24, bounds that are not finite float32 or whose low is above their high).
   static MlpPolicy load(const std::string& path);
+  /// The same from the file's text; `path` names it in the errors.
+  static MlpPolicy parse(const std::string& text, const std::string& path);
 
   /// The env it was trained on, and the kwargs to make it with.
   const std::string& env_id() const { return env_id_; }

@@ -1,5 +1,5 @@
-// Starts drawn again until nothing touches, as dm_control's finger and ball_in_cup draw theirs
-// (suite/utils/randomizers.py's loop: at most 1000 draws).
+// Starts drawn again until nothing touches, as dm_control's finger (its _set_random_joint_angles:
+// at most 1000 draws) and ball_in_cup (without a limit; it never needs many) draw theirs.
 #pragma once
 
 #include <Eigen/Core>

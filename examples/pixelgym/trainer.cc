@@ -21,6 +21,7 @@
 #include "examples/trainer/drq/drq_algorithm.h"
 #include "examples/trainer/drqv2/drqv2_algorithm.h"
 #include "examples/trainer/ppo/ppo_algorithm.h"
+#include "pixelgym/testing/mlp_policy.h"
 #include "pixelgym/trainer/atomic_file.h"
 #include "pixelgym/trainer/evaluation.h"
 #include "pixelgym/trainer/process_tuning.h"
@@ -433,6 +434,13 @@ int run_export(const ExportArguments& args) {
                     {"env_steps", policy.env_steps},
                     {"seed", settings.seed()}};
   const std::string text = file.dump(1) + "\n";
+  // What is written reads back: a policy MlpPolicy refuses is refused here, and no file written.
+  try {
+    testing::MlpPolicy::parse(text, out.string());
+  } catch (const std::runtime_error& error) {
+    throw std::runtime_error("export: " + policy.checkpoint.string() +
+                             ": the policy file would not load: " + error.what());
+  }
   trainer::write_file_atomically(out, {text}, "export");
   std::cout << "wrote " << out.string() << " (" << settings.env_id << ", "
             << file.at("layers").size() << " layers, from " << policy.checkpoint.string() << " at "

@@ -448,9 +448,9 @@ TEST(PixelgymCliTest, HelpListsEverySubcommandAndExplainsEach) {
   const CliRun help = run("help");
   ASSERT_EQ(help.exit_code, 0) << help.output;
   EXPECT_THAT(help.output, HasSubstr("Usage: pixelgym [OPTIONS] SUBCOMMAND"));
-  const std::vector<std::string> subcommands = {"list",     "wrappers", "info",  "check",
-                                                "snapshot", "rollout",  "bench", "record",
-                                                "inspect",  "view",     "help"};
+  const std::vector<std::string> subcommands = {
+      "list",  "wrappers", "info",   "check",   "snapshot", "rollout", "bench", "record",
+      "train", "eval",     "export", "compare", "inspect",  "view",    "help"};
   for (const std::string& name : subcommands) {
     EXPECT_THAT(help.output, HasSubstr("\n  " + name + " ")) << name;
     const CliRun one = run("help " + name);

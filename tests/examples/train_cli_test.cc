@@ -880,16 +880,24 @@ TEST(TrainCliTest, ExportWritesAPolicyFileThatActsAsTheRunsPolicy) {
   const CliRun evaluated = run_cli("eval " + run.string() + " --episodes 3 --seed 7");
   ASSERT_EQ(evaluated.exit_code, 0) << evaluated.output;
   std::unique_ptr<Env> env = make(policy.env_id(), policy.env_kwargs());
+  // eval prints 6 significant digits; torch sums in float32 and MlpPolicy in double, so the
+  // actions agree to about 1e-7.
+  const auto tolerance = [](double expected) { return 1e-5 + 2e-5 * std::abs(expected); };
+  bool other_policy_differs = false;  // the comparison can tell policies apart
   for (int e = 0; e < 3; ++e) {
     const std::string line = "episode " + std::to_string(e) + ": return=";
     const std::size_t at = evaluated.output.find(line);
     ASSERT_NE(at, std::string::npos) << evaluated.output;
     const double expected = std::stod(evaluated.output.substr(at + line.size()));
-    const double got = episode_return(*env, 7 + static_cast<std::uint64_t>(e),
-                                      [&](const Value& obs) { return Value(policy.act(obs)); });
-    // float32 in torch, double sums here: the actions agree to about 1e-6.
-    EXPECT_NEAR(got, expected, 1e-3 + 1e-4 * std::abs(expected)) << "episode " << e;
+    const std::uint64_t seed = 7 + static_cast<std::uint64_t>(e);
+    const double got =
+        episode_return(*env, seed, [&](const Value& obs) { return Value(policy.act(obs)); });
+    EXPECT_NEAR(got, expected, tolerance(expected)) << "episode " << e;
+    const double still = episode_return(
+        *env, seed, [](const Value&) { return Value(Array::from_vector<float>({1}, {0.0F})); });
+    other_policy_differs = other_policy_differs || std::abs(still - expected) > tolerance(expected);
   }
+  EXPECT_TRUE(other_policy_differs);
 
   const auto refused = [&](const std::string& source, const std::string& expected) {
     const fs::path out = folder / "refused.json";
@@ -914,6 +922,17 @@ TEST(TrainCliTest, ExportWritesAPolicyFileThatActsAsTheRunsPolicy) {
   refused(ppo.string(),
           "(ppo on CartPoleBalance-v0): expected a policy that is an MLP over "
           "vector observations");
+  const fs::path wrapped = folder / "wrapped";
+  ASSERT_EQ(run_cli("train CartPoleSwingup-v1 --algo drq --set obs_mode=state "
+                    "--set max_episode_steps=24 --wrap normalize_observation=key=joint_vel "
+                    "--threads 1 --config " +
+                    (folder / "drq.json").string() +
+                    " --steps 32 --eval-episodes 1 --quiet --out " + wrapped.string())
+                .exit_code,
+            0);
+  refused(wrapped.string(),
+          "expected a run on the bare env (a policy file names the env by its "
+          "id and kwargs), got one wrapped in --wrap normalize_observation");
   refused((folder / "nothing").string(),
           "export: " + (folder / "nothing").string() + " does not exist");
   fs::remove_all(folder);

@@ -4,6 +4,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstring>
@@ -48,8 +49,11 @@ json small_policy() {
           {"action", {{"size", 2}, {"low", {-1.0, 0.0}}, {"high", {1.0, 10.0}}}}};
 }
 
+// A file of `text` in the temporary folder, named for this process (ctest runs each test in a
+// process of its own, several at once, and the sanitizer builds share the folder).
 std::string write(const std::string& name, const std::string& text) {
-  const auto path = std::filesystem::temp_directory_path() / ("pixelgym_mlp_policy_" + name);
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("pixelgym_mlp_policy_" + std::to_string(::getpid()) + "_" + name);
   std::ofstream(path) << text;
   return path.string();
 }
@@ -126,6 +130,8 @@ TEST(MlpPolicyTest, Base64IsRfc4648s) {
               ::testing::ThrowsMessage<std::invalid_argument>(HasSubstr("got '!' at character 2")));
   EXPECT_THAT([] { decode_base64("Z=9v"); },
               ::testing::ThrowsMessage<std::invalid_argument>(HasSubstr("at character 1")));
+  // The weights' bytes are little-endian float32: 1.0f is 00 00 80 3f.
+  EXPECT_EQ(base64_floats({1.0f}), "AACAPw==");
 }
 
 TEST(MlpPolicyTest, BadFilesAreRefusedWithWhatWasExpected) {
@@ -144,8 +150,11 @@ TEST(MlpPolicyTest, BadFilesAreRefusedWithWhatWasExpected) {
     edit(policy);
     return policy.dump();
   };
-  refused("missing.json", "", "expected JSON");
-  EXPECT_THROW(MlpPolicy::load("/nonexistent/policy.json"), std::runtime_error);
+  refused("missing.json", "", "expected JSON, got text that is not");
+  EXPECT_THAT([] { MlpPolicy::load("/nonexistent/policy.json"); },
+              ::testing::ThrowsMessage<std::runtime_error>(
+                  HasSubstr("MLP policy /nonexistent/policy.json: cannot be opened for reading")));
+  refused("root.json", "[1, 2]", "expected an object with \"format\", got [1,2]");
   refused("format.json", edited([](json& p) { p["format"] = "onnx"; }),
           "expected format \"pixelgym mlp policy\", got \"onnx\"");
   refused("version.json", edited([](json& p) { p["version"] = 2; }),
@@ -171,7 +180,37 @@ TEST(MlpPolicyTest, BadFilesAreRefusedWithWhatWasExpected) {
   refused("bounds.json", edited([](json& p) { p["action"]["low"] = {-1.0}; }),
           "action: expected \"low\" to hold 2 numbers (the action's size), got [-1.0]");
   refused("size.json", edited([](json& p) { p["inputs"][0]["size"] = -2; }),
-          "inputs: expected \"size\" to be a positive integer, got -2");
+          "input 0: expected \"size\" to be an integer from 1 to 16777216, got -2");
+  // Sizes whose product would overflow are refused before any arithmetic on them.
+  refused(
+      "huge.json", edited([](json& p) {
+        p["inputs"] = {{{"key", "a"}, {"size", std::int64_t{1} << 62}}};
+        p["layers"][0]["inputs"] = std::int64_t{1} << 62;
+        p["layers"][0]["weight"] = "";
+      }),
+      "input 0: expected \"size\" to be an integer from 1 to 16777216, got 4611686018427387904");
+  refused("unsigned.json",
+          edited([](json& p) { p["layers"][0]["outputs"] = 18446744073709551615ULL; }),
+          "layer 0: expected \"outputs\" to be an integer from 1 to 16777216, got "
+          "18446744073709551615");
+  refused("twice.json", edited([](json& p) { p["inputs"][1]["key"] = "a"; }),
+          "input 1: expected each key once, got \"a\" again");
+  refused("entry.json", edited([](json& p) { p["inputs"][0] = 3; }),
+          "input 0: expected an object with \"key\", got 3");
+  refused("base64.json", edited([](json& p) { p["layers"][1]["bias"] = "AAAA!AAA"; }),
+          "layer 1: \"bias\": expected base64, got '!' at character 4");
+  refused("inverted.json", edited([](json& p) {
+            p["action"]["low"] = {2.0, 0.0};
+          }),
+          "action: expected \"low\" <= \"high\", got 2.000000 > 1.000000 at element 0");
+  refused("wide.json", edited([](json& p) {
+            p["action"]["high"] = {1.0, 1e39};
+          }),
+          "action: expected \"high\" value 1 to be a finite float32, got 1e+39");
+  refused("text_bound.json", edited([](json& p) {
+            p["action"]["low"] = {-1.0, "zero"};
+          }),
+          "action: expected \"low\" to hold 2 numbers (the action's size)");
 }
 
 }  // namespace

@@ -146,16 +146,22 @@ nlohmann::json OffPolicyActor::mlp_policy() const {
         "the image \"" +
         input.image_key + "\" (train from state, --set obs_mode=state, to export it)");
   }
+  if (input.vector_keys.size() == 1 && input.vector_keys.front().empty()) {
+    throw std::invalid_argument(
+        "expected a Dict observation (a policy file reads its inputs by "
+        "key), got a bare Box");
+  }
   const torch::nn::Sequential mlp = agent_->policy_mlp();
   if (!mlp) {
     throw std::invalid_argument(
-        "expected a policy that is an MLP over the vectors, got one "
-        "built otherwise");
+        "expected a policy that is an MLP over the vectors (drq's), got one with other layers "
+        "before its MLP (drqv2's trunk)");
   }
   const auto base64 = [](const torch::Tensor& values) {
     const torch::Tensor floats = values.detach().to(torch::kFloat32).contiguous();
     std::vector<std::uint8_t> bytes(static_cast<std::size_t>(floats.numel()) * 4);
-    // Little-endian, as every machine this builds for stores float32.
+    // The file's floats are little-endian, as this machine stores them.
+    static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "policy files are little-endian");
     std::memcpy(bytes.data(), floats.data_ptr<float>(), bytes.size());
     return testing::encode_base64(bytes);
   };
@@ -174,11 +180,13 @@ nlohmann::json OffPolicyActor::mlp_policy() const {
                         {"activation", "none"},
                         {"weight", base64(linear->weight)},
                         {"bias", base64(linear->bias)}});
-    } else if (child->as<torch::nn::ReLU>() != nullptr && !layers.empty()) {
+    } else if (child->as<torch::nn::ReLU>() != nullptr && !layers.empty() &&
+               layers.back()["activation"] == "none") {
       layers.back()["activation"] = "relu";
     } else {
-      throw std::invalid_argument("expected an MLP of Linear and ReLU layers, got a " +
-                                  child->name());
+      throw std::invalid_argument(
+          "expected an MLP of Linear layers, each followed by at most one ReLU, got a " +
+          child->name() + " after " + std::to_string(layers.size()) + " Linear layers");
     }
   }
   policy["layers"] = std::move(layers);
