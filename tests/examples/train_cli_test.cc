@@ -906,15 +906,20 @@ TEST(TrainCliTest, ExportWritesAPolicyFileThatActsAsTheRunsPolicy) {
     EXPECT_NE(result.output.find(expected), std::string::npos) << result.output;
     EXPECT_FALSE(fs::exists(out)) << source;
   };
-  const fs::path pixels = folder / "pixels";
-  ASSERT_EQ(run_cli("train CartPoleSwingup-v1 --algo drq --set obs_mode=pixels --set width=32 "
-                    "--set height=32 --set max_episode_steps=24 --wrap frame_stack=3 --threads 1 "
-                    "--config " +
-                    (folder / "drq.json").string() +
-                    " --steps 32 --eval-episodes 1 --quiet --out " + pixels.string())
-                .exit_code,
-            0);
-  refused(pixels.string(),
+  // A 32-step drq run on CartPoleSwingup-v1 with `settings` (kwargs and wrappers).
+  const auto tiny_drq_run = [&](const std::string& name, const std::string& settings) {
+    const fs::path out = folder / name;
+    EXPECT_EQ(run_cli("train CartPoleSwingup-v1 --algo drq --set max_episode_steps=24 " + settings +
+                      " --threads 1 --config " + (folder / "drq.json").string() +
+                      " --steps 32 --eval-episodes 1 --quiet --out " + out.string())
+                  .exit_code,
+              0)
+        << name;
+    return out.string();
+  };
+  refused(tiny_drq_run("pixels",
+                       "--set obs_mode=pixels --set width=32 --set height=32 "
+                       "--wrap frame_stack=3"),
           "(drq on CartPoleSwingup-v1): expected a policy that reads vectors "
           "only, got one that reads the image \"pixels\"");
   const fs::path ppo = folder / "ppo";
@@ -922,17 +927,10 @@ TEST(TrainCliTest, ExportWritesAPolicyFileThatActsAsTheRunsPolicy) {
   refused(ppo.string(),
           "(ppo on CartPoleBalance-v0): expected a policy that is an MLP over "
           "vector observations");
-  const fs::path wrapped = folder / "wrapped";
-  ASSERT_EQ(run_cli("train CartPoleSwingup-v1 --algo drq --set obs_mode=state "
-                    "--set max_episode_steps=24 --wrap normalize_observation=key=joint_vel "
-                    "--threads 1 --config " +
-                    (folder / "drq.json").string() +
-                    " --steps 32 --eval-episodes 1 --quiet --out " + wrapped.string())
-                .exit_code,
-            0);
-  refused(wrapped.string(),
-          "expected a run on the bare env (a policy file names the env by its "
-          "id and kwargs), got one wrapped in --wrap normalize_observation");
+  refused(
+      tiny_drq_run("wrapped", "--set obs_mode=state --wrap normalize_observation=key=joint_vel"),
+      "expected a run on the bare env (a policy file names the env by its "
+      "id and kwargs), got one wrapped in --wrap normalize_observation");
   refused((folder / "nothing").string(),
           "export: " + (folder / "nothing").string() + " does not exist");
   fs::remove_all(folder);
