@@ -314,6 +314,10 @@ Array MlpPolicy::act(const Value& observation) const {
   }
   std::vector<float> action(static_cast<std::size_t>(action_size_));
   for (std::size_t a = 0; a < action.size(); ++a) {
+    if (std::isnan(x[a])) {
+      throw std::runtime_error("MLP policy " + path_ +
+                               ": the action is not a number (the layers' sums overflowed)");
+    }
     const double unit = std::tanh(x[a]);
     action[a] = static_cast<float>(low_[a] + (unit + 1.0) * 0.5 * (high_[a] - low_[a]));
   }

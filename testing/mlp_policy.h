@@ -25,6 +25,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pixelgym/envs/array.h"
@@ -48,10 +49,17 @@ class MlpPolicy {
   const Params& env_kwargs() const { return env_kwargs_; }
   /// Elements of the action.
   std::int64_t action_size() const { return action_size_; }
+  /// The observation keys it reads, in order, with their sizes (elements).
+  std::vector<std::pair<std::string, std::int64_t>> inputs() const {
+    std::vector<std::pair<std::string, std::int64_t>> result;
+    for (const Input& input : inputs_) result.emplace_back(input.key, input.size);
+    return result;
+  }
 
   /// The deterministic action (float32, shape (action_size,)) for one observation: a Dict holding
   /// each input key as a floating array of its size. Throws std::invalid_argument naming a
-  /// missing key, a key of another size or dtype, or an observation that is not a Dict.
+  /// missing key, a key of another size or dtype, or an observation that is not a Dict;
+  /// std::runtime_error when the layers' sums overflow to NaN.
   Array act(const Value& observation) const;
 
  private:
