@@ -53,8 +53,9 @@ set(CPACK_PACKAGE_CONTACT "pixelgym maintainers <pixelgym@users.noreply.github.c
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION science)
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
-# Headers include Eigen's; find_package(pixelgym) finds it and Threads.
-set(CPACK_DEBIAN_PACKAGE_DEPENDS "libeigen3-dev (>= 3.4), python3-numpy")
+# Headers include Eigen's; find_package(pixelgym) finds it, Threads and nlohmann_json (the
+# trainer's headers use it, and pixelgym::testing links it).
+set(CPACK_DEBIAN_PACKAGE_DEPENDS "libeigen3-dev (>= 3.4), nlohmann-json3-dev (>= 3), python3-numpy")
 if(PIXELGYM_OSMESA)
   string(APPEND CPACK_DEBIAN_PACKAGE_DEPENDS ", libosmesa6")
 endif()

@@ -205,6 +205,34 @@ TEST(FingerTest, TouchSensesTheFingertipPressingOnTheSpinner) {
   EXPECT_TRUE(pressed) << "the fingertip never pressed on anything";
 }
 
+// Which sensor reads which side: with the finger pointing at the spinner the top sensor (x =
+// +0.01 in the distal frame) faces up. Tilted up (a positive proximal angle) and pushed down onto
+// the flat spinner's left end, the fingertip presses with its underside: the bottom sensor reads
+// the force. Tilted down and pushed up: the top one.
+TEST(FingerTest, EachTouchSensorReadsItsOwnSideOfTheFingertip) {
+  std::unique_ptr<Env> env = make("FingerSpin-v0", {{"obs_mode", "state"}});
+  for (const double tilt : {0.3, -0.3}) {
+    env->reset(0);
+    auto& world = const_cast<engine::World&>(world_of(*env));
+    const engine::RobotModel& model = world.robot_model(engine::RobotId{0});
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(3);
+    q[model.dof_index("proximal")] = tilt;
+    q[model.dof_index("hinge")] = M_PI / 2;  // the spinner flat
+    world.set_joint_state(engine::RobotId{0}, q, Eigen::VectorXd::Zero(3));
+    ASSERT_TRUE(world.detect_contacts().empty());
+    Eigen::Vector2d most = Eigen::Vector2d::Zero();  // the step with the largest total force
+    for (int t = 0; t < 20; ++t) {
+      env->step(action(tilt > 0 ? -1.0F : 1.0F, 0.0F));
+      const Eigen::Vector2d force = task_of(*env).touch_forces(world_of(*env));
+      if (force.sum() > most.sum()) most = force;
+    }
+    const int pressed = tilt > 0 ? 1 : 0;  // bottom when pushed down, top when pushed up
+    EXPECT_GT(most[pressed], 1.0) << "tilt " << tilt << ": " << most.transpose();
+    EXPECT_LT(most[1 - pressed], 0.2 * most[pressed])
+        << "tilt " << tilt << ": " << most.transpose();
+  }
+}
+
 TEST(FingerTest, CameraZeroLooksAtBothBodiesFromDmControlsPlace) {
   std::unique_ptr<Env> env = make("FingerSpin-v0", {{"obs_mode", "state"}});
   env->reset(0);
