@@ -29,6 +29,18 @@ constexpr double kUnboundedForce = 1e9;  // N or N m, for motors without a limit
 constexpr int kCollisionPoolSize = 128;
 
 btVector3 to_bt(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+// Gives a link's collider its material; a stiffness of 0 clears Bullet's flag for soft contacts,
+// so that a link made soft and then rigid again is rigid.
+void apply_contact_material(btMultiBodyLinkCollider& collider, const ContactMaterial& material) {
+  collider.setFriction(material.friction);
+  if (material.stiffness_n_m > 0.0) {
+    collider.setContactStiffnessAndDamping(material.stiffness_n_m, material.damping_n_s_m);
+  } else {
+    collider.setCollisionFlags(collider.getCollisionFlags() &
+                               ~btCollisionObject::CF_HAS_CONTACT_STIFFNESS_DAMPING);
+  }
+}
 Eigen::Vector3d from_bt(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
 
 btTransform to_bt(const Eigen::Isometry3d& X) {
@@ -140,6 +152,7 @@ struct World::Impl {
     std::vector<btMultiBodyJointMotor*> motors;           // per dof, owned by `constraints`
     std::vector<btMultiBodyJointMotor*> friction_motors;  // per dof or null
     int first_segmentation_id = 0;                        // of link 0; link l has this + l
+    std::vector<ContactMaterial> link_materials;          // per model link, from add_robot
   };
 
   struct Body {
@@ -272,7 +285,7 @@ struct World::Impl {
       auto collider = std::make_unique<btMultiBodyLinkCollider>(&body, bullet_link);
       if (shape != nullptr) {
         collider->setCollisionShape(shape);
-        collider->setFriction(0.8);
+        apply_contact_material(*collider, robot.link_materials[l]);
         const bool is_static_base = l == 0 && robot.options.fixed_base;
         const int link_group = l == 0 ? group : btBroadphaseProxy::DefaultFilter;
         const int mask = is_static_base
@@ -586,6 +599,7 @@ RobotId World::add_robot(std::shared_ptr<const RobotModel> model, RobotOptions o
       impl_->visual_refs.push_back({robot_index, static_cast<int>(l), visual.X_link_geometry});
     }
   }
+  robot.link_materials.assign(links.size(), ContactMaterial{});
   for (int joint : model->movable_joints()) {
     Impl::Dof dof;
     dof.joint = joint;
@@ -969,6 +983,46 @@ int World::add_string(const StringOptions& options) {
   return static_cast<int>(impl_->strings.size()) - 1;
 }
 
+void World::set_link_contact_material(RobotId robot, int link, const ContactMaterial& material) {
+  check_robot(robot, "set_link_contact_material");
+  Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot.index)];
+  if (link < 0 || static_cast<std::size_t>(link) >= r.link_materials.size()) {
+    throw std::out_of_range("World::set_link_contact_material: robot \"" + r.model->name() +
+                            "\" has " + std::to_string(r.link_materials.size()) +
+                            " links, got link " + std::to_string(link));
+  }
+  const auto finite_at_least = [](double value, double least) {
+    return std::isfinite(value) && value >= least;
+  };
+  if (!finite_at_least(material.friction, 0.0) || !finite_at_least(material.stiffness_n_m, 0.0) ||
+      !finite_at_least(material.damping_n_s_m, 0.0) ||
+      (material.stiffness_n_m == 0.0 && material.damping_n_s_m != 0.0)) {
+    std::ostringstream message;
+    message << "World::set_link_contact_material: expected a friction, stiffness_n_m and "
+               "damping_n_s_m that are finite and >= 0, and a damping of 0 with a stiffness of 0 "
+               "(rigid); got friction "
+            << material.friction << ", stiffness_n_m " << material.stiffness_n_m
+            << ", damping_n_s_m " << material.damping_n_s_m;
+    throw std::invalid_argument(message.str());
+  }
+  r.link_materials[static_cast<std::size_t>(link)] = material;
+  btMultiBodyLinkCollider& collider = *r.colliders[static_cast<std::size_t>(link)];
+  if (collider.getCollisionShape() != impl_->island_anchor_shape.get()) {
+    apply_contact_material(collider, material);
+  }
+}
+
+const ContactMaterial& World::link_contact_material(RobotId robot, int link) const {
+  check_robot(robot, "link_contact_material");
+  const Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot.index)];
+  if (link < 0 || static_cast<std::size_t>(link) >= r.link_materials.size()) {
+    throw std::out_of_range("World::link_contact_material: robot \"" + r.model->name() + "\" has " +
+                            std::to_string(r.link_materials.size()) + " links, got link " +
+                            std::to_string(link));
+  }
+  return r.link_materials[static_cast<std::size_t>(link)];
+}
+
 double World::string_length(int string) const {
   if (string < 0 || static_cast<std::size_t>(string) >= impl_->strings.size()) {
     throw std::out_of_range("World::string_length: no string " + std::to_string(string) +
@@ -1003,8 +1057,8 @@ void World::link_contacts(RobotId robot, int link, std::vector<LinkContact>& out
     for (int p = 0; p < manifold.getNumContacts(); ++p) {
       const btManifoldPoint& point = manifold.getContactPoint(p);
       if (point.getDistance() > 0 && point.getAppliedImpulse() <= 0) continue;
-      out.push_back(
-          {from_bt(point.getPositionWorldOnB()), point.getAppliedImpulse() / config_.timestep_s});
+      out.push_back({from_bt((point.getPositionWorldOnA() + point.getPositionWorldOnB()) * 0.5),
+                     point.getAppliedImpulse() / config_.timestep_s});
     }
   }
 }

@@ -85,7 +85,8 @@ struct Contact {
 
 /// Where one contact touches a robot's link, and how hard: what World::link_contacts lists.
 struct LinkContact {
-  /// The contact point on the second body's surface, in world coordinates, m (as Contact's).
+  /// Midway between the two bodies' surface points, in world coordinates, m: MuJoCo's contact
+  /// position, which stays between the surfaces where soft contacts let them overlap.
   Eigen::Vector3d position_world_m = Eigen::Vector3d::Zero();
   /// The normal impulse of the last step divided by the timestep, N.
   double normal_force_n = 0.0;
@@ -120,6 +121,21 @@ struct BodyId {
 };
 inline bool operator==(BodyId a, BodyId b) { return a.index == b.index; }
 inline bool operator!=(BodyId a, BodyId b) { return a.index != b.index; }
+
+/// How the contacts of one link of a robot behave (World::set_link_contact_material).
+struct ContactMaterial {
+  /// The friction coefficient. Bullet multiplies the two sides' coefficients, so against a link
+  /// at 0.8 a link at 1.25 makes the contact's friction 1 (MuJoCo takes the larger side's).
+  double friction = 0.8;
+  /// 0: rigid contacts. Otherwise each contact point of the link pushes back as a spring of this
+  /// stiffness and a damper of damping_n_s_m on the penetration (Bullet's contact stiffness and
+  /// damping; against another soft link the stiffnesses act in series and the dampings add), as
+  /// the soft contacts of a MuJoCo model do. Per point: a box resting on a face touches at four
+  /// corners, so it sinks m g / (4 k).
+  double stiffness_n_m = 0.0;
+  /// N s/m; 0 unless stiffness_n_m is set.
+  double damping_n_s_m = 0.0;
+};
 
 /// A massless string between a point of one robot link and a point of another (dm_control's
 /// spatial tendon with only a length limit, as ball-in-cup's). Slack while the points are at
@@ -194,6 +210,14 @@ class World {
   int add_string(const StringOptions& options);
   /// String `string`'s length now (the distance between its points), m.
   double string_length(int string) const;
+  /// Gives link `link` (an index into the model's links()) of `robot` the contact material
+  /// `material`; every link starts with ContactMaterial's defaults (friction 0.8, rigid). Kept
+  /// across the world's rebuilds. Throws std::out_of_range for a robot or link that does not
+  /// exist, std::invalid_argument for a value that is negative or not finite, or a damping
+  /// without a stiffness.
+  void set_link_contact_material(RobotId robot, int link, const ContactMaterial& material);
+  /// Link `link`'s contact material. Throws std::out_of_range as set_link_contact_material.
+  const ContactMaterial& link_contact_material(RobotId robot, int link) const;
 
   /// Advances `steps` physics steps of config().timestep_s with the current controls. Throws
   /// std::invalid_argument for steps < 0, and NonFiniteState after the step that left a state

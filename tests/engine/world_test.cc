@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <string>
 #include <thread>
 
 namespace pixelgym::engine {
@@ -457,6 +458,94 @@ TEST(WorldTest, LinkContactsListWhatTouchesOneLinkWithItsForce) {
   EXPECT_TRUE(proximal.empty());  // cleared: the proximal link touches nothing
   EXPECT_THAT([&] { world.link_contacts(finger, 7, proximal); },
               ::testing::ThrowsMessage<std::out_of_range>(HasSubstr("has 4 links, got link 7")));
+}
+
+// On ground tilted by gravity's x component (tan 0.5) a cube slides where its friction is under
+// 0.5 (Bullet multiplies it by the ground's 1) and holds where it is over: the default 0.8 holds,
+// 0.3 slides at (0.5 - 0.3) g, and the setting outlives the rebuilds of add_robot and reset.
+TEST(WorldTest, AContactMaterialsFrictionChangesHowALinkSlides) {
+  ModelCache cache;
+  WorldConfig config;
+  config.gravity_m_s2 = Eigen::Vector3d(0.5 * 9.81, 0, -9.81);
+  World world(config);
+  RobotOptions free;
+  free.fixed_base = false;
+  free.X_world_base.translation() = Eigen::Vector3d(0, 0, 0.025);
+  const RobotId held = world.add_robot(cache.load_urdf(asset_path("objects/cube.urdf")), free);
+  free.X_world_base.translation() = Eigen::Vector3d(0, 0.5, 0.025);
+  const RobotId sliding = world.add_robot(cache.load_urdf(asset_path("objects/cube.urdf")), free);
+  ContactMaterial slippery;
+  slippery.friction = 0.3;
+  world.set_link_contact_material(sliding, 0, slippery);
+  EXPECT_EQ(world.link_contact_material(held, 0).friction, 0.8);
+  EXPECT_EQ(world.link_contact_material(sliding, 0).friction, 0.3);
+  free.X_world_base.translation() = Eigen::Vector3d(0, 1.0, 0.025);
+  world.add_robot(cache.load_urdf(asset_path("objects/cube.urdf")), free);  // a rebuild
+  for (int pass = 0; pass < 2; ++pass) {
+    const double held_x = world.base_pose(held).translation().x();
+    const double sliding_x = world.base_pose(sliding).translation().x();
+    world.step(240);  // one second
+    EXPECT_NEAR(world.base_pose(held).translation().x(), held_x, 1e-3) << "pass " << pass;
+    // x = a t^2 / 2 with a = (0.5 - 0.3) g, from rest.
+    EXPECT_NEAR(world.base_pose(sliding).translation().x() - sliding_x, 0.2 * 9.81 / 2, 0.1)
+        << "pass " << pass;
+    world.reset();
+  }
+}
+
+// A cube of 0.1 kg resting on the ground sinks m g / 4 k into it where each of its contact points
+// is a spring of stiffness k (its face touches the plane at four corners), and not at all where
+// they are rigid; made rigid again, it rises back. The setting outlives a rebuild.
+TEST(WorldTest, AContactMaterialsStiffnessMakesALinksContactsSoft) {
+  ModelCache cache;
+  World world;  // gravity on
+  RobotOptions free;
+  free.fixed_base = false;
+  free.X_world_base.translation() = Eigen::Vector3d(0, 0, 0.025);
+  const RobotId rigid = world.add_robot(cache.load_urdf(asset_path("objects/cube.urdf")), free);
+  free.X_world_base.translation() = Eigen::Vector3d(0, 0.5, 0.025);
+  const RobotId soft = world.add_robot(cache.load_urdf(asset_path("objects/cube.urdf")), free);
+  ContactMaterial spring;
+  spring.stiffness_n_m = 100.0;
+  spring.damping_n_s_m = 2.0;
+  world.set_link_contact_material(soft, 0, spring);
+  free.X_world_base.translation() = Eigen::Vector3d(0, 1.0, 0.025);
+  world.add_robot(cache.load_urdf(asset_path("objects/cube.urdf")), free);  // a rebuild
+  world.step(480);                               // two seconds, to settle
+  const double sink = 0.1 * 9.81 / (4 * 100.0);  // 2.5 mm
+  EXPECT_NEAR(world.base_pose(rigid).translation().z(), 0.025, 2e-4);
+  EXPECT_NEAR(world.base_pose(soft).translation().z(), 0.025 - sink, 2e-4);
+  world.set_link_contact_material(soft, 0, ContactMaterial{});
+  world.step(480);
+  EXPECT_NEAR(world.base_pose(soft).translation().z(), 0.025, 2e-4);
+  EXPECT_EQ(world.link_contact_material(soft, 0).stiffness_n_m, 0.0);
+}
+
+TEST(WorldTest, AContactMaterialOutOfRangeIsRefusedNamingIt) {
+  ModelCache cache;
+  World world;
+  RobotOptions free;
+  free.fixed_base = false;
+  const RobotId cube = world.add_robot(cache.load_urdf(asset_path("objects/cube.urdf")), free);
+  EXPECT_THAT([&] { world.set_link_contact_material(cube, 1, ContactMaterial{}); },
+              ::testing::ThrowsMessage<std::out_of_range>(HasSubstr("has 1 links, got link 1")));
+  EXPECT_THAT([&] { world.link_contact_material(cube, -1); },
+              ::testing::ThrowsMessage<std::out_of_range>(HasSubstr("has 1 links, got link -1")));
+  const auto refused = [&](double friction, double stiffness, double damping,
+                           const std::string& got) {
+    ContactMaterial material;
+    material.friction = friction;
+    material.stiffness_n_m = stiffness;
+    material.damping_n_s_m = damping;
+    EXPECT_THAT([&] { world.set_link_contact_material(cube, 0, material); },
+                ::testing::ThrowsMessage<std::invalid_argument>(HasSubstr(got)))
+        << got;
+  };
+  refused(-0.1, 0, 0, "got friction -0.1, stiffness_n_m 0, damping_n_s_m 0");
+  refused(0.8, std::nan(""), 0, "stiffness_n_m nan");
+  refused(0.8, 100, -1, "damping_n_s_m -1");
+  refused(0.8, 0, 1, "a damping of 0 with a stiffness of 0");
+  EXPECT_EQ(world.link_contact_material(cube, 0).friction, 0.8);  // unchanged by the refusals
 }
 
 TEST(WorldTest, AStringIsSlackUpToItsLengthAndPullsPastIt) {

@@ -88,8 +88,8 @@ std::function<Value(const Value&)> controller() {
   };
 }
 
-// The controller's mean return over seeds 2-4 is 191 (173 on the search's seeds 0 and 1), random
-// actions' 0: well above random, far from the top (dm_control's state SAC: 811 after 100k steps).
+// The controller's mean return over seeds 2-4 is 191 (tuned before the contacts were soft), random
+// actions' 0.3: well above random, far from the top (a policy trained from state: 969, below).
 constexpr double kControllerFloor = 120.0;
 
 TEST(FingerTest, TheControllerSpinsItFarAboveRandomActions) {
@@ -107,14 +107,14 @@ TEST(FingerTest, TheControllerSpinsItFarAboveRandomActions) {
   EXPECT_LE(random, 50.0);
 }
 
-// A policy trained from state (drq, action repeat 2, seed 0, 100k env steps = 200k control
-// steps; the command is in controllers/README.md): twice the scripted sweep, still far from state
-// SAC's 811 in dm_control. It hits the spinner back and forth (the hinge's speed swings between
-// about -20 and +19 rad/s) rather than spinning it one way.
+// A policy trained from state (drq, action repeat 2, seed 2, 100k env steps = 200k control
+// steps; the command is in controllers/README.md) scores 969 over seeds 2-4, near the top (state
+// SAC in dm_control: 811 after 100k control steps, 923 after 500k). It spins the spinner one way,
+// hitting it each time an end comes round.
 TEST(FingerTest, ATrainedPolicySpinsItFarAboveRandomActions) {
   const testing::TrainedAndRandom played = testing::play_trained_policy("finger_spin.policy.json");
   ASSERT_EQ(played.env_id, "FingerSpin-v0");
-  EXPECT_GE(played.trained, 300.0);
+  EXPECT_GE(played.trained, 900.0);
   EXPECT_LE(played.random, 50.0);
 }
 
