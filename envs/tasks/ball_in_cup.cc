@@ -47,6 +47,11 @@ void BallInCupTask::build(engine::World& world) {
   for (int i = 0; i < kDofs; ++i) dof_[static_cast<std::size_t>(i)] = model->dof_index(kJoints[i]);
   cup_link_ = model->link_index("cup");
   ball_link_ = model->link_index("ball");
+  // dm_control's ball-cup friction is 1 (MuJoCo's default); Bullet multiplies the two sides', so
+  // the cup's 1.25 times the ball's 0.8.
+  engine::ContactMaterial cup;
+  cup.friction = 1.25;
+  world.set_link_contact_material(robot_, cup_link_, cup);
   gear_ = model->joints()[static_cast<std::size_t>(model->joint_index("cup_x"))].effort_limit;
   engine::StringOptions string;
   string.robot_a = robot_;

@@ -27,6 +27,9 @@ const TrackingCamera kSide{{-0.0378F, -3.0F, 0.149F}, {0.0F, 1.0F, 0.0F}, {0.0F,
 const TrackingCamera kBack{
     {-1.8378F, -1.3F, 0.949F}, {0.842F, 0.421F, -0.336F}, {0.301F, 0.150F, 0.942F}};
 
+// Each link's friction: sqrt(0.4), so that two links touching have dm_control's 0.4.
+const double kLinkFriction = std::sqrt(0.4);
+
 }  // namespace
 
 SpacePtr CheetahTask::action_space() const {
@@ -38,9 +41,10 @@ engine::WorldConfig CheetahTask::world_config() const {
   // 4 physics steps per control step: the joint springs and damping act explicitly, and on the
   // feet (60 and 120 N m/rad on a joint inertia of about 0.1 kg m^2) need steps this short.
   config.timestep_s = 0.0025;
-  // Bullet multiplies the two sides' friction; the links have 0.8, so the ground's 1.25 gives
-  // dm_control's 1.0 (MuJoCo takes the larger of the ground's 1 and the cheetah's 0.4).
-  config.ground_friction = 1.25;
+  // dm_control's friction is 1 with the ground (MuJoCo takes the larger of the ground's 1 and the
+  // cheetah's 0.4) and 0.4 between the cheetah's own bodies. Bullet multiplies the two sides', so
+  // each link gets sqrt(0.4) (build) and the ground 1 / sqrt(0.4).
+  config.ground_friction = 1.0 / kLinkFriction;
   return config;
 }
 
@@ -50,6 +54,11 @@ void CheetahTask::build(engine::World& world) {
   engine::RobotOptions options;
   options.self_collision = true;  // as dm_control's cheetah: a foot can hit the torso
   robot_ = world.add_robot(model, options);
+  engine::ContactMaterial material;
+  material.friction = kLinkFriction;
+  for (int link = 0; link < static_cast<int>(model->links().size()); ++link) {
+    world.set_link_contact_material(robot_, link, material);
+  }
   const auto& joints = model->joints();
   for (int leg = 0; leg < 6; ++leg) {
     gears_[leg] =
