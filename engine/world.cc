@@ -29,18 +29,6 @@ constexpr double kUnboundedForce = 1e9;  // N or N m, for motors without a limit
 constexpr int kCollisionPoolSize = 128;
 
 btVector3 to_bt(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
-
-// Gives a link's collider its material; a stiffness of 0 clears Bullet's flag for soft contacts,
-// so that a link made soft and then rigid again is rigid.
-void apply_contact_material(btMultiBodyLinkCollider& collider, const ContactMaterial& material) {
-  collider.setFriction(material.friction);
-  if (material.stiffness_n_m > 0.0) {
-    collider.setContactStiffnessAndDamping(material.stiffness_n_m, material.damping_n_s_m);
-  } else {
-    collider.setCollisionFlags(collider.getCollisionFlags() &
-                               ~btCollisionObject::CF_HAS_CONTACT_STIFFNESS_DAMPING);
-  }
-}
 Eigen::Vector3d from_bt(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
 
 btTransform to_bt(const Eigen::Isometry3d& X) {
@@ -54,6 +42,27 @@ Eigen::Isometry3d from_bt(const btTransform& X) {
   result.linear() = Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()).toRotationMatrix();
   result.translation() = from_bt(X.getOrigin());
   return result;
+}
+
+// Gives a link's collider its material; a stiffness of 0 clears Bullet's flag for soft contacts,
+// so that a link made soft and then rigid again is rigid.
+void apply_contact_material(btMultiBodyLinkCollider& collider, const ContactMaterial& material) {
+  collider.setFriction(material.friction);
+  if (material.stiffness_n_m > 0.0) {
+    collider.setContactStiffnessAndDamping(material.stiffness_n_m, material.damping_n_s_m);
+  } else {
+    collider.setCollisionFlags(collider.getCollisionFlags() &
+                               ~btCollisionObject::CF_HAS_CONTACT_STIFFNESS_DAMPING);
+  }
+}
+
+// Throws std::out_of_range naming `caller` for a link index outside the model's links().
+void check_link_index(const RobotModel& model, int link, const char* caller) {
+  if (link < 0 || static_cast<std::size_t>(link) >= model.links().size()) {
+    throw std::out_of_range(std::string("World::") + caller + ": robot \"" + model.name() +
+                            "\" has " + std::to_string(model.links().size()) + " links, got link " +
+                            std::to_string(link));
+  }
 }
 
 btQuaternion to_bt_rotation(const Eigen::Matrix3d& R) {
@@ -956,12 +965,9 @@ int World::segmentation_id(BodyId body) const {
 int World::add_string(const StringOptions& options) {
   const auto check_end = [&](RobotId robot, int link, const Eigen::Vector3d& point) {
     check_robot(robot, "add_string");
+    check_link_index(*impl_->robots[static_cast<std::size_t>(robot.index)].model, link,
+                     "add_string");
     const RobotModel& model = *impl_->robots[static_cast<std::size_t>(robot.index)].model;
-    if (link < 0 || static_cast<std::size_t>(link) >= model.links().size()) {
-      throw std::out_of_range("World::add_string: robot \"" + model.name() + "\" has " +
-                              std::to_string(model.links().size()) + " links, got link " +
-                              std::to_string(link));
-    }
     if (!point.allFinite()) {
       throw std::invalid_argument("World::add_string: a non-finite point on robot \"" +
                                   model.name() + "\"");
@@ -985,12 +991,9 @@ int World::add_string(const StringOptions& options) {
 
 void World::set_link_contact_material(RobotId robot, int link, const ContactMaterial& material) {
   check_robot(robot, "set_link_contact_material");
+  check_link_index(*impl_->robots[static_cast<std::size_t>(robot.index)].model, link,
+                   "set_link_contact_material");
   Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot.index)];
-  if (link < 0 || static_cast<std::size_t>(link) >= r.link_materials.size()) {
-    throw std::out_of_range("World::set_link_contact_material: robot \"" + r.model->name() +
-                            "\" has " + std::to_string(r.link_materials.size()) +
-                            " links, got link " + std::to_string(link));
-  }
   const auto finite_at_least = [](double value, double least) {
     return std::isfinite(value) && value >= least;
   };
@@ -1014,13 +1017,10 @@ void World::set_link_contact_material(RobotId robot, int link, const ContactMate
 
 const ContactMaterial& World::link_contact_material(RobotId robot, int link) const {
   check_robot(robot, "link_contact_material");
-  const Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot.index)];
-  if (link < 0 || static_cast<std::size_t>(link) >= r.link_materials.size()) {
-    throw std::out_of_range("World::link_contact_material: robot \"" + r.model->name() + "\" has " +
-                            std::to_string(r.link_materials.size()) + " links, got link " +
-                            std::to_string(link));
-  }
-  return r.link_materials[static_cast<std::size_t>(link)];
+  check_link_index(*impl_->robots[static_cast<std::size_t>(robot.index)].model, link,
+                   "link_contact_material");
+  return impl_->robots[static_cast<std::size_t>(robot.index)]
+      .link_materials[static_cast<std::size_t>(link)];
 }
 
 double World::string_length(int string) const {
@@ -1038,12 +1038,9 @@ std::vector<Contact> World::contacts() const {
 
 void World::link_contacts(RobotId robot, int link, std::vector<LinkContact>& out) const {
   check_robot(robot, "link_contacts");
+  check_link_index(*impl_->robots[static_cast<std::size_t>(robot.index)].model, link,
+                   "link_contacts");
   const Impl::Robot& r = impl_->robots[static_cast<std::size_t>(robot.index)];
-  if (link < 0 || static_cast<std::size_t>(link) >= r.model->links().size()) {
-    throw std::out_of_range("World::link_contacts: robot \"" + r.model->name() + "\" has " +
-                            std::to_string(r.model->links().size()) + " links, got link " +
-                            std::to_string(link));
-  }
   const auto is_link = [&](const btCollisionObject* object) {
     const btMultiBodyLinkCollider* collider = btMultiBodyLinkCollider::upcast(object);
     return collider != nullptr && collider->m_multiBody == r.body.get() &&
