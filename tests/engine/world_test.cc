@@ -460,6 +460,14 @@ TEST(WorldTest, LinkContactsListWhatTouchesOneLinkWithItsForce) {
               ::testing::ThrowsMessage<std::out_of_range>(HasSubstr("has 4 links, got link 7")));
 }
 
+// Adds a free 5 cm cube resting on the ground at (0, y).
+RobotId add_resting_cube(World& world, ModelCache& cache, double y) {
+  RobotOptions free;
+  free.fixed_base = false;
+  free.X_world_base.translation() = Eigen::Vector3d(0, y, 0.025);
+  return world.add_robot(cache.load_urdf(asset_path("objects/cube.urdf")), free);
+}
+
 // On ground tilted by gravity's x component (tan 0.5) a cube slides where its friction is under
 // 0.5 (Bullet multiplies it by the ground's 1) and holds where it is over: the default 0.8 holds,
 // 0.3 slides at (0.5 - 0.3) g, and the setting outlives the rebuilds of add_robot and reset.
@@ -468,19 +476,14 @@ TEST(WorldTest, AContactMaterialsFrictionChangesHowALinkSlides) {
   WorldConfig config;
   config.gravity_m_s2 = Eigen::Vector3d(0.5 * 9.81, 0, -9.81);
   World world(config);
-  RobotOptions free;
-  free.fixed_base = false;
-  free.X_world_base.translation() = Eigen::Vector3d(0, 0, 0.025);
-  const RobotId held = world.add_robot(cache.load_urdf(asset_path("objects/cube.urdf")), free);
-  free.X_world_base.translation() = Eigen::Vector3d(0, 0.5, 0.025);
-  const RobotId sliding = world.add_robot(cache.load_urdf(asset_path("objects/cube.urdf")), free);
+  const RobotId held = add_resting_cube(world, cache, 0.0);
+  const RobotId sliding = add_resting_cube(world, cache, 0.5);
   ContactMaterial slippery;
   slippery.friction = 0.3;
   world.set_link_contact_material(sliding, 0, slippery);
   EXPECT_EQ(world.link_contact_material(held, 0).friction, 0.8);
   EXPECT_EQ(world.link_contact_material(sliding, 0).friction, 0.3);
-  free.X_world_base.translation() = Eigen::Vector3d(0, 1.0, 0.025);
-  world.add_robot(cache.load_urdf(asset_path("objects/cube.urdf")), free);  // a rebuild
+  add_resting_cube(world, cache, 1.0);  // a rebuild
   for (int pass = 0; pass < 2; ++pass) {
     const double held_x = world.base_pose(held).translation().x();
     const double sliding_x = world.base_pose(sliding).translation().x();
@@ -499,18 +502,13 @@ TEST(WorldTest, AContactMaterialsFrictionChangesHowALinkSlides) {
 TEST(WorldTest, AContactMaterialsStiffnessMakesALinksContactsSoft) {
   ModelCache cache;
   World world;  // gravity on
-  RobotOptions free;
-  free.fixed_base = false;
-  free.X_world_base.translation() = Eigen::Vector3d(0, 0, 0.025);
-  const RobotId rigid = world.add_robot(cache.load_urdf(asset_path("objects/cube.urdf")), free);
-  free.X_world_base.translation() = Eigen::Vector3d(0, 0.5, 0.025);
-  const RobotId soft = world.add_robot(cache.load_urdf(asset_path("objects/cube.urdf")), free);
+  const RobotId rigid = add_resting_cube(world, cache, 0.0);
+  const RobotId soft = add_resting_cube(world, cache, 0.5);
   ContactMaterial spring;
   spring.stiffness_n_m = 100.0;
   spring.damping_n_s_m = 2.0;
   world.set_link_contact_material(soft, 0, spring);
-  free.X_world_base.translation() = Eigen::Vector3d(0, 1.0, 0.025);
-  world.add_robot(cache.load_urdf(asset_path("objects/cube.urdf")), free);  // a rebuild
+  add_resting_cube(world, cache, 1.0);           // a rebuild
   world.step(480);                               // two seconds, to settle
   const double sink = 0.1 * 9.81 / (4 * 100.0);  // 2.5 mm
   EXPECT_NEAR(world.base_pose(rigid).translation().z(), 0.025, 2e-4);
@@ -524,9 +522,7 @@ TEST(WorldTest, AContactMaterialsStiffnessMakesALinksContactsSoft) {
 TEST(WorldTest, AContactMaterialOutOfRangeIsRefusedNamingIt) {
   ModelCache cache;
   World world;
-  RobotOptions free;
-  free.fixed_base = false;
-  const RobotId cube = world.add_robot(cache.load_urdf(asset_path("objects/cube.urdf")), free);
+  const RobotId cube = add_resting_cube(world, cache, 0.0);
   EXPECT_THAT([&] { world.set_link_contact_material(cube, 1, ContactMaterial{}); },
               ::testing::ThrowsMessage<std::out_of_range>(HasSubstr("has 1 links, got link 1")));
   EXPECT_THAT([&] { world.link_contact_material(cube, -1); },
