@@ -56,10 +56,12 @@ Params without_render_mode(const EnvSpec& spec, const Params& kwargs, const std:
 }  // namespace
 
 void Registry::register_env(EnvSpec spec) {
-  static const std::regex kIdPattern("[A-Za-z][A-Za-z0-9_]*-v[0-9]+");
+  // Gymnasium's ids allow hyphens in the name (a variant: CartPoleSwingup-distracting-v1).
+  static const std::regex kIdPattern("[A-Za-z][A-Za-z0-9_]*(-[A-Za-z][A-Za-z0-9_]*)*-v[0-9]+");
   if (!std::regex_match(spec.id, kIdPattern)) {
     throw std::invalid_argument("register_env: id \"" + spec.id +
-                                "\" is not of the form Name-vN (e.g. CartPoleSwingup-v0)");
+                                "\" is not of the form Name-vN (e.g. CartPoleSwingup-v0, or "
+                                "CartPoleSwingup-distracting-v1 for a variant)");
   }
   if (!spec.factory) throw std::invalid_argument("register_env: " + spec.id + " has no factory");
   for (const ParamSpec& param : spec.params) {

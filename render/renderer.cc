@@ -1,6 +1,7 @@
 #include "pixelgym/render/renderer.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -50,8 +51,34 @@ void background_key(const Scene& scene, const Camera& camera,
   add(scene.sky.zenith);
   key.insert(key.end(),
              {scene.floor.enabled ? 1.0F : 0.0F, scene.floor.height_m, scene.floor.tile_m,
-              static_cast<float>(camera.width), static_cast<float>(camera.height),
-              static_cast<float>(camera.msaa_samples)});
+              scene.floor.opacity, scene.sky.image_span_deg, static_cast<float>(camera.width),
+              static_cast<float>(camera.height), static_cast<float>(camera.msaa_samples)});
+  // The images by serial, 16 bits to a float so that every serial is kept exactly.
+  for (const auto* image : {scene.floor.image.get(), scene.sky.image.get()}) {
+    const std::uint64_t serial = image == nullptr ? 0 : image->serial();
+    for (int shift = 0; shift < 64; shift += 16) {
+      key.push_back(static_cast<float>((serial >> shift) & 0xFFFFU));
+    }
+  }
+}
+
+// Texture units: 0 for instances' textures and the floor's image, 1 for the shadow map, this for
+// the sky's image.
+constexpr int kSkyImageUnit = 2;
+
+constexpr float kRadiansPerDegree = 3.14159265358979F / 180.0F;
+
+// Throws std::invalid_argument naming the setting for a floor opacity outside [0, 1] or a sky image
+// span outside (0, 180) degrees.
+void check_background(const Scene& scene) {
+  if (!(scene.floor.opacity >= 0.0F && scene.floor.opacity <= 1.0F)) {
+    throw std::invalid_argument("Renderer: floor.opacity must be in [0, 1], got " +
+                                std::to_string(scene.floor.opacity));
+  }
+  if (!(scene.sky.image_span_deg > 0.0F && scene.sky.image_span_deg < 180.0F)) {
+    throw std::invalid_argument("Renderer: sky.image_span_deg must be in (0, 180), got " +
+                                std::to_string(scene.sky.image_span_deg));
+  }
 }
 
 void check_sizes(const Camera& camera, const RenderTargets& targets) {
@@ -178,6 +205,7 @@ struct ContextGroup::State {
         textures.bind_white();
       }
       glUniform4fv(lit.base_color, 1, instance.material.base_color.data());
+      glUniform3fv(lit.color_offset, 1, instance.material.color_offset.data());
       MeshArena::draw(*drawn[i]);
     }
     glDisable(GL_CULL_FACE);
@@ -185,9 +213,9 @@ struct ContextGroup::State {
 
   // Draws `mesh` from `vertex_array` as floor. `depth_offset` pushes it back (polygon offset
   // factor and units) so that shapes resting on the floor never fight it for depth.
-  void draw_floor(const Scene& scene, const Eigen::Matrix4f& view_projection,
-                  const Eigen::Matrix4f& light_matrix, bool use_shadows, const GpuMesh& mesh,
-                  GLuint vertex_array, float depth_offset) {
+  void draw_floor(const Scene& scene, const Eigen::Vector3f& eye,
+                  const Eigen::Matrix4f& view_projection, const Eigen::Matrix4f& light_matrix,
+                  bool use_shadows, const GpuMesh& mesh, GLuint vertex_array, float depth_offset) {
     const FloorProgram& program = programs.floor;
     Eigen::Matrix4f model = Eigen::Matrix4f::Identity();
     model(2, 3) = scene.floor.height_m;
@@ -205,11 +233,28 @@ struct ContextGroup::State {
     glUniform3fv(program.direct, 1, direct.data());
     glUniform1i(program.use_shadows, use_shadows ? 1 : 0);
     glUniform1i(program.shadow_map, 1);
+    glUniform1i(program.use_image, scene.floor.image != nullptr ? 1 : 0);
+    glUniform1i(program.image, 0);
+    if (scene.floor.image != nullptr) textures.bind_image(scene.floor.image, 0);
+    glUniform1f(program.opacity, scene.floor.opacity);
+    glUniform3fv(program.camera_position, 1, eye.data());
+    glUniform1f(program.height, scene.floor.height_m);
+    set_sky(program.sky, scene.sky);
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(depth_offset, depth_offset);
     MeshArena::draw(mesh);
     glDisable(GL_POLYGON_OFFSET_FILL);
     glBindVertexArray(arena.vertex_array());
+  }
+
+  // Sets the shared sky colour's uniforms of the program in use, binding the sky's image if any.
+  void set_sky(const SkyUniforms& uniforms, const Sky& sky) {
+    glUniform3fv(uniforms.horizon, 1, sky.horizon.data());
+    glUniform3fv(uniforms.zenith, 1, sky.zenith.data());
+    glUniform1i(uniforms.use_image, sky.image != nullptr ? 1 : 0);
+    glUniform1i(uniforms.image, kSkyImageUnit);
+    glUniform1f(uniforms.span, sky.image_span_deg * kRadiansPerDegree);
+    if (sky.image != nullptr) textures.bind_image(sky.image, kSkyImageUnit);
   }
 
   // The sky at the far plane: depth-tested against what is already drawn (so only its visible
@@ -221,8 +266,7 @@ struct ContextGroup::State {
     glUseProgram(sky.program.get());
     const Eigen::Matrix4f inverse = view_projection.inverse();
     glUniformMatrix4fv(sky.inverse_view_projection, 1, GL_FALSE, inverse.data());
-    glUniform3fv(sky.horizon, 1, scene.sky.horizon.data());
-    glUniform3fv(sky.zenith, 1, scene.sky.zenith.data());
+    set_sky(sky.sky, scene.sky);
     glDrawArrays(GL_TRIANGLES, 0, 3);  // positions come from gl_VertexID; the arena is bound
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_LESS);
@@ -231,6 +275,7 @@ struct ContextGroup::State {
   void render(const Scene& scene, const Camera& camera, const RenderTargets& out) {
     camera.validate();
     check_sizes(camera, out);
+    check_background(scene);
     // Bound for this call only: the next call may come from another thread (see Context).
     const Context::Scope current(context);
     if (camera.msaa_samples > max_samples) {
@@ -296,8 +341,8 @@ struct ContextGroup::State {
       glViewport(0, 0, camera.width, camera.height);
       glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
       if (scene.floor.enabled) {
-        draw_floor(scene, view_projection, light_matrix, false, floor_mesh, arena.vertex_array(),
-                   kFloorDepthOffset);
+        draw_floor(scene, eye, view_projection, light_matrix, false, floor_mesh,
+                   arena.vertex_array(), kFloorDepthOffset);
       }
       draw_sky(scene, view_projection);
       cached.key = frame_key;
@@ -315,7 +360,7 @@ struct ContextGroup::State {
         // floor (and still behind the instances), the first footprint over a pixel passes the
         // depth test and the ones after it tie and fail: each floor pixel is shaded once.
         const GpuMesh& footprints = shadow_floor.upload(footprint_rectangles);
-        draw_floor(scene, view_projection, light_matrix, true, footprints,
+        draw_floor(scene, eye, view_projection, light_matrix, true, footprints,
                    shadow_floor.vertex_array(), kFootprintDepthOffset);
       }
     }

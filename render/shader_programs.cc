@@ -20,6 +20,32 @@ float lit_fraction() {
 }
 )";
 
+// The background's colour in a view direction: the sky's gradient or its image; spliced into the
+// sky's fragment shader and the floor's (which shows it through when not opaque) at "@SKY@".
+constexpr const char* kSkyColor = R"(
+uniform vec3 horizon;
+uniform vec3 zenith;
+uniform bool sky_use_image;
+uniform sampler2D sky_image;
+uniform float sky_span;  // radians one copy of the image spans, seen from the camera
+vec3 sky_color(vec3 ray) {
+  vec3 d = normalize(ray);
+  if (sky_use_image) {
+    // On the face of a cube around the camera that the ray meets, one copy of the image centred
+    // on the face's axis (the horizon at mid-height on the side faces); copies mirrored at their
+    // edges meet the next face's without a seam.
+    vec3 a = abs(d);
+    vec2 face = a.z >= max(a.x, a.y) ? d.xy / a.z
+              : a.x >= a.y ? vec2(-sign(d.x) * d.y, d.z) / a.x
+                           : vec2(sign(d.y) * d.x, d.z) / a.y;
+    vec2 uv = 0.5 + 0.5 * face / tan(0.5 * sky_span);
+    return texture(sky_image, vec2(uv.x, 1.0 - uv.y)).rgb;
+  }
+  float elevation = clamp(d.z, 0.0, 1.0);
+  return mix(horizon, zenith, sqrt(elevation));
+}
+)";
+
 constexpr const char* kLitVertex = R"(#version 330 core
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
@@ -63,6 +89,7 @@ uniform sampler2D albedo;
 uniform bool use_shadows;
 uniform sampler2DShadow shadow_map;
 uniform bool mirrored;  // a negative scale turns the winding, and so gl_FrontFacing, around
+uniform vec3 color_offset;
 out vec4 fragment;
 
 @SHADOW@
@@ -73,6 +100,7 @@ void main() {
   // A mesh part's own colour, or the instance's when the part has none (alpha < 0).
   vec3 color = vertex_color.a >= 0.0 ? vertex_color.rgb : base_color.rgb;
   if (use_texture) color *= texture(albedo, texcoord).rgb;
+  if (color_offset != vec3(0.0)) color = clamp(color + color_offset, 0.0, 1.0);
   float diffuse = max(dot(n, to_light), 0.0);
   vec3 view = normalize(camera_position - world_position);
   float highlight = diffuse > 0.0 ? pow(max(dot(n, normalize(to_light + view)), 0.0), shininess) : 0.0;
@@ -97,13 +125,9 @@ void main() {
 
 constexpr const char* kSkyFragment = R"(#version 330 core
 in vec3 ray;
-uniform vec3 horizon;
-uniform vec3 zenith;
 out vec4 fragment;
-void main() {
-  float elevation = clamp(normalize(ray).z, 0.0, 1.0);
-  fragment = vec4(mix(horizon, zenith, sqrt(elevation)), 1.0);
-}
+@SKY@
+void main() { fragment = vec4(sky_color(ray), 1.0); }
 )";
 
 // The floor: flat, so its light (ambient + diffuse, from the CPU) is one value per frame; only the
@@ -133,19 +157,34 @@ uniform vec3 ambient;
 uniform vec3 direct;
 uniform bool use_shadows;
 uniform sampler2DShadow shadow_map;
+uniform bool use_image;
+uniform sampler2D floor_image;
+uniform float opacity;
+uniform vec3 camera_position;
+uniform float floor_height;
 out vec4 fragment;
 
 @SHADOW@
+@SKY@
 
 void main() {
+  float light = use_shadows ? lit_fraction() : 1.0;
+  if (use_image) {
+    vec3 color = texture(floor_image, floor_position / (2.0 * tile)).rgb * color_a;
+    fragment = vec4(clamp(color * (ambient + direct * light), 0.0, 1.0), 1.0);
+  } else {
   // The checker averaged over the pixel's footprint (a box filter integrated in closed form),
   // so that distant tiles blend smoothly instead of flickering into moire.
   vec2 p = floor_position / tile;
   vec2 w = fwidth(p) + 1e-4;
   vec2 i = 2.0 * (abs(fract((p - 0.5 * w) * 0.5) - 0.5) - abs(fract((p + 0.5 * w) * 0.5) - 0.5)) / w;
   vec3 color = mix(color_a, color_b, 0.5 - 0.5 * i.x * i.y);
-  float light = use_shadows ? lit_fraction() : 1.0;
   fragment = vec4(clamp(color * (ambient + direct * light), 0.0, 1.0), 1.0);
+  }
+  if (opacity < 1.0) {
+    vec3 behind = sky_color(vec3(floor_position, floor_height) - camera_position);
+    fragment.rgb = mix(behind, fragment.rgb, opacity);
+  }
 }
 )";
 
@@ -179,13 +218,25 @@ GlShader compile(GLenum type, const char* source) {
   return shader;
 }
 
-// `source` with the shared shadow lookup spliced in.
-std::string with_shadow_lookup(const char* source) {
+// `source` with the shared shadow lookup and sky colour spliced in.
+std::string with_shared_code(const char* source) {
   std::string text = source;
-  const std::string marker = "@SHADOW@";
-  const std::size_t at = text.find(marker);
-  if (at != std::string::npos) text.replace(at, marker.size(), kShadowLookup);
+  for (const auto& [marker, code] : {std::pair<std::string, const char*>{"@SHADOW@", kShadowLookup},
+                                     std::pair<std::string, const char*>{"@SKY@", kSkyColor}}) {
+    const std::size_t at = text.find(marker);
+    if (at != std::string::npos) text.replace(at, marker.size(), code);
+  }
   return text;
+}
+
+SkyUniforms look_up_sky(const GlProgram& program) {
+  SkyUniforms sky;
+  sky.horizon = glGetUniformLocation(program.get(), "horizon");
+  sky.zenith = glGetUniformLocation(program.get(), "zenith");
+  sky.use_image = glGetUniformLocation(program.get(), "sky_use_image");
+  sky.image = glGetUniformLocation(program.get(), "sky_image");
+  sky.span = glGetUniformLocation(program.get(), "sky_span");
+  return sky;
 }
 
 }  // namespace
@@ -211,7 +262,7 @@ GlProgram link_program(const char* vertex_source, const char* fragment_source) {
 }
 
 ShaderPrograms::ShaderPrograms() {
-  lit.program = link_program(kLitVertex, with_shadow_lookup(kLitFragment).c_str());
+  lit.program = link_program(kLitVertex, with_shared_code(kLitFragment).c_str());
   const auto lit_at = [this](const char* name) {
     return glGetUniformLocation(lit.program.get(), name);
   };
@@ -231,8 +282,9 @@ ShaderPrograms::ShaderPrograms() {
   lit.use_shadows = lit_at("use_shadows");
   lit.shadow_map = lit_at("shadow_map");
   lit.mirrored = lit_at("mirrored");
+  lit.color_offset = lit_at("color_offset");
 
-  floor.program = link_program(kFloorVertex, with_shadow_lookup(kFloorFragment).c_str());
+  floor.program = link_program(kFloorVertex, with_shared_code(kFloorFragment).c_str());
   const auto floor_at = [this](const char* name) {
     return glGetUniformLocation(floor.program.get(), name);
   };
@@ -246,11 +298,16 @@ ShaderPrograms::ShaderPrograms() {
   floor.direct = floor_at("direct");
   floor.use_shadows = floor_at("use_shadows");
   floor.shadow_map = floor_at("shadow_map");
+  floor.use_image = floor_at("use_image");
+  floor.image = floor_at("floor_image");
+  floor.opacity = floor_at("opacity");
+  floor.camera_position = floor_at("camera_position");
+  floor.height = floor_at("floor_height");
+  floor.sky = look_up_sky(floor.program);
 
-  sky.program = link_program(kSkyVertex, kSkyFragment);
+  sky.program = link_program(kSkyVertex, with_shared_code(kSkyFragment).c_str());
   sky.inverse_view_projection = glGetUniformLocation(sky.program.get(), "inverse_view_projection");
-  sky.horizon = glGetUniformLocation(sky.program.get(), "horizon");
-  sky.zenith = glGetUniformLocation(sky.program.get(), "zenith");
+  sky.sky = look_up_sky(sky.program);
 
   depth.program = link_program(kDepthVertex, kDepthFragment);
   depth.model_view_projection = glGetUniformLocation(depth.program.get(), "model_view_projection");

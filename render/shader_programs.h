@@ -20,20 +20,28 @@ struct LitProgram {
   GLint model = -1, normal_matrix = -1, view_projection = -1, light_matrix = -1, base_color = -1,
         specular = -1, shininess = -1, to_light = -1, light_color = -1, ambient = -1,
         camera_position = -1, use_texture = -1, albedo = -1, use_shadows = -1, shadow_map = -1,
-        mirrored = -1;
+        mirrored = -1, color_offset = -1;
+};
+
+/// The uniforms of the shared sky colour (the sky's gradient or image) in a program that has it.
+struct SkyUniforms {
+  GLint horizon = -1, zenith = -1, use_image = -1, image = -1, span = -1;
 };
 
 /// The floor: a box-filtered checker, lit once per frame, with the shadow lookup.
 struct FloorProgram {
   GlProgram program;
   GLint model = -1, view_projection = -1, light_matrix = -1, tile = -1, color_a = -1, color_b = -1,
-        ambient = -1, direct = -1, use_shadows = -1, shadow_map = -1;
+        ambient = -1, direct = -1, use_shadows = -1, shadow_map = -1, use_image = -1, image = -1,
+        opacity = -1, camera_position = -1, height = -1;
+  SkyUniforms sky;
 };
 
-/// The sky: a full-screen triangle (no vertex data) with a vertical gradient.
+/// The sky: a full-screen triangle (no vertex data) with a vertical gradient or an image.
 struct SkyProgram {
   GlProgram program;
-  GLint inverse_view_projection = -1, horizon = -1, zenith = -1;
+  GLint inverse_view_projection = -1;
+  SkyUniforms sky;
 };
 
 /// Depth only (the shadow map): positions through one matrix.

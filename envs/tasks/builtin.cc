@@ -1,6 +1,10 @@
 #include "pixelgym/envs/tasks/builtin.h"
 
+#include <algorithm>
 #include <optional>
+#include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include "pixelgym/envs/tasks/acrobot.h"
 #include "pixelgym/envs/tasks/arm_push.h"
@@ -11,6 +15,7 @@
 #include "pixelgym/envs/tasks/finger.h"
 #include "pixelgym/envs/tasks/grid_world.h"
 #include "pixelgym/envs/tasks/pendulum.h"
+#include "pixelgym/envs/tasks/pixel_env.h"
 #include "pixelgym/envs/tasks/reacher.h"
 #include "pixelgym/envs/tasks/urdf_reach.h"
 #include "pixelgym/envs/tasks/walker.h"
@@ -20,18 +25,33 @@ namespace pixelgym {
 
 void register_builtin_envs(Registry& registry) {
   // One line per task.
-  registry.register_env(GridWorld::spec_v0());
-  for (EnvSpec& spec : CartPoleTask::specs()) registry.register_env(std::move(spec));
-  registry.register_env(PendulumTask::spec_v0());
-  registry.register_env(AcrobotTask::spec_v0());
-  for (EnvSpec& spec : ReacherTask::specs()) registry.register_env(std::move(spec));
-  registry.register_env(ArmReachTask::spec_v0());
-  registry.register_env(ArmPushTask::spec_v0());
-  registry.register_env(UrdfReachTask::spec_v0());
-  registry.register_env(CheetahTask::spec_v0());
-  for (EnvSpec& spec : WalkerTask::specs()) registry.register_env(std::move(spec));
-  registry.register_env(FingerTask::spec_v0());
-  registry.register_env(BallInCupTask::spec_v0());
+  std::vector<EnvSpec> specs;
+  const auto add = [&specs](std::vector<EnvSpec> more) {
+    for (EnvSpec& spec : more) specs.push_back(std::move(spec));
+  };
+  add({GridWorld::spec_v0()});
+  add(CartPoleTask::specs());
+  add({PendulumTask::spec_v0()});
+  add({AcrobotTask::spec_v0()});
+  add(ReacherTask::specs());
+  add({ArmReachTask::spec_v0()});
+  add({ArmPushTask::spec_v0()});
+  add({UrdfReachTask::spec_v0()});
+  add({CheetahTask::spec_v0()});
+  add(WalkerTask::specs());
+  add({FingerTask::spec_v0()});
+  add({BallInCupTask::spec_v0()});
+  // The Distracting Control Suite's six tasks (PlaNet's), with its ground-plane alpha per domain.
+  const std::vector<std::pair<std::string, float>> distracting = {
+      {"CartPoleSwingup-v1", 0.3F}, {"ReacherEasy-v1", 0.0F},    {"CheetahRun-v0", 1.0F},
+      {"FingerSpin-v0", 0.3F},      {"BallInCupCatch-v0", 0.3F}, {"WalkerWalk-v0", 1.0F}};
+  for (const auto& [id, floor_opacity] : distracting) {
+    const auto base = std::find_if(specs.begin(), specs.end(),
+                                   [&id = id](const EnvSpec& spec) { return spec.id == id; });
+    if (base == specs.end()) throw std::logic_error("no built-in " + id + " to vary");
+    specs.push_back(distracting_task_spec(*base, floor_opacity));
+  }
+  for (EnvSpec& spec : specs) registry.register_env(std::move(spec));
 }
 
 // The process-wide registry and its free functions (declared in envs/registry.h and

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <stdexcept>
 #include <string>
 
@@ -26,6 +27,36 @@ int read_size(const Params& params, const std::string& key, const std::string& e
                                 std::to_string(value));
   }
   return static_cast<int>(value);
+}
+
+// "x,y,z" as three finite numbers; throws std::invalid_argument naming `env`, `key` and the text.
+Eigen::Vector3f read_point(const std::string& text, const std::string& key,
+                           const std::string& env) {
+  Eigen::Vector3f point;
+  std::size_t start = 0;
+  int count = 0;
+  bool ok = true;
+  while (ok && start <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', start), text.size());
+    const std::string part = text.substr(start, comma - start);
+    char* end = nullptr;
+    const double value = std::strtod(part.c_str(), &end);
+    ok = !part.empty() && end != part.c_str() && *end == '\0' && std::isfinite(value) && count < 3;
+    if (ok) point[count++] = static_cast<float>(value);
+    start = comma + 1;
+  }
+  if (!ok || count != 3) {
+    throw std::invalid_argument(env + ": " + key +
+                                " must be three numbers \"x,y,z\" (world coordinates, m), got \"" +
+                                text + "\"");
+  }
+  return point;
+}
+
+std::string quoted_list(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& name : names) out += (out.empty() ? "\"" : ", \"") + name + "\"";
+  return out;
 }
 
 }  // namespace
@@ -54,23 +85,42 @@ float* StateSlots::slot(const char* name, std::int64_t size) {
 
 std::vector<ParamSpec> TaskConfig::params() {
   const TaskConfig d;
-  return {{"width", d.width, "observation image width in pixels"},
-          {"height", d.height, "observation image height in pixels"},
-          {"camera", d.camera, "observation and render() camera (empty: the task's default)"},
-          {"obs_mode", d.obs_mode,
-           "\"pixels+state\" (Dict), \"pixels\" (Dict of the image), \"rgb\" (the image Box "
-           "itself, for CnnPolicy) or \"state\""},
-          {"render_width", d.render_width, "render() frame width in pixels"},
-          {"render_height", d.render_height, "render() frame height in pixels"},
-          {"action_repeat", d.action_repeat, "control steps per env step (rewards are summed)"},
-          {"shadows", d.shadows, "draw shadows in observations and render()"},
-          {"msaa", d.msaa,
-           "anti-aliasing samples per observation pixel: 0 (off), 2, 4, or 8 where the OpenGL "
-           "offers it (llvmpipe: at most 4; render() uses 4)"},
-          {"render_backend", render::gl_backend_name(d.render_backend),
-           "the OpenGL to draw with: auto (PIXELGYM_GL when set, else osmesa where it works, else "
-           "egl), osmesa or egl (a GPU's EGL device where one exists, else llvmpipe; "
-           "PIXELGYM_EGL_DEVICE picks one)"}};
+  std::vector<ParamSpec> specs = {
+      {"width", d.width, "observation image width in pixels"},
+      {"height", d.height, "observation image height in pixels"},
+      {"camera", d.camera, "observation and render() camera (empty: the task's default)"},
+      {"obs_mode", d.obs_mode,
+       "\"pixels+state\" (Dict), \"pixels\" (Dict of the image), \"rgb\" (the image Box "
+       "itself, for CnnPolicy) or \"state\""},
+      {"render_width", d.render_width, "render() frame width in pixels"},
+      {"render_height", d.render_height, "render() frame height in pixels"},
+      {"action_repeat", d.action_repeat, "control steps per env step (rewards are summed)"},
+      {"shadows", d.shadows, "draw shadows in observations and render()"},
+      {"msaa", d.msaa,
+       "anti-aliasing samples per observation pixel: 0 (off), 2, 4, or 8 where the OpenGL "
+       "offers it (llvmpipe: at most 4; render() uses 4)"},
+      {"render_backend", render::gl_backend_name(d.render_backend),
+       "the OpenGL to draw with: auto (PIXELGYM_GL when set, else osmesa where it works, else "
+       "egl), osmesa or egl (a GPU's EGL device where one exists, else llvmpipe; "
+       "PIXELGYM_EGL_DEVICE picks one)"},
+      {"cameras", std::string(),
+       "cameras drawn into the observation, comma-separated, each as \"pixels/<name>\" (empty: "
+       "`camera` as \"pixels\")"},
+      {"camera_pos", std::string(),
+       "\"x,y,z\": the position of a camera of your own, named \"custom\" (with camera_lookat)"},
+      {"camera_lookat", std::string(), "\"x,y,z\": the point the custom camera looks at"},
+      {"camera_fov", d.camera_fov,
+       "vertical field of view of every camera, degrees (0: each camera's own)"}};
+  const std::vector<ParamSpec> variation = VariationConfig::params();
+  specs.insert(specs.end(), variation.begin(), variation.end());
+  return specs;
+}
+
+std::vector<std::string> TaskConfig::camera_names(
+    const std::vector<std::string>& task_cameras) const {
+  std::vector<std::string> names = task_cameras;
+  if (has_custom_camera) names.emplace_back("custom");
+  return names;
 }
 
 TaskConfig TaskConfig::from_params(const Params& params, const std::vector<std::string>& cameras,
@@ -80,11 +130,50 @@ TaskConfig TaskConfig::from_params(const Params& params, const std::vector<std::
   c.height = read_size(params, "height", env);
   c.render_width = read_size(params, "render_width", env);
   c.render_height = read_size(params, "render_height", env);
+  const std::string pos = params.at("camera_pos").as_string();
+  const std::string lookat = params.at("camera_lookat").as_string();
+  if (pos.empty() != lookat.empty()) {
+    throw std::invalid_argument(env + ": camera_pos and camera_lookat go together, got only " +
+                                (pos.empty() ? "camera_lookat" : "camera_pos"));
+  }
+  if (!pos.empty()) {
+    c.has_custom_camera = true;
+    c.camera_pos = read_point(pos, "camera_pos", env);
+    c.camera_lookat = read_point(lookat, "camera_lookat", env);
+    if ((c.camera_pos - c.camera_lookat).norm() < 1e-6F) {
+      throw std::invalid_argument(env + ": camera_pos and camera_lookat must differ, both are \"" +
+                                  pos + "\"");
+    }
+  }
+  c.camera_fov = params.at("camera_fov").as_float();
+  if (!(c.camera_fov >= 0.0 && c.camera_fov < 170.0)) {
+    throw std::invalid_argument(env +
+                                ": camera_fov must be in [0, 170) degrees (0: each camera's "
+                                "own), got " +
+                                std::to_string(c.camera_fov));
+  }
+  const std::vector<std::string> known = c.camera_names(cameras);
+  const auto check_camera = [&](const std::string& name, const std::string& key) {
+    if (std::find(known.begin(), known.end(), name) == known.end()) {
+      const std::string suggestion = did_you_mean(name, known);
+      throw std::invalid_argument(
+          env + ": unknown camera \"" + name + "\"" + (key == "camera" ? "" : " in " + key) +
+          "; cameras: " + quoted_list(known) + (suggestion.empty() ? "" : "; " + suggestion));
+    }
+  };
   c.camera = params.at("camera").as_string();
-  if (!c.camera.empty() && std::find(cameras.begin(), cameras.end(), c.camera) == cameras.end()) {
-    std::string names;
-    for (const std::string& name : cameras) names += (names.empty() ? "\"" : ", \"") + name + "\"";
-    throw std::invalid_argument(env + ": unknown camera \"" + c.camera + "\"; cameras: " + names);
+  if (c.camera.empty() && c.has_custom_camera) c.camera = "custom";
+  if (!c.camera.empty()) check_camera(c.camera, "camera");
+  const std::string listed = params.at("cameras").as_string();
+  for (std::size_t start = 0; !listed.empty() && start <= listed.size();) {
+    const std::size_t comma = std::min(listed.find(',', start), listed.size());
+    const std::string name = listed.substr(start, comma - start);
+    check_camera(name, "cameras");
+    if (std::find(c.cameras.begin(), c.cameras.end(), name) != c.cameras.end()) {
+      throw std::invalid_argument(env + ": camera \"" + name + "\" is listed twice in cameras");
+    }
+    c.cameras.push_back(name);
+    start = comma + 1;
   }
   c.obs_mode = params.at("obs_mode").as_string();
   if (c.obs_mode != "pixels+state" && c.obs_mode != "pixels" && c.obs_mode != "rgb" &&
@@ -110,16 +199,24 @@ TaskConfig TaskConfig::from_params(const Params& params, const std::vector<std::
   c.msaa = static_cast<int>(msaa);
   c.render_backend =
       render::parse_gl_backend(params.at("render_backend").as_string(), env + ": render_backend");
+  if (!c.cameras.empty() && (c.obs_mode == "rgb" || c.obs_mode == "state")) {
+    throw std::invalid_argument(env + ": cameras gives a Dict of images, which obs_mode \"" +
+                                c.obs_mode +
+                                "\" has no place for (use \"pixels\" or "
+                                "\"pixels+state\")");
+  }
+  c.variation = VariationConfig::from_params(params, env);
   return c;
 }
 
 EnvDescription PixelEnv::describe(const Task& task, const TaskConfig& config) {
   EnvDescription description;
-  description.cameras = task.camera_names();
+  description.cameras = config.camera_names(task.camera_names());
   const auto image = std::make_shared<spaces::Box>(
       0.0, 255.0, Shape{config.height, config.width, 3}, DType::kUInt8);
   spaces::Dict::Entries entries;
-  if (config.has_pixels()) entries.emplace_back("pixels", image);
+  if (config.has_pixels() && config.cameras.empty()) entries.emplace_back("pixels", image);
+  for (const std::string& name : config.cameras) entries.emplace_back("pixels/" + name, image);
   if (config.has_state()) {
     const double inf = std::numeric_limits<double>::infinity();
     for (const StateSpec& spec : task.state_specs()) {
@@ -186,6 +283,9 @@ PixelEnv::PixelEnv(std::unique_ptr<Task> task, TaskConfig config, std::string na
   task_->build(*world_);
   scene_ = std::make_unique<WorldScene>(*world_);
   scene_->scene().shadows = config_.shadows;
+  if (config_.variation.active()) {
+    variation_ = std::make_unique<VisualVariation>(config_.variation, scene_->scene());
+  }
   if (config_.has_pixels()) {
     // More samples than this OpenGL offers would fail at the first reset: refuse them now, with
     // what it offers (llvmpipe: 0, 2 and 4; a GPU through EGL: 8 too).
@@ -213,11 +313,23 @@ render::Renderer& PixelEnv::renderer() {
   return *renderer_;
 }
 
-void PixelEnv::do_reset(std::optional<std::uint64_t> /*seed*/, const Options& options,
+void PixelEnv::do_reset(std::optional<std::uint64_t> seed, const Options& options,
                         ResetResult& out) {
   if (!options.empty()) {
     throw std::invalid_argument(name() + ": reset() takes no options, got \"" +
                                 options.begin()->first + "\"");
+  }
+  if (variation_ != nullptr) {
+    // Drawn first: an image that cannot be read fails the reset before anything has changed.
+    constexpr std::uint64_t kVariationStream = 0x76697375616c5f76ULL;  // "visual_v"
+    if (seed.has_value()) {
+      variation_rng_.emplace(*seed ^ kVariationStream);
+    } else if (!variation_rng_.has_value()) {
+      variation_rng_.emplace(rng().state()[0] ^ kVariationStream);  // reads rng(), draws nothing
+    }
+    variation_sample_ = variation_->sample(scene_->scene().instances.size(), *variation_rng_);
+    VisualVariation::apply(variation_sample_, scene_->scene());
+    pivot_distance_m_.clear();
   }
   world_->reset();
   task_->initialize_episode(*world_, rng());
@@ -263,7 +375,12 @@ void PixelEnv::observe(Value& obs) {
   // Entries in observation_space() order: "pixels" first when present, then the state arrays.
   std::vector<Value>& slots = obs.dict().values();
   std::size_t next = 0;
-  if (config_.has_pixels()) render_camera_into(camera_, config_.msaa, slots[next++].array());
+  if (config_.has_pixels() && config_.cameras.empty()) {
+    render_camera_into(camera_, config_.msaa, slots[next++].array());
+  }
+  for (const std::string& name : config_.cameras) {
+    render_camera_into(name, config_.msaa, slots[next++].array());
+  }
   if (config_.has_state()) {
     StateSlots state(state_specs_, slots.data() + next);
     task_->observe(*world_, state);
@@ -295,12 +412,38 @@ void PixelEnv::render_camera_into(const std::string& camera, int msaa_samples, A
         std::string(dtype_name(frame.dtype())) + " " + shape_to_string(shape));
   }
   scene_->update(*world_);
-  render::Camera view = task_->camera(camera, *world_);
+  render::Camera view = view_of(camera);
   view.height = static_cast<int>(shape[0]);
   view.width = static_cast<int>(shape[1]);
   view.msaa_samples = msaa_samples;
   renderer().render(scene_->scene(), view, {view.width, view.height, frame.data<std::uint8_t>()});
   ++frames_rendered_;
+}
+
+render::Camera PixelEnv::view_of(const std::string& name) {
+  render::Camera view;
+  float pivot_m = 0.0F;
+  if (name == "custom" && config_.has_custom_camera) {
+    view = render::Camera::look_at(
+        config_.camera_pos, config_.camera_lookat,
+        std::abs((config_.camera_lookat - config_.camera_pos).normalized().z()) > 0.999F
+            ? Eigen::Vector3f::UnitY()
+            : Eigen::Vector3f::UnitZ());
+    pivot_m = (config_.camera_lookat - config_.camera_pos).norm();
+  } else {
+    view = task_->camera(name, *world_);
+  }
+  if (config_.camera_fov > 0.0) view.fov_y_deg = static_cast<float>(config_.camera_fov);
+  if (variation_ == nullptr) return view;
+  // The camera turns about what it looks at: the point of its view axis nearest the scene's
+  // centre at the episode's first frame from it (the custom camera's look-at point).
+  auto [pivot, added] = pivot_distance_m_.try_emplace(name, pivot_m);
+  if (added && pivot_m == 0.0F) {
+    const Eigen::Vector3f to_centre = scene_->bounds().center() - view.X_world_camera.translation();
+    const float along = to_centre.dot(-view.X_world_camera.linear().col(2));
+    pivot->second = std::max(along > 0.1F ? along : to_centre.norm(), 0.1F);
+  }
+  return VisualVariation::apply(variation_sample_, view, pivot->second);
 }
 
 Array PixelEnv::do_render() {
@@ -335,6 +478,57 @@ EnvSpec pixel_task_spec(const std::string& id, const std::string& description,
   const Params defaults = resolve_params(spec.params, {}, id);
   const std::int64_t repeat = defaults.at("action_repeat").as_int();
   spec.max_episode_steps = (make_task(defaults)->episode_length() + repeat - 1) / repeat;
+  return spec;
+}
+
+EnvSpec distracting_task_spec(const EnvSpec& base, float floor_opacity) {
+  const std::size_t version = base.id.rfind("-v");
+  if (version == std::string::npos || !base.factory || !base.describe) {
+    throw std::invalid_argument("distracting_task_spec: \"" + base.id +
+                                "\" is not a pixel task's spec (Name-vN, made by pixel_task_spec)");
+  }
+  EnvSpec spec = base;
+  spec.id = base.id.substr(0, version) + "-distracting" + base.id.substr(version);
+  spec.description = base.description + "; the Distracting Control Suite's variant (" + base.id +
+                     " with random body colours, camera and background)";
+  const std::map<std::string, Param> defaults = {
+      {"variation", 0.2},
+      {"vary_textures", 0.0},
+      {"vary_light", 0.0},
+      {"vary_fov", 0.0},
+      {"sky_texture", std::string("noise")},
+      {"floor_opacity", static_cast<double>(floor_opacity)}};
+  for (ParamSpec& param : spec.params) {
+    const auto found = defaults.find(param.name);
+    if (found != defaults.end()) param.default_value = found->second;
+    if (param.name == "variation") {
+      param.doc =
+          "the Distracting Control Suite's intensity, 0 to 1: 0.1 easy, 0.2 medium "
+          "(default), 0.3 hard (colours shifted by up to it, the camera turned by up to 90 "
+          "times it degrees)";
+    }
+  }
+  // The base's factory names the base in its messages: name the variant instead.
+  const auto renamed = [from = base.id, to = spec.id](const std::invalid_argument& error) {
+    std::string what = error.what();
+    if (what.compare(0, from.size(), from) == 0) what.replace(0, from.size(), to);
+    return std::invalid_argument(what);
+  };
+  spec.factory = [factory = base.factory, renamed](const Params& kwargs,
+                                                   const MakeOptions& options) {
+    try {
+      return factory(kwargs, options);
+    } catch (const std::invalid_argument& error) {
+      throw renamed(error);
+    }
+  };
+  spec.describe = [describe = base.describe, renamed](const Params& kwargs) {
+    try {
+      return describe(kwargs);
+    } catch (const std::invalid_argument& error) {
+      throw renamed(error);
+    }
+  };
   return spec;
 }
 

@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -57,6 +58,8 @@ class PixelEnv final : public Env {
   const WorldScene& scene() const { return *scene_; }
   /// The render resources it draws with, as given at construction; null: a context of its own.
   const PixelRenderResources* render_resources() const { return render_resources_.get(); }
+  /// This episode's visual variation (all zero when the config varies nothing).
+  const VariationSample& variation() const { return variation_sample_; }
   /// Control steps taken in this episode.
   int control_steps() const { return control_steps_; }
   /// Frames drawn so far (observations and render()); stays 0 with obs_mode="state" until
@@ -64,9 +67,10 @@ class PixelEnv final : public Env {
   std::int64_t frames_rendered() const { return frames_rendered_; }
 
   /// Camera `camera`'s image of the world as it is now, at any size and MSAA sample count
-  /// (0, 2, 4 or 8), as a new (height, width, 3) uint8 array (for tests and tools). Counts in
-  /// frames_rendered(); creates the renderer if there is none yet. `camera` goes to Task::camera
-  /// unchecked (the built-in tasks draw an unknown name as one of their cameras). Throws
+  /// (0, 2, 4 or 8), as a new (height, width, 3) uint8 array (for tests and tools), with this
+  /// episode's variation. Counts in frames_rendered(); creates the renderer if there is none yet.
+  /// `camera` goes to Task::camera unchecked (the built-in tasks draw an unknown name as one of
+  /// their cameras) unless it is "custom" and the config has a custom camera. Throws
   /// std::invalid_argument for an invalid size or sample count (render::Camera::validate).
   Array render_camera(const std::string& camera, int width, int height, int msaa_samples);
   /// The same, drawn into `frame`: a uint8 (height, width, 3) array the caller owns. Throws
@@ -74,8 +78,9 @@ class PixelEnv final : public Env {
   void render_camera_into(const std::string& camera, int msaa_samples, Array& frame);
 
   /// The spaces, time limit, cameras and metadata of `task` under `config`, without a world: the
-  /// observation Dict ("pixels" a uint8 Box [0, 255] of (height, width, 3), then each state array
-  /// a float32 Box (-inf, inf)), max_episode_steps = ceil(episode_length / action_repeat),
+  /// observation Dict ("pixels" a uint8 Box [0, 255] of (height, width, 3), or one such
+  /// "pixels/<name>" per camera of config.cameras, then each state array a float32 Box
+  /// (-inf, inf)), max_episode_steps = ceil(episode_length / action_repeat),
   /// render_fps = 1 / (control_timestep_s * action_repeat) and render_shape from render_width and
   /// render_height.
   static EnvDescription describe(const Task& task, const TaskConfig& config);
@@ -90,6 +95,9 @@ class PixelEnv final : public Env {
 
  private:
   void observe(Value& obs);
+  // Camera `name` for the world as it is now: the task's or the custom one, with camera_fov and
+  // this episode's camera variation.
+  render::Camera view_of(const std::string& name);
   // Throws PhysicsDivergence naming the env, the control step and `what` went non-finite.
   [[noreturn]] void diverged(const std::string& what) const;
   render::Renderer& renderer();
@@ -109,6 +117,12 @@ class PixelEnv final : public Env {
   std::unique_ptr<render::Renderer> renderer_;
   int control_steps_ = 0;
   std::int64_t frames_rendered_ = 0;
+  // Visual variation: drawn at reset from a generator of its own (seeded from the reset seed),
+  // so that the physics' generator, rng(), draws the same numbers with it on or off.
+  std::unique_ptr<VisualVariation> variation_;  // null: the config varies nothing
+  VariationSample variation_sample_;
+  std::optional<Rng> variation_rng_;
+  std::map<std::string, float> pivot_distance_m_;  // per camera, this episode's
 };
 
 /// What the pixel envs that one thread steps share to draw (RenderResources, made by make_vec
@@ -147,6 +161,13 @@ class PixelRenderResources final : public RenderResources {
 EnvSpec pixel_task_spec(const std::string& id, const std::string& description,
                         std::function<std::unique_ptr<Task>(const Params& kwargs)> make_task,
                         std::vector<ParamSpec> extra_params = {});
+
+/// The Distracting Control Suite's variant of the pixel task `base` (made by pixel_task_spec):
+/// id "<Name>-distracting-v<N>" for base "<Name>-v<N>", the same task and kwargs with other
+/// defaults: variation 0.2 (the suite's "medium"; 0.1 easy, 0.3 hard) for body colours and the
+/// camera only, a procedural background (sky_texture "noise", or a folder of the user's) and the
+/// floor at `floor_opacity` (the suite's ground-plane alpha for the domain).
+EnvSpec distracting_task_spec(const EnvSpec& base, float floor_opacity);
 
 /// A sphere that is drawn but never touched (a target or goal marker), static.
 engine::BodyOptions marker_body(const std::string& name, double radius_m,

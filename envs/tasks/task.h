@@ -13,6 +13,7 @@
 #include "pixelgym/envs/params.h"
 #include "pixelgym/envs/rng.h"
 #include "pixelgym/envs/space.h"
+#include "pixelgym/envs/tasks/visual_variation.h"
 #include "pixelgym/envs/value.h"
 #include "pixelgym/render/camera.h"
 #include "pixelgym/render/context.h"
@@ -24,8 +25,20 @@ struct TaskConfig {
   /// Observation image size in pixels.
   int width = 84;
   int height = 84;
-  /// One of the task's camera names; empty for its default (the first).
+  /// One of the task's camera names (or "custom"); empty for its default (the first), or
+  /// "custom" when camera_pos is given.
   std::string camera;
+  /// Cameras drawn into the observation, each as its own "pixels/<name>" image in the Dict (in
+  /// place of "pixels"); empty for the one `camera` as "pixels".
+  std::vector<std::string> cameras;
+  /// A camera of the user's, named "custom": at `camera_pos` looking at `camera_lookat` (world
+  /// coordinates, m) with +z up in the image, fixed in the world.
+  bool has_custom_camera = false;
+  Eigen::Vector3f camera_pos = Eigen::Vector3f::Zero();
+  Eigen::Vector3f camera_lookat = Eigen::Vector3f::Zero();
+  /// Vertical field of view of every camera drawn, degrees; 0 for each camera's own (the custom
+  /// camera's: 45).
+  double camera_fov = 0.0;
   /// "pixels+state": Dict of "pixels" and the state arrays; "pixels": Dict of "pixels" alone;
   /// "rgb": the (height, width, 3) uint8 image itself, a bare Box (ALE's obs_type="rgb", what
   /// SB3's CnnPolicy and Gymnasium's image wrappers take); "state": only the state arrays (no
@@ -47,6 +60,8 @@ struct TaskConfig {
   /// The OpenGL the env draws with (render::GlBackend): auto (PIXELGYM_GL when set, else OSMesa
   /// where it works, else EGL), osmesa or egl. On llvmpipe both draw the same bytes.
   render::GlBackend render_backend = render::GlBackend::kAuto;
+  /// Visual variation drawn at each reset (none by default).
+  VariationConfig variation;
 
   /// Whether observations hold the image (obs_mode is not "state").
   bool has_pixels() const { return obs_mode != "state"; }
@@ -55,12 +70,17 @@ struct TaskConfig {
   /// Whether the observation is the image itself, a bare Box (obs_mode "rgb").
   bool image_only() const { return obs_mode == "rgb"; }
 
-  /// The keys above with their defaults and docs.
+  /// The keys above with their defaults and docs (VariationConfig::params for the variation).
   static std::vector<ParamSpec> params();
+  /// The cameras an env of `task` under this config draws: the task's, then "custom" if given.
+  std::vector<std::string> camera_names(const std::vector<std::string>& task_cameras) const;
   /// Reads resolved kwargs; `cameras` are the task's camera names. Throws std::invalid_argument,
-  /// naming `env` and the key, for a size outside [16, 8192], an unknown obs_mode or camera,
-  /// action_repeat outside [1, 1000], msaa other than 0, 2, 4 or 8, or a render_backend other than
-  /// auto, egl or osmesa.
+  /// naming `env` and the key, for a size outside [16, 8192], an unknown obs_mode or camera (in
+  /// `camera` or `cameras`, or a repeated one), `cameras` with obs_mode "rgb" or "state",
+  /// camera_pos or camera_lookat that is not three numbers "x,y,z" or given without the other,
+  /// the two equal, camera_fov outside [0, 170), action_repeat outside [1, 1000], msaa other than
+  /// 0, 2, 4 or 8, a render_backend other than auto, egl or osmesa, and what
+  /// VariationConfig::from_params refuses.
   static TaskConfig from_params(const Params& params, const std::vector<std::string>& cameras,
                                 const std::string& env);
 };

@@ -203,6 +203,13 @@ void declare_eval(CLI::App& eval, EvalArguments& args) {
   eval.add_option("--video", args.video, "Record the first episode to this .mp4");
   eval.add_flag("--stochastic", args.stochastic,
                 "Sample actions from the policy instead of taking its mean / most likely one");
+  eval.add_option("--env", args.env,
+                  "Play in this env instead of the run's, with the run's kwargs and --wrap (its "
+                  "spaces must be the run's): e.g. the task's -distracting variant, to see how a "
+                  "policy trained on the plain task copes with distractions");
+  eval.add_option("--set", args.sets,
+                  "Env kwarg as key=value over the run's (repeatable), e.g. variation=0.3")
+      ->type_name("KEY=VALUE");
 }
 
 // --- export ---

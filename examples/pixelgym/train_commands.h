@@ -52,6 +52,8 @@ struct EvalArguments {
   bool seed_given = false;  // else the run's final evaluation's seed (summary.json's)
   std::string video;
   bool stochastic = false;
+  std::string env;                // --env: another env to play in (same spaces); empty: the run's
+  std::vector<std::string> sets;  // --set KEY=VALUE, over the run's env kwargs
 };
 
 /// `pixelgym export`'s command line.

@@ -387,6 +387,8 @@ int run_eval(const EvalArguments& args) {
   if (args.seed_given) request.seed = args.seed;
   request.stochastic = args.stochastic;
   if (!args.video.empty()) request.video = fs::path(args.video);
+  if (!args.env.empty()) request.env_id = args.env;
+  request.env_sets = args.sets;
   const trainer::CheckpointEvaluation result =
       trainer::evaluate_checkpoint(kAlgorithms, args.run, request, std::cerr);
   const trainer::PolicyEvaluation& evaluation = result.evaluation;

@@ -131,6 +131,21 @@ TEST(TrainCliTest, AShortRunWritesACompleteRunFolder) {
   std::ostringstream expected_clipped;
   expected_clipped << "clipped_action_fraction=" << clipped << "\n";
   EXPECT_NE(evaluated.output.find(expected_clipped.str()), std::string::npos) << evaluated.output;
+  // Played elsewhere: with other kwargs over the run's, or in another env of the same spaces (a
+  // -distracting variant); an env of other spaces is refused, naming both.
+  const CliRun varied = run_cli("eval " + run.string() + " --episodes 1 --set variation=0.5");
+  ASSERT_EQ(varied.exit_code, 0) << varied.output;
+  EXPECT_THAT(varied.output, ::testing::HasSubstr(": CartPoleBalance-v0, 1 episodes"));
+  const CliRun distracting =
+      run_cli("eval " + run.string() + " --episodes 1 --env CartPoleSwingup-distracting-v1");
+  ASSERT_EQ(distracting.exit_code, 0) << distracting.output;
+  EXPECT_THAT(distracting.output,
+              ::testing::HasSubstr(": CartPoleSwingup-distracting-v1, 1 episodes"));
+  const CliRun other = run_cli("eval " + run.string() + " --episodes 1 --env CheetahRun-v0");
+  EXPECT_NE(other.exit_code, 0);
+  EXPECT_THAT(other.output,
+              ::testing::HasSubstr("CheetahRun-v0's action space Box(-1.0, 1.0, (6,), float32) is "
+                                   "not the run's (CartPoleBalance-v0: Box(-1.0, 1.0, (1,)"));
   // A checkpoint file carries its run's settings: copied away from its folder, it evaluates
   // the same.
   const fs::path away = folder / "away";

@@ -7,8 +7,10 @@
 #include <memory>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 #include <utility>
 
+#include "pixelgym/envs/registry.h"
 #include "pixelgym/envs/time_limit.h"
 #include "pixelgym/envs/vector/sync_vector_env.h"
 #include "pixelgym/envs/wrapper.h"
@@ -333,6 +335,28 @@ CheckpointEvaluation evaluate_checkpoint(const AlgorithmFactories& algorithms,
   request.stochastic = given.stochastic;
   request.video = given.video;
   const std::unique_ptr<Actor> actor = load_run_actor(algorithm, result.settings, checkpoint);
+  if (given.env_id || !given.env_sets.empty()) {
+    // Another env, or other kwargs: the policy reads the run's spaces, so these must be the same.
+    const std::unique_ptr<Env> run_env = make_run_env(result.settings);
+    const std::string run_id = result.settings.env_id;
+    if (given.env_id) result.settings.env_id = *given.env_id;
+    for (auto& [key, value] : parse_kwargs(result.settings.env_id, given.env_sets)) {
+      result.settings.env_kwargs.insert_or_assign(key, value);
+    }
+    const std::unique_ptr<Env> played = make_run_env(result.settings);
+    for (const auto& [what, ours, theirs] :
+         {std::tuple<const char*, const Space*, const Space*>{
+              "observation", &played->observation_space(), &run_env->observation_space()},
+          {"action", &played->action_space(), &run_env->action_space()}}) {
+      if (!ours->equals(*theirs)) {
+        throw std::runtime_error("eval: " + result.settings.env_id + "'s " + what + " space " +
+                                 ours->to_string() + " is not the run's (" + run_id + ": " +
+                                 theirs->to_string() + "); the policy reads the run's");
+      }
+    }
+    run_env->close();
+    played->close();
+  }
   result.evaluation = evaluate(*actor, result.settings, request);
   return result;
 }

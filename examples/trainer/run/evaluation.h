@@ -101,13 +101,17 @@ struct CheckpointEvaluationRequest {
   std::optional<std::uint64_t> seed;
   bool stochastic = false;
   std::optional<std::filesystem::path> video;
+  /// Another env to play in, with the run's kwargs and wrappers; its spaces must be the run's.
+  std::optional<std::string> env_id;
+  /// Env kwargs as KEY=VALUE over the run's (parse_kwargs).
+  std::vector<std::string> env_sets;
 };
 
 /// A checkpoint's evaluation.
 struct CheckpointEvaluation {
   std::filesystem::path checkpoint;  // the file evaluated
   RunSettings settings;              // the run's, which built the env (settings.algorithm: its
-                                     // algorithm's name)
+                                     // algorithm's name), with the request's env and kwargs
   EvaluationRequest request;         // the episodes played
   /// Where the episodes and seed not given came from: "summary.json" (the run's final
   /// evaluation, of this checkpoint) or "the run's settings" (seed + 1,000,000, eval_episodes).
