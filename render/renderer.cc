@@ -81,6 +81,22 @@ void check_background(const Scene& scene) {
   }
 }
 
+// Everything the sky depends on (the camera's orientation and projection, the sky's settings),
+// written into `key`.
+void sky_key(const Scene& scene, const Camera& camera, const Eigen::Matrix4f& turn_projection,
+             std::vector<float>& key) {
+  key.assign(turn_projection.data(), turn_projection.data() + 16);
+  key.insert(key.end(), scene.sky.horizon.data(), scene.sky.horizon.data() + 3);
+  key.insert(key.end(), scene.sky.zenith.data(), scene.sky.zenith.data() + 3);
+  const std::uint64_t serial = scene.sky.image == nullptr ? 0 : scene.sky.image->serial();
+  for (int shift = 0; shift < 64; shift += 16) {
+    key.push_back(static_cast<float>((serial >> shift) & 0xFFFFU));
+  }
+  key.insert(key.end(),
+             {scene.sky.image_span_deg, static_cast<float>(camera.width),
+              static_cast<float>(camera.height), static_cast<float>(camera.msaa_samples)});
+}
+
 void check_sizes(const Camera& camera, const RenderTargets& targets) {
   if (targets.width != camera.width || targets.height != camera.height) {
     throw std::invalid_argument("Renderer: RenderTargets are " + std::to_string(targets.width) +
@@ -143,25 +159,24 @@ struct ContextGroup::State {
         .first->second;
   }
 
-  // The cached background (sky and unshadowed floor) drawn from `frame_key` when there is one; else
-  // one to draw it into (with another key: a new one, or the least recently used when
-  // kBackgroundsPerSize exist).
-  Background& background(const Camera& camera) {
+  // The image of `store` drawn from `key` when there is one; else one to draw it into (with
+  // another key: a new one, or the least recently used when kBackgroundsPerSize exist). `what`
+  // names it in errors.
+  Background& cached_image(std::map<TargetKey, std::vector<Background>>& store,
+                           const Camera& camera, const std::vector<float>& key, const char* what) {
     std::vector<Background>& kept =
-        backgrounds[TargetKey{camera.width, camera.height, camera.msaa_samples}];
+        store[TargetKey{camera.width, camera.height, camera.msaa_samples}];
     Background* chosen = nullptr;
     for (Background& candidate : kept) {
-      if (candidate.key == frame_key) {
+      if (candidate.key == key) {
         chosen = &candidate;
         break;
       }
       if (chosen == nullptr || candidate.last_used < chosen->last_used) chosen = &candidate;
     }
-    if (chosen == nullptr || (chosen->key != frame_key && kept.size() < kBackgroundsPerSize)) {
+    if (chosen == nullptr || (chosen->key != key && kept.size() < kBackgroundsPerSize)) {
       kept.push_back(
-          {ColorTarget(camera.width, camera.height, camera.msaa_samples, false, "background"),
-           {},
-           0});
+          {ColorTarget(camera.width, camera.height, camera.msaa_samples, false, what), {}, 0});
       chosen = &kept.back();
     }
     chosen->last_used = ++frames;
@@ -257,19 +272,19 @@ struct ContextGroup::State {
     if (sky.image != nullptr) textures.bind_image(sky.image, kSkyImageUnit);
   }
 
-  // The sky at the far plane: depth-tested against what is already drawn (so only its visible
-  // pixels are shaded), writing no depth.
-  void draw_sky(const Scene& scene, const Eigen::Matrix4f& view_projection) {
+  // The sky over the whole of the target bound, from the camera's orientation alone (a camera
+  // that moves without turning sees the same sky), writing no depth.
+  void draw_sky(const Scene& scene, const Eigen::Matrix4f& turn_projection) {
     const SkyProgram& sky = programs.sky;
-    glDepthFunc(GL_LEQUAL);
+    glDisable(GL_DEPTH_TEST);
     glDepthMask(GL_FALSE);
     glUseProgram(sky.program.get());
-    const Eigen::Matrix4f inverse = view_projection.inverse();
+    const Eigen::Matrix4f inverse = turn_projection.inverse();
     glUniformMatrix4fv(sky.inverse_view_projection, 1, GL_FALSE, inverse.data());
     set_sky(sky.sky, scene.sky);
     glDrawArrays(GL_TRIANGLES, 0, 3);  // positions come from gl_VertexID; the arena is bound
     glDepthMask(GL_TRUE);
-    glDepthFunc(GL_LESS);
+    glEnable(GL_DEPTH_TEST);
   }
 
   void render(const Scene& scene, const Camera& camera, const RenderTargets& out) {
@@ -333,18 +348,34 @@ struct ContextGroup::State {
     // inside the casters' footprints on the floor, so with shadows on, only those rectangles of
     // floor are drawn again (same shader, now with the shadow lookup). Every frame, the first
     // included, takes this path, so a scene always gives the same bytes.
+    // The sky depends on the camera's orientation alone: a camera that follows a body without
+    // turning (a tracking camera) redraws the floor every frame but copies its sky.
     const ColorTarget& frame = target(camera);
     background_key(scene, camera, view_projection, frame_key);
-    Background& cached = background(camera);
+    Background& cached = cached_image(backgrounds, camera, frame_key, "background");
     if (frame_key != cached.key) {
+      Eigen::Matrix4f turn = camera.view_matrix();
+      turn.block<3, 1>(0, 3).setZero();
+      const Eigen::Matrix4f turn_projection = camera.projection_matrix() * turn;
+      sky_key(scene, camera, turn_projection, sky_frame_key);
+      Background& sky = cached_image(skies, camera, sky_frame_key, "sky");
+      if (sky_frame_key != sky.key) {
+        glBindFramebuffer(GL_FRAMEBUFFER, sky.target.framebuffer());
+        glViewport(0, 0, camera.width, camera.height);
+        draw_sky(scene, turn_projection);
+        sky.key = sky_frame_key;
+      }
+      glBindFramebuffer(GL_READ_FRAMEBUFFER, sky.target.framebuffer());
+      glBindFramebuffer(GL_DRAW_FRAMEBUFFER, cached.target.framebuffer());
+      glBlitFramebuffer(0, 0, camera.width, camera.height, 0, 0, camera.width, camera.height,
+                        GL_COLOR_BUFFER_BIT, GL_NEAREST);
       glBindFramebuffer(GL_FRAMEBUFFER, cached.target.framebuffer());
       glViewport(0, 0, camera.width, camera.height);
-      glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+      glClear(GL_DEPTH_BUFFER_BIT);
       if (scene.floor.enabled) {
         draw_floor(scene, eye, view_projection, light_matrix, false, floor_mesh,
                    arena.vertex_array(), kFloorDepthOffset);
       }
-      draw_sky(scene, view_projection);
       cached.key = frame_key;
     }
     glBindFramebuffer(GL_READ_FRAMEBUFFER, cached.target.framebuffer());
@@ -421,6 +452,8 @@ struct ContextGroup::State {
   // Several per size (the renderers of a ContextGroup may look from different cameras), the
   // least recently used redrawn when none matches.
   std::map<TargetKey, std::vector<Background>> backgrounds;
+  // The skies the backgrounds were drawn over, kept as the backgrounds are.
+  std::map<TargetKey, std::vector<Background>> skies;
   std::uint64_t frames = 0;
   std::map<std::pair<int, int>, SegmentationTarget> segmentation_targets;
   GLint max_samples = 0;
@@ -429,6 +462,7 @@ struct ContextGroup::State {
   std::vector<Eigen::AlignedBox3f> bounds;  // each drawn mesh's bounds, in mesh coordinates
   std::vector<Eigen::AlignedBox2f> footprint_rectangles;
   std::vector<float> frame_key;        // of this frame's background
+  std::vector<float> sky_frame_key;    // of this frame's sky
   std::vector<std::uint8_t> readback;  // RGBA, packed into RGB
 };
 

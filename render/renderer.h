@@ -32,11 +32,11 @@ struct RenderTargets {
 /// one of their own. They share the compiled shader programs, the meshes and textures uploaded (by
 /// MeshData address and texture path, so envs of one task upload each mesh once), the framebuffers
 /// a frame is drawn in, the shadow map, and the cached backgrounds (by camera and scene settings,
-/// up to 16 per image size). Every frame sets all the GL state it draws with and redraws every
-/// pixel it reads, so a renderer's frames are byte-identical to those of a renderer with a context
-/// of its own. Meshes and textures stay until the group and all its renderers are gone. Its
-/// context is of copy `mesa_copy()` of Mesa (see MesaCopy). Why share: docs/design-notes.md,
-/// "Rendering".
+/// up to 16 per image size) and the skies they were drawn over (by camera orientation and sky).
+/// Every frame sets all the GL state it draws with and redraws every pixel it reads, so a
+/// renderer's frames are byte-identical to those of a renderer with a context of its own. Meshes
+/// and textures stay until the group and all its renderers are gone. Its context is of copy
+/// `mesa_copy()` of Mesa (see MesaCopy). Why share: docs/design-notes.md, "Rendering".
 ///
 /// Threads: the renderers sharing a context must never draw (or be made or destroyed) at the same
 /// time: give one group to renderers that one thread runs in turn (or several threads, one after

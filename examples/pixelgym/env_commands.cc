@@ -249,11 +249,36 @@ struct SnapshotArguments : EnvArguments {
   bool observation = false;
 };
 
-// The observation's image as an (H, W, 3) picture: the "pixels" entry of a Dict observation, or
-// a bare uint8 observation. A gray image ((H, W) or (H, W, 1)) becomes grey RGB; planes on a
-// leading axis ((k, H, W): stacked gray frames or channel-first planes; (k, H, W, C): stacked
-// frames) are laid side by side, the first leftmost. Throws UsageError for anything else.
+// The observation's image as an (H, W, 3) picture: the "pixels" entry of a Dict observation (its
+// "pixels/<camera>" entries side by side, the first leftmost), or a bare uint8 observation. A gray
+// image ((H, W) or (H, W, 1)) becomes grey RGB; planes on a leading axis ((k, H, W): stacked gray
+// frames or channel-first planes; (k, H, W, C): stacked frames) are laid side by side, the first
+// leftmost. Throws UsageError for anything else.
 Array observation_picture(const std::string& id, const Value& obs) {
+  // Several cameras ("pixels/<name>" entries, kwarg cameras): their pictures side by side.
+  if (obs.is_dict() && !obs.dict().contains("pixels")) {
+    std::vector<Array> pictures;
+    for (const std::string& key : obs.dict().keys()) {
+      if (key.rfind("pixels/", 0) == 0)
+        pictures.push_back(observation_picture(id, obs.dict().at(key)));
+    }
+    if (!pictures.empty()) {
+      const std::int64_t height = pictures[0].shape()[0];
+      std::int64_t width = 0;
+      for (const Array& picture : pictures) width += picture.shape()[1];
+      Array row(DType::kUInt8, {height, width, 3});
+      std::int64_t left = 0;
+      for (const Array& picture : pictures) {
+        const std::int64_t w = picture.shape()[1];
+        for (std::int64_t y = 0; y < height; ++y) {
+          std::copy_n(picture.data<std::uint8_t>() + y * w * 3, w * 3,
+                      row.data<std::uint8_t>() + (y * width + left) * 3);
+        }
+        left += w;
+      }
+      return row;
+    }
+  }
   const Array* image = nullptr;
   if (obs.is_dict() && obs.dict().contains("pixels") && obs.dict().at("pixels").is_array()) {
     image = &obs.dict().at("pixels").array();
@@ -359,7 +384,8 @@ void declare_snapshot(CLI::App& snapshot, SnapshotArguments& args) {
   snapshot.add_flag(
       "--observation", args.observation,
       "Take the observation's \"pixels\" (what the agent sees, after any --wrap) instead of "
-      "render(); gray images as grey, stacked frames side by side, oldest leftmost");
+      "render(); gray images as grey, stacked frames side by side, oldest leftmost, and the "
+      "images of several cameras (--set cameras=a,b) side by side");
   add_env_options(snapshot, args);
 }
 
