@@ -150,7 +150,7 @@ TaskConfig TaskConfig::from_params(const Params& params, const std::vector<std::
     throw std::invalid_argument(env +
                                 ": camera_fov must be in [0, 170) degrees (0: each camera's "
                                 "own), got " +
-                                std::to_string(c.camera_fov));
+                                Param(c.camera_fov).to_string());
   }
   const std::vector<std::string> known = c.camera_names(cameras);
   const auto check_camera = [&](const std::string& name, const std::string& key) {

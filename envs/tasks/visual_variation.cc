@@ -33,7 +33,7 @@ double read_level(const Params& params, const std::string& key, bool may_follow,
   if (!(value >= 0.0 && value <= 1.0)) {
     throw std::invalid_argument(env + ": " + key + " must be in [0, 1]" +
                                 (may_follow ? " (or -1 to follow variation)" : "") + ", got " +
-                                std::to_string(value));
+                                Param(value).to_string());
   }
   return value;
 }
@@ -94,23 +94,60 @@ TextureSource TextureSource::parse(const std::string& text, const std::string& d
   }
   source.kind = Kind::kFolder;
   source.folder = text;
-  for (fs::directory_iterator it(text, error), end; !error && it != end; it.increment(error)) {
-    const std::string extension = lower(it->path().extension().string());
-    if ((extension == ".png" || extension == ".jpg" || extension == ".jpeg") &&
-        it->is_regular_file(error)) {
-      source.files.push_back(it->path().string());
+  const auto is_image = [](const fs::directory_entry& entry, std::error_code& code) {
+    const std::string extension = lower(entry.path().extension().string());
+    return (extension == ".png" || extension == ".jpg" || extension == ".jpeg") &&
+           entry.is_regular_file(code);
+  };
+  // The images directly in `folder`, sorted by name.
+  const auto images_in = [&](const fs::path& folder) {
+    std::vector<std::string> files;
+    for (fs::directory_iterator it(folder, error), end; !error && it != end; it.increment(error)) {
+      if (is_image(*it, error)) files.push_back(it->path().string());
     }
+    if (error) {
+      throw std::invalid_argument(context + ": " + key + ": cannot list the folder \"" +
+                                  folder.string() + "\": " + error.message());
+    }
+    std::sort(files.begin(), files.end());
+    return files;
+  };
+  // Each image directly in the folder is a background of its own, each subfolder with images one
+  // video; both sorted together by name.
+  std::vector<std::pair<std::string, std::vector<std::string>>> named;
+  for (const std::string& file : images_in(text)) named.push_back({file, {file}});
+  std::vector<fs::path> subfolders;
+  for (fs::directory_iterator it(text, error), end; !error && it != end; it.increment(error)) {
+    if (it->is_directory(error)) subfolders.push_back(it->path());
   }
   if (error) {
     throw std::invalid_argument(context + ": " + key + ": cannot list the folder \"" + text +
                                 "\": " + error.message());
   }
-  if (source.files.empty()) {
-    throw std::invalid_argument(context + ": " + key + ": the folder \"" + text +
-                                "\" holds no .png, .jpg or .jpeg image");
+  for (const fs::path& subfolder : subfolders) {
+    std::vector<std::string> frames = images_in(subfolder);
+    if (!frames.empty()) named.push_back({subfolder.string(), std::move(frames)});
   }
-  std::sort(source.files.begin(), source.files.end());
+  if (named.empty()) {
+    throw std::invalid_argument(
+        context + ": " + key + ": the folder \"" + text +
+        "\" holds no .png, .jpg or .jpeg image, directly or in a subfolder");
+  }
+  std::sort(named.begin(), named.end());
+  for (auto& [name, frames] : named) source.clips.push_back(std::move(frames));
   return source;
+}
+
+std::size_t TextureSource::count() const {
+  switch (kind) {
+    case Kind::kDefault:
+      return 0;
+    case Kind::kNoise:
+      return noise_textures().size();
+    case Kind::kFolder:
+      return clips.size();
+  }
+  return 0;
 }
 
 bool VariationConfig::active() const {
@@ -140,7 +177,12 @@ std::vector<ParamSpec> VariationConfig::params() {
        "picked per episode)"},
       {"sky_texture", std::string("gradient"),
        "the background: \"gradient\", \"noise\" (procedural images) or a folder of .png/.jpg "
-       "images, e.g. video frames (one picked per episode)"},
+       "images, or of subfolders each holding one video's frames (one image picked per "
+       "episode)"},
+      {"sky_backgrounds", 0,
+       "how many of sky_texture's backgrounds (its images and videos, or the noise images) "
+       "episodes pick from, the first by name; 0: all (the Distracting Control Suite: 4 at easy, "
+       "8 at medium, all at hard)"},
       {"floor_opacity", 1.0, "how much of the background the floor hides, 0 to 1"}};
 }
 
@@ -161,6 +203,18 @@ VariationConfig VariationConfig::from_params(const Params& params, const std::st
   config.sky =
       TextureSource::parse(params.at("sky_texture").as_string(), "gradient", "sky_texture", env);
   config.floor_opacity = static_cast<float>(read_level(params, "floor_opacity", false, env));
+  const std::int64_t backgrounds = params.at("sky_backgrounds").as_int();
+  const std::size_t available = config.sky.count();
+  if (backgrounds < 0 || (backgrounds > 0 && static_cast<std::size_t>(backgrounds) > available)) {
+    const std::string source = params.at("sky_texture").as_string();
+    throw std::invalid_argument(
+        env + ": sky_backgrounds must be in [0, " + std::to_string(available) + "] (0: all of " +
+        (available == 0 ? "them; sky_texture \"" + source +
+                              "\" has none: give \"noise\" or a folder for it to count)"
+                        : "sky_texture \"" + source + "\"'s " + std::to_string(available) + ")") +
+        ", got " + std::to_string(backgrounds));
+  }
+  config.sky_backgrounds = static_cast<std::size_t>(backgrounds);
   return config;
 }
 
@@ -260,20 +314,18 @@ std::shared_ptr<const render::TextureImage> VisualVariation::load(const std::str
 }
 
 std::shared_ptr<const render::TextureImage> VisualVariation::pick(const TextureSource& source,
-                                                                  Rng& rng) {
-  switch (source.kind) {
-    case TextureSource::Kind::kDefault:
-      return nullptr;
-    case TextureSource::Kind::kNoise: {
-      const auto& images = noise_textures();
-      return images[static_cast<std::size_t>(
-          rng.integer(0, static_cast<std::int64_t>(images.size()) - 1))];
-    }
-    case TextureSource::Kind::kFolder:
-      return load(source.files[static_cast<std::size_t>(
-          rng.integer(0, static_cast<std::int64_t>(source.files.size()) - 1))]);
-  }
-  return nullptr;
+                                                                  std::size_t limit, Rng& rng) {
+  const std::size_t count = limit > 0 ? std::min(limit, source.count()) : source.count();
+  if (count == 0) return nullptr;
+  const auto index = static_cast<std::size_t>(rng.integer(0, static_cast<std::int64_t>(count) - 1));
+  if (source.kind == TextureSource::Kind::kNoise) return noise_textures()[index];
+  // A video shows one of its frames (a background of one image draws nothing more).
+  const std::vector<std::string>& frames = source.clips[index];
+  const std::size_t frame =
+      frames.size() == 1
+          ? 0
+          : static_cast<std::size_t>(rng.integer(0, static_cast<std::int64_t>(frames.size()) - 1));
+  return load(frames[frame]);
 }
 
 VariationSample VisualVariation::sample(std::size_t instance_count, Rng& rng) {
@@ -294,9 +346,9 @@ VariationSample VisualVariation::sample(std::size_t instance_count, Rng& rng) {
   const Eigen::Vector3f tint = shifted(Eigen::Vector3f::Ones(), textures, rng);
   out.sky.horizon = shifted(base_sky_.horizon, textures, rng);
   out.sky.zenith = shifted(base_sky_.zenith, textures, rng);
-  out.floor.image = pick(config_.floor, rng);
+  out.floor.image = pick(config_.floor, 0, rng);
   if (out.floor.image != nullptr) out.floor.color_a = tint;
-  out.sky.image = pick(config_.sky, rng);
+  out.sky.image = pick(config_.sky, config_.sky_backgrounds, rng);
   out.floor.opacity = config_.floor_opacity;
 
   const auto light = static_cast<float>(config_.light);

@@ -24,14 +24,20 @@ struct TextureSource {
   Kind kind = Kind::kDefault;
   /// The folder, for kFolder.
   std::string folder;
-  /// The folder's images, sorted by name (read when an episode first shows them).
-  std::vector<std::string> files;
+  /// The folder's backgrounds, sorted by name: each image directly in it is one of a single frame,
+  /// and each subfolder holding images is one video, its frames sorted by name (the layout of
+  /// DAVIS's JPEGImages/480p). Read when an episode first shows them.
+  std::vector<std::vector<std::string>> clips;
 
   /// `text` read as `key`'s value: `default_name` ("checker" or "gradient"), "noise", or a folder
-  /// holding at least one .png, .jpg or .jpeg file. Throws std::invalid_argument naming `context`,
-  /// `key` and the text for a folder that does not exist, is not a folder, or holds no image.
+  /// holding at least one .png, .jpg or .jpeg file, directly or in its subfolders. Throws
+  /// std::invalid_argument naming `context`, `key` and the text for a folder that does not exist,
+  /// is not a folder, or holds no image.
   static TextureSource parse(const std::string& text, const std::string& default_name,
                              const std::string& key, const std::string& context);
+  /// How many backgrounds an episode picks from: the folder's clips, the noise images, or 0 for
+  /// the task's own look.
+  std::size_t count() const;
 };
 
 /// The settings of visual variation: a level per factor in [0, 1] (0: the task as it is drawn),
@@ -59,17 +65,20 @@ struct VariationConfig {
   TextureSource sky;
   /// The floor's opacity (render::Floor::opacity): below 1 the sky shows through it.
   float floor_opacity = 1.0F;
+  /// How many of the sky's backgrounds episodes pick from, the first by name (0: all of them).
+  /// The Distracting Control Suite uses 4 videos at easy, 8 at medium and all at hard.
+  std::size_t sky_backgrounds = 0;
 
   /// Whether anything differs from the task as it is drawn.
   bool active() const;
 
   /// The `make` kwargs: variation (the level of every factor), vary_colors, vary_textures,
   /// vary_light, vary_camera, vary_fov (each -1 to follow variation), floor_texture, sky_texture,
-  /// floor_opacity.
+  /// sky_backgrounds, floor_opacity.
   static std::vector<ParamSpec> params();
   /// Reads resolved kwargs. Throws std::invalid_argument naming `env`, the key and the value for a
-  /// level outside [0, 1] (vary_* may also be -1), an opacity outside [0, 1], or a texture source
-  /// TextureSource::parse refuses.
+  /// level outside [0, 1] (vary_* may also be -1), an opacity outside [0, 1], a texture source
+  /// TextureSource::parse refuses, or sky_backgrounds below 0 or above the sky's count.
   static VariationConfig from_params(const Params& params, const std::string& env);
 };
 
@@ -109,7 +118,10 @@ class VisualVariation {
                               float pivot_distance_m);
 
  private:
-  std::shared_ptr<const render::TextureImage> pick(const TextureSource& source, Rng& rng);
+  /// One of the first `limit` (0: all) of `source`'s backgrounds, and for a video one of its
+  /// frames; null for the task's own look.
+  std::shared_ptr<const render::TextureImage> pick(const TextureSource& source, std::size_t limit,
+                                                   Rng& rng);
   std::shared_ptr<const render::TextureImage> load(const std::string& path);
 
   VariationConfig config_;

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -202,6 +203,11 @@ void write_solid_png(const fs::path& path, int side, std::uint8_t r, std::uint8_
   render::write_png(path.string(), image.view());
 }
 
+bool ends_with(const std::string& text, const std::string& tail) {
+  return text.size() >= tail.size() &&
+         text.compare(text.size() - tail.size(), tail.size(), tail) == 0;
+}
+
 std::string error_of(const std::string& id, const Params& kwargs) {
   try {
     make(id, kwargs)->reset(0);
@@ -216,8 +222,12 @@ TEST(VariationErrorsTest, BadSettingsAreErrorsThatNameThem) {
   fs::create_directories(folder / "empty");
   std::ofstream(folder / "notes.txt") << "not an image";
 
-  EXPECT_NE(error_of(kTask, {{"variation", 1.5}}).find("variation must be in [0, 1], got 1.5"),
-            std::string::npos);
+  // Levels are printed as given ("got 1.5", not "got 1.500000").
+  EXPECT_TRUE(
+      ends_with(error_of(kTask, {{"variation", 1.5}}), ": variation must be in [0, 1], got 1.5"))
+      << error_of(kTask, {{"variation", 1.5}});
+  EXPECT_TRUE(ends_with(error_of(kTask, {{"camera_fov", 172.5}}), "got 172.5"))
+      << error_of(kTask, {{"camera_fov", 172.5}});
   EXPECT_NE(error_of(kTask, {{"vary_camera", -0.5}}).find("vary_camera must be in [0, 1]"),
             std::string::npos);
   EXPECT_NE(error_of(kTask, {{"floor_opacity", 2.0}}).find("floor_opacity must be in [0, 1]"),
@@ -247,6 +257,9 @@ TEST(VariationErrorsTest, BadSettingsAreErrorsThatNameThem) {
   EXPECT_NE(error_of("CartPoleSwingup-distracting-v1", {{"variation", 7}})
                 .find("CartPoleSwingup-distracting-v1: variation must be in [0, 1], got 7"),
             std::string::npos);
+  EXPECT_TRUE(ends_with(error_of(kTask, {{"vary_camera", 0.25}, {"vary_fov", 1.75}}),
+                        "vary_fov must be in [0, 1] (or -1 to follow variation), got 1.75"))
+      << error_of(kTask, {{"vary_fov", 1.75}});
   fs::remove_all(folder);
 }
 
@@ -298,6 +311,73 @@ TEST(VariationTexturesTest, AFolderOfImagesIsDrawnAsTheSky) {
     EXPECT_EQ(row[x * 3 + 1], 10) << x;
   }
   fs::remove_all(folder);
+}
+
+// A folder of subfolders is a folder of videos (DAVIS's layout): an episode picks one of the first
+// sky_backgrounds of them (images directly in the folder count as one each), then one frame.
+TEST(VariationTexturesTest, SubfoldersAreVideosAndSkyBackgroundsTakesTheFirstByName) {
+  const fs::path folder = fresh_folder("videos");
+  // Backgrounds by name: "a.png" (grey), then the videos "b" (reds), "c" (greens), "d" (blues).
+  write_solid_png(folder / "a.png", 8, 90, 90, 90);
+  const std::uint8_t shades[3] = {150, 190, 230};
+  for (const char* video : {"b", "c", "d"}) fs::create_directories(folder / video);
+  for (int frame = 0; frame < 3; ++frame) {
+    const std::string name = "0000" + std::to_string(frame) + ".png";
+    write_solid_png(folder / "b" / name, 8, shades[frame], 0, 0);
+    write_solid_png(folder / "c" / name, 8, 0, shades[frame], 0);
+    write_solid_png(folder / "d" / name, 8, 0, 0, shades[frame]);
+  }
+  fs::create_directories(folder / "e_empty");
+  // The colours the sky shows over 96 seeds, at a count of `backgrounds`.
+  const auto seen = [&](int backgrounds) {
+    std::set<std::array<int, 3>> colors;
+    const std::unique_ptr<Env> env =
+        make(kTask, small({{"sky_texture", folder.string()}, {"sky_backgrounds", backgrounds}}));
+    for (std::uint64_t seed = 0; seed < 96; ++seed) {
+      env->reset(seed);
+      const std::vector<std::uint8_t>& pixels =
+          pixel_env(*env).variation().sky.image->image().pixels;
+      colors.insert({pixels[0], pixels[1], pixels[2]});
+    }
+    return colors;
+  };
+  const std::set<std::array<int, 3>> two = seen(2);
+  std::set<std::array<int, 3>> expected = {{90, 90, 90}};
+  for (const std::uint8_t shade : shades) expected.insert({shade, 0, 0});
+  EXPECT_EQ(two, expected);
+  const std::set<std::array<int, 3>> all = seen(0);
+  for (const std::uint8_t shade : shades) {
+    expected.insert({0, shade, 0});
+    expected.insert({0, 0, shade});
+  }
+  EXPECT_EQ(all, expected);
+  EXPECT_EQ(seen(4), all);
+  fs::remove_all(folder);
+}
+
+TEST(VariationTexturesTest, SkyBackgroundsLimitsTheNoiseImages) {
+  const std::unique_ptr<Env> env =
+      make(kTask, small({{"sky_texture", "noise"}, {"sky_backgrounds", 4}}));
+  const auto& noise = noise_textures();
+  std::set<const render::TextureImage*> seen;
+  for (std::uint64_t seed = 0; seed < 48; ++seed) {
+    env->reset(seed);
+    seen.insert(pixel_env(*env).variation().sky.image.get());
+  }
+  EXPECT_EQ(seen, (std::set<const render::TextureImage*>{noise[0].get(), noise[1].get(),
+                                                         noise[2].get(), noise[3].get()}));
+}
+
+TEST(VariationErrorsTest, SkyBackgroundsOutsideTheSkysCountIsAnError) {
+  EXPECT_TRUE(ends_with(error_of(kTask, {{"sky_texture", "noise"}, {"sky_backgrounds", 17}}),
+                        "sky_backgrounds must be in [0, 16] (0: all of sky_texture \"noise\"'s "
+                        "16), got 17"))
+      << error_of(kTask, {{"sky_texture", "noise"}, {"sky_backgrounds", 17}});
+  EXPECT_NE(error_of(kTask, {{"sky_texture", "noise"}, {"sky_backgrounds", -1}}).find("got -1"),
+            std::string::npos);
+  EXPECT_NE(error_of(kTask, {{"sky_backgrounds", 4}})
+                .find("sky_texture \"gradient\" has none: give \"noise\" or a folder"),
+            std::string::npos);
 }
 
 TEST(CamerasTest, SeveralNamedCamerasAreImagesOfTheirOwnInTheDict) {
