@@ -26,14 +26,53 @@ namespace {
 constexpr float kFloorDepthOffset = 1.0F;
 constexpr float kFootprintDepthOffset = 0.5F;
 
+// Half the side of the floor's square, m.
+constexpr float kFloorHalfSide = 500.0F;
+
 // The floor: a large square (its checker pattern comes from world coordinates).
 std::shared_ptr<const MeshData> make_floor_mesh() {
   auto mesh = std::make_shared<MeshData>();
-  const float half = 500.0F;
+  const float half = kFloorHalfSide;
   mesh->positions = {{-half, -half, 0}, {half, -half, 0}, {half, half, 0}, {-half, half, 0}};
   mesh->normals.assign(4, Eigen::Vector3f::UnitZ());
   mesh->indices = {0, 1, 2, 0, 2, 3};
   return mesh;
+}
+
+// The floor is drawn pushed back (polygon offset, more the more it slants away from the camera)
+// so that shapes resting on it win the depth test; that push would show in the depth image, up to
+// a tenth of the distance at grazing angles. So wherever a pixel sees the floor plane or something
+// behind it (which the opaque floor hides: it is the floor that is seen), its depth is set to the
+// plane's own along that pixel's centre ray, in eye depth as read_depth gives it.
+void exact_floor_depth(const Camera& camera, const Eigen::Matrix4f& view_projection, float height_m,
+                       float* depth) {
+  // In double: the far plane's points are tens of metres away, the depths wanted to a millimetre.
+  const Eigen::Matrix4d unproject = view_projection.cast<double>().inverse();
+  const Eigen::Vector4d depth_row = -camera.view_matrix().cast<double>().row(2).transpose();
+  // Unprojected points are linear in the pixel's x before their division by w.
+  const Eigen::Vector4d step_x = unproject.col(0);
+  for (int y = 0; y < camera.height; ++y) {
+    const double ndc_y = (2.0 * y + 1.0) / camera.height - 1.0;
+    const Eigen::Vector4d near_row = unproject * Eigen::Vector4d(0.0, ndc_y, -1.0, 1.0);
+    const Eigen::Vector4d far_row = unproject * Eigen::Vector4d(0.0, ndc_y, 1.0, 1.0);
+    for (int x = 0; x < camera.width; ++x) {
+      const double ndc_x = (2.0 * x + 1.0) / camera.width - 1.0;
+      const Eigen::Vector4d near_h = near_row + ndc_x * step_x;
+      const Eigen::Vector4d far_h = far_row + ndc_x * step_x;
+      const Eigen::Vector3d near = near_h.head<3>() / near_h.w();
+      const Eigen::Vector3d far = far_h.head<3>() / far_h.w();
+      const double rise = far.z() - near.z();
+      if (rise == 0.0) continue;
+      const double t = (height_m - near.z()) / rise;
+      if (!(t >= 0.0 && t <= 1.0)) continue;  // the plane is not between the clipping planes
+      const Eigen::Vector3d hit = near + t * (far - near);
+      if (std::abs(hit.x()) > kFloorHalfSide || std::abs(hit.y()) > kFloorHalfSide) continue;
+      const auto plane_depth = static_cast<float>(depth_row.dot(hit.homogeneous()));
+      float& seen = depth[static_cast<std::size_t>(y) * static_cast<std::size_t>(camera.width) +
+                          static_cast<std::size_t>(x)];
+      if (seen > plane_depth) seen = plane_depth;
+    }
+  }
 }
 
 // Everything the background (sky and floor without shadows) depends on, written into `key`.
@@ -402,6 +441,9 @@ struct ContextGroup::State {
     if (out.rgb != nullptr) read_rgb(camera.width, camera.height, readback, out.rgb);
     if (out.depth != nullptr) {
       read_depth(camera.width, camera.height, camera.near_m, camera.far_m, out.depth);
+      if (scene.floor.enabled) {
+        exact_floor_depth(camera, view_projection, scene.floor.height_m, out.depth);
+      }
     }
     if (out.segmentation != nullptr) {
       render_segmentation(scene, camera, view_projection, floor_mesh, out.segmentation);

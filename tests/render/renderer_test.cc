@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <thread>
 
 namespace pixelgym::render {
@@ -103,6 +104,50 @@ TEST(RendererTest, DepthOfAPlaneAtAKnownDistanceWithinOneMillimetre) {
   Scene empty = flat_scene();
   renderer.render(empty, camera, {kSize, kSize, nullptr, depth.data()});
   EXPECT_EQ(depth[0], camera.far_m);
+}
+
+// The floor is drawn pushed back in depth (so that what rests on it wins the depth test), which
+// must not show in the depth image: each floor pixel's depth is the plane's along the pixel's
+// centre ray, worked out here from the camera alone, at grazing angles too.
+TEST(RendererTest, FloorDepthIsThePlanesOwnEvenAtGrazingAngles) {
+  Renderer renderer;
+  Scene scene = flat_scene();
+  scene.floor.enabled = true;
+  scene.floor.height_m = 0.1F;
+  // A box resting on the floor, in the middle of the view.
+  scene.instances.push_back(box({0, 0, 0.35F}, {0.5F, 0.5F, 0.5F}, {1, 0, 0, 1}, 5));
+  for (const Eigen::Vector3f& eye : {Eigen::Vector3f(0, -6, 0.45F), Eigen::Vector3f(2, -3, 2.5F)}) {
+    Camera camera = Camera::look_at(eye, {0, 0, 0.3F});
+    camera.width = kSize;
+    camera.height = kSize;
+    std::vector<float> depth(kSize * kSize);
+    std::vector<std::int32_t> ids(kSize * kSize);
+    renderer.render(scene, camera, {kSize, kSize, nullptr, depth.data(), ids.data()});
+    const float tan_half = std::tan(camera.fov_y_deg * 3.14159265F / 360.0F);
+    int floor_pixels = 0;
+    for (int row = 0; row < kSize; ++row) {
+      for (int col = 0; col < kSize; ++col) {
+        // The ray through the pixel's centre in the camera's frame (it looks along -z, y up,
+        // rows top first), scaled to eye depth 1, then in the world.
+        const Eigen::Vector3f ray((2.0F * col + 1.0F - kSize) / kSize * tan_half,
+                                  (kSize - 2.0F * row - 1.0F) / kSize * tan_half, -1.0F);
+        const Eigen::Vector3f world = camera.X_world_camera.linear() * ray;
+        const auto p = static_cast<std::size_t>(row * kSize + col);
+        if (ids[p] != -1) continue;  // the box or the sky
+        ASSERT_LT(world.z(), 0.0F);
+        const float plane = (scene.floor.height_m - eye.z()) / world.z();
+        const float seen = depth[p];
+        ++floor_pixels;
+        ASSERT_NEAR(seen, plane, 1e-3F + 1e-4F * plane)
+            << "row " << row << ", column " << col << ", camera at " << eye.transpose();
+      }
+    }
+    EXPECT_GT(floor_pixels, kSize * kSize / 4) << eye.transpose();
+    // The box is still in front: its middle is drawn, nearer than its centre.
+    const auto middle = static_cast<std::size_t>(kSize / 2 * kSize + kSize / 2);
+    EXPECT_EQ(ids[middle], 5) << eye.transpose();
+    EXPECT_LT(depth[middle], (eye - Eigen::Vector3f(0, 0, 0.35F)).norm()) << eye.transpose();
+  }
 }
 
 TEST(RendererTest, SegmentationIdsAreExact) {
