@@ -315,11 +315,24 @@ render::Renderer& PixelEnv::renderer() {
 
 void PixelEnv::do_reset(std::optional<std::uint64_t> seed, const Options& options,
                         ResetResult& out) {
+  // Options set the visual variation's kwargs from this reset on, over the env's own: checked
+  // against them (names and types), and read as make() reads them, before anything changes.
+  std::optional<VariationConfig> changed;
+  std::unique_ptr<VisualVariation> next;
   if (!options.empty()) {
-    throw std::invalid_argument(name() + ": reset() takes no options, got \"" +
-                                options.begin()->first + "\"");
+    std::vector<ParamSpec> current = VariationConfig::params();
+    for (ParamSpec& spec : current) spec.default_value = config_.variation.settings.at(spec.name);
+    changed = VariationConfig::from_params(
+        resolve_params(current, options,
+                       name() + ": reset options (the visual variation's kwargs)"),
+        name());
+    if (changed->active()) {
+      next = variation_ != nullptr ? variation_->with_config(*changed)
+                                   : std::make_unique<VisualVariation>(*changed, scene_->scene());
+    }
   }
-  if (variation_ != nullptr) {
+  VisualVariation* drawing = changed.has_value() ? next.get() : variation_.get();
+  if (drawing != nullptr) {
     // Drawn first: an image that cannot be read fails the reset before anything has changed.
     constexpr std::uint64_t kVariationStream = 0x76697375616c5f76ULL;  // "visual_v"
     if (seed.has_value()) {
@@ -327,9 +340,18 @@ void PixelEnv::do_reset(std::optional<std::uint64_t> seed, const Options& option
     } else if (!variation_rng_.has_value()) {
       variation_rng_.emplace(rng().state()[0] ^ kVariationStream);  // reads rng(), draws nothing
     }
-    variation_sample_ = variation_->sample(scene_->scene().instances.size(), *variation_rng_);
+    variation_sample_ = drawing->sample(scene_->scene().instances.size(), *variation_rng_);
     VisualVariation::apply(variation_sample_, scene_->scene());
     pivot_distance_m_.clear();
+  } else if (changed.has_value() && variation_ != nullptr) {
+    // Variation turned off: the task's own look again.
+    VisualVariation::apply(variation_->base(scene_->scene().instances.size()), scene_->scene());
+    variation_sample_ = VariationSample{};
+    pivot_distance_m_.clear();
+  }
+  if (changed.has_value()) {
+    config_.variation = std::move(*changed);
+    variation_ = std::move(next);
   }
   world_->reset();
   task_->initialize_episode(*world_, rng());

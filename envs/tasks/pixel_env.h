@@ -29,9 +29,11 @@ class PixelRenderResources;
 /// a GL context of its own); it is built in the constructor when observations hold pixels, and
 /// on the first render() call otherwise, so obs_mode="state" never creates a GL context unless
 /// asked to render. A PixelEnv never truncates on its own: the registry's TimeLimit does, after
-/// the task's episode length (Task::episode_length). reset() takes no options
-/// (std::invalid_argument names the first one given); a step whose command, state, observation
-/// or reward goes non-finite throws PhysicsDivergence.
+/// the task's episode length (Task::episode_length). reset()'s options are visual variation
+/// kwargs (VariationConfig::params: variation, vary_*, floor_texture, sky_texture,
+/// sky_backgrounds, floor_opacity), which replace the env's from that reset on; any other key, a
+/// wrong type or a bad value is std::invalid_argument, and the env is as it was. A step whose
+/// command, state, observation or reward goes non-finite throws PhysicsDivergence.
 class PixelEnv final : public Env {
  public:
   /// Builds the world (Task::build) and, when observations hold pixels, the renderer. `config`
@@ -119,7 +121,7 @@ class PixelEnv final : public Env {
   std::int64_t frames_rendered_ = 0;
   // Visual variation: drawn at reset from a generator of its own (seeded from the reset seed),
   // so that the physics' generator, rng(), draws the same numbers with it on or off.
-  std::unique_ptr<VisualVariation> variation_;  // null: the config varies nothing
+  std::unique_ptr<VisualVariation> variation_;  // null: config_.variation varies nothing
   VariationSample variation_sample_;
   std::optional<Rng> variation_rng_;
   std::map<std::string, float> pivot_distance_m_;  // per camera, this episode's

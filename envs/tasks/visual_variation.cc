@@ -215,6 +215,9 @@ VariationConfig VariationConfig::from_params(const Params& params, const std::st
         ", got " + std::to_string(backgrounds));
   }
   config.sky_backgrounds = static_cast<std::size_t>(backgrounds);
+  for (const ParamSpec& spec : VariationConfig::params()) {
+    config.settings.emplace(spec.name, params.at(spec.name));
+  }
   return config;
 }
 
@@ -311,6 +314,21 @@ std::shared_ptr<const render::TextureImage> VisualVariation::load(const std::str
   loaded_.emplace(path, texture);
   load_order_.push_back(path);
   return texture;
+}
+
+std::unique_ptr<VisualVariation> VisualVariation::with_config(VariationConfig config) const {
+  auto out = std::make_unique<VisualVariation>(*this);
+  out->config_ = std::move(config);
+  return out;
+}
+
+VariationSample VisualVariation::base(std::size_t instance_count) const {
+  VariationSample out;
+  out.color_offsets.assign(instance_count, Eigen::Vector3f::Zero());
+  out.floor = base_floor_;
+  out.sky = base_sky_;
+  out.light = base_light_;
+  return out;
 }
 
 std::shared_ptr<const render::TextureImage> VisualVariation::pick(const TextureSource& source,

@@ -68,6 +68,9 @@ struct VariationConfig {
   /// How many of the sky's backgrounds episodes pick from, the first by name (0: all of them).
   /// The Distracting Control Suite uses 4 videos at easy, 8 at medium and all at hard.
   std::size_t sky_backgrounds = 0;
+  /// The kwargs it was read from, each of params() with its value (for reset options that change
+  /// some of them).
+  Params settings;
 
   /// Whether anything differs from the task as it is drawn.
   bool active() const;
@@ -107,6 +110,10 @@ class VisualVariation {
   VisualVariation(VariationConfig config, const render::Scene& base);
 
   const VariationConfig& config() const { return config_; }
+  /// The same base look (and images read so far) under another config.
+  std::unique_ptr<VisualVariation> with_config(VariationConfig config) const;
+  /// The task's own look: no colour offsets, and the base floor, sky and light.
+  VariationSample base(std::size_t instance_count) const;
 
   /// A new episode's look, drawn from `rng` for `instance_count` instances. Throws
   /// std::runtime_error naming the file when an image it picks cannot be read.

@@ -53,6 +53,21 @@ def test_same_seed_gives_byte_identical_trajectories(env_id):
     assert not trajectories_equal(a, c)
 
 
+def test_reset_options_set_the_visual_variation_from_that_reset_on():
+    env = pixelgym.make("CartPoleSwingup-v1", width=48, height=48)
+    varied = pixelgym.make("CartPoleSwingup-v1", width=48, height=48, variation=0.3)
+    plain = pixelgym.make("CartPoleSwingup-v1", width=48, height=48)
+    obs, _ = env.reset(seed=3, options={"variation": 0.3})
+    assert same(obs, varied.reset(seed=3)[0])
+    assert not same(obs, plain.reset(seed=3)[0])
+    assert same(env.reset(seed=4)[0], varied.reset(seed=4)[0])
+    with pytest.raises(ValueError, match=r"variation must be in \[0, 1\], got 2"):
+        env.reset(seed=1, options={"variation": 2.0})
+    with pytest.raises(ValueError, match='unknown kwarg "colour"'):
+        env.reset(seed=1, options={"colour": 0.1})
+    assert same(env.reset(seed=5, options={"variation": 0})[0], plain.reset(seed=5)[0])
+
+
 def test_reset_with_the_same_seed_repeats_and_unseeded_reset_continues():
     env = pixelgym.make("PendulumSwingup-v0", obs_mode="state")
     first, _ = env.reset(seed=3)

@@ -380,6 +380,47 @@ TEST(VariationErrorsTest, SkyBackgroundsOutsideTheSkysCountIsAnError) {
             std::string::npos);
 }
 
+// reset()'s options set the variation's kwargs from that reset on (a curriculum, or evaluating
+// one policy under several settings without a new env): each reset looks exactly as an env made
+// with those kwargs does, turning it off gives the plain task's bytes back, and a bad option
+// changes nothing.
+TEST(VariationOptionsTest, ResetOptionsSetTheVariationFromThatResetOn) {
+  const std::unique_ptr<Env> env = make(kTask, small());
+  const std::unique_ptr<Env> plain = make(kTask, small());
+  const std::unique_ptr<Env> varied = make(kTask, small({{"variation", 0.3}}));
+  const std::unique_ptr<Env> camera = make(kTask, small({{"vary_camera", 0.3}}));
+  const auto same_frame = [](const Value& a, const Value& b) {
+    return pixels(a).equals(pixels(b)) && same_state(a, b);
+  };
+
+  EXPECT_TRUE(same_frame(env->reset(3, {{"variation", 0.3}}).obs, varied->reset(3).obs));
+  EXPECT_FALSE(same_frame(env->reset(3, {{"variation", 0.3}}).obs, plain->reset(3).obs));
+  // It stays for the resets after (an autoresetting vector env's too).
+  EXPECT_TRUE(same_frame(env->reset(4).obs, varied->reset(4).obs));
+  EXPECT_TRUE(same_frame(env->reset().obs, varied->reset().obs));
+  // Off again: the task's own look, byte for byte.
+  EXPECT_TRUE(same_frame(env->reset(5, {{"variation", 0}}).obs, plain->reset(5).obs));
+  EXPECT_TRUE(same_frame(env->reset(6, {{"vary_camera", 0.3}}).obs, camera->reset(6).obs));
+
+  const auto refusal = [&](const Options& options) {
+    try {
+      env->reset(7, options);
+    } catch (const std::invalid_argument& error) {
+      return std::string(error.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_NE(refusal({{"gravity", 3.0}}).find("reset options (the visual variation's kwargs)"),
+            std::string::npos)
+      << refusal({{"gravity", 3.0}});
+  EXPECT_NE(refusal({{"gravity", 3.0}}).find("vary_camera (float, default 0.3)"), std::string::npos)
+      << refusal({{"gravity", 3.0}});
+  EXPECT_TRUE(ends_with(refusal({{"variation", 1.5}}), "variation must be in [0, 1], got 1.5"));
+  EXPECT_NE(refusal({{"sky_texture", 2}}).find("sky_texture"), std::string::npos);
+  // None of them changed anything: the next reset is as before them.
+  EXPECT_TRUE(same_frame(env->reset(8).obs, camera->reset(8).obs));
+}
+
 TEST(CamerasTest, SeveralNamedCamerasAreImagesOfTheirOwnInTheDict) {
   const std::unique_ptr<Env> env = make(kTask, small({{"cameras", "close,tracking"}}));
   const auto& space = dynamic_cast<const spaces::Dict&>(env->observation_space());
