@@ -395,13 +395,15 @@ void PixelEnv::observe(Value& obs) {
     return;
   }
   // Entries in observation_space() order: "pixels" first when present, then the state arrays.
+  // The scene takes the world's poses once, however many cameras draw it.
   std::vector<Value>& slots = obs.dict().values();
   std::size_t next = 0;
+  if (config_.has_pixels()) scene_->update(*world_);
   if (config_.has_pixels() && config_.cameras.empty()) {
-    render_camera_into(camera_, config_.msaa, slots[next++].array());
+    draw_camera_into(camera_, config_.msaa, slots[next++].array());
   }
   for (const std::string& name : config_.cameras) {
-    render_camera_into(name, config_.msaa, slots[next++].array());
+    draw_camera_into(name, config_.msaa, slots[next++].array());
   }
   if (config_.has_state()) {
     StateSlots state(state_specs_, slots.data() + next);
@@ -427,13 +429,17 @@ Array PixelEnv::render_camera(const std::string& camera, int width, int height, 
 }
 
 void PixelEnv::render_camera_into(const std::string& camera, int msaa_samples, Array& frame) {
+  scene_->update(*world_);
+  draw_camera_into(camera, msaa_samples, frame);
+}
+
+void PixelEnv::draw_camera_into(const std::string& camera, int msaa_samples, Array& frame) {
   const Shape& shape = frame.shape();
   if (frame.dtype() != DType::kUInt8 || shape.size() != 3 || shape[2] != 3) {
     throw std::invalid_argument(
         name() + ": a frame must be a uint8 (height, width, 3) array, got " +
         std::string(dtype_name(frame.dtype())) + " " + shape_to_string(shape));
   }
-  scene_->update(*world_);
   render::Camera view = view_of(camera);
   view.height = static_cast<int>(shape[0]);
   view.width = static_cast<int>(shape[1]);

@@ -97,6 +97,8 @@ class PixelEnv final : public Env {
 
  private:
   void observe(Value& obs);
+  // render_camera_into without updating the scene first: it draws the poses of the last update.
+  void draw_camera_into(const std::string& camera, int msaa_samples, Array& frame);
   // Camera `name` for the world as it is now: the task's or the custom one, with camera_fov and
   // this episode's camera variation.
   render::Camera view_of(const std::string& name);
